@@ -1,0 +1,249 @@
+/* polyc.h - learn compact polyline maps from aligned 2D laser scans.
+ *
+ * libpolyc implements Veeck & Burgard, "Learning Polyline Maps from Range
+ * Scan Data Acquired with Mobile Robots" (IROS 2004): a hit/miss grid built
+ * by ray casting, a contour of first-hit cells, traced into initial
+ * polylines, then optimised by local search on a BIC score.
+ *
+ * Memory: the caller owns everything. polyc_memory_size() says how many
+ * bytes a context needs for given limits; polyc_init() places the context
+ * inside that caller block. The library never allocates, never does I/O and
+ * keeps no global state: two contexts may be used from two threads.
+ *
+ * Units: metres, radians, counter-clockwise angles, in the frame of the poses.
+ * Errors: every call returns a polyc_status; POLYC_OK is 0. After an error
+ * the context stays valid; polyc_last_error() gives a static message.
+ *
+ * SPDX-License-Identifier: MIT
+ */
+#ifndef POLYC_H
+#define POLYC_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define POLYC_VERSION_MAJOR 0
+#define POLYC_VERSION_MINOR 1
+#define POLYC_VERSION_PATCH 0
+/* One number, comparable: major * 10000 + minor * 100 + patch. */
+#define POLYC_VERSION (POLYC_VERSION_MAJOR * 10000 + POLYC_VERSION_MINOR * 100 + POLYC_VERSION_PATCH)
+
+#if defined(POLYC_BUILD_SHARED) && defined(__GNUC__)
+#define POLYC_API __attribute__((visibility("default")))
+#else
+#define POLYC_API
+#endif
+
+/* Status codes. Append-only: values never change meaning. */
+typedef enum polyc_status {
+    POLYC_OK = 0,
+    POLYC_ERR_NULL = 1,      /* a required pointer was NULL */
+    POLYC_ERR_CONFIG = 2,    /* a configuration or limit is out of range */
+    POLYC_ERR_NOMEM = 3,     /* the memory block is too small for this work */
+    POLYC_ERR_SCAN = 4,      /* a scan is malformed (see polyc_last_error) */
+    POLYC_ERR_STATE = 5,     /* call out of order (e.g. results before build) */
+    POLYC_ERR_EXTENT = 6,    /* the data span more than config.max_extent_m */
+    POLYC_ERR_LIMIT = 7,     /* more scans or beams than the limits allow */
+    POLYC_ERR_RANGE = 8,     /* an index argument is out of range */
+    POLYC_ERR_STOPPED = 9    /* the progress callback asked to stop (result kept) */
+} polyc_status;
+
+/* Flags of polyc_config.flags. */
+#define POLYC_FLAG_EXACT_POINTS  0x1u /* keep every scan endpoint as its own data
+                                         point instead of one weighted point per
+                                         grid cell (slower, more memory) */
+#define POLYC_FLAG_NO_GRAZING    0x2u /* count misses all the way to the hit, as
+                                         the paper does (see docs/algorithm.md) */
+
+typedef struct polyc_config {
+    /* Grid (paper section III) */
+    float cell_m;              /* grid resolution; paper 0.025 */
+    float contour_threshold;   /* a cell is contour if m > this; paper 0.5 */
+    float data_min_m;          /* an endpoint is a data point only if its cell
+                                  has m >= this (rejects people, spurious hits) */
+    float free_range_m;        /* a beam with no return marks free space up to
+                                  this range (0: such beams are ignored) */
+    float grazing_cells;       /* skip misses in the last grazing_cells/sin(incidence)
+                                  cells before a hit (0 = off) */
+    float max_extent_m;        /* refuse data spanning more than this, either axis */
+    /* Optimiser (paper section IV) */
+    float alpha;               /* BIC weight of the error; paper 500 */
+    float gamma;               /* weight of the angle prior; 0 = uniform prior */
+    float merge_dist_m;        /* join polyline ends closer than this; paper 0.15 */
+    float split_gap_m;         /* split segments with a data gap longer; paper 0.20 */
+    float step_m;              /* hill-climbing step; paper 0.01 */
+    float noise_m;             /* initial std-dev of the vertex noise; paper 0.05 */
+    float noise_decay;         /* noise std-dev factor per iteration, (0, 1] */
+    float overlap_m;           /* polyline ends this close to another polyline are
+                                  zipped onto it */
+    float search_radius_m;     /* data farther than this from every segment costs
+                                  as if at this distance (bounds the search) */
+    uint32_t patience;         /* stop after this many iterations without a
+                                  better BIC; paper 5 */
+    uint32_t max_iterations;   /* hard cap on iterations (0 = no optimisation) */
+    uint32_t flags;            /* POLYC_FLAG_* */
+    uint32_t reserved;         /* must be 0 */
+    uint64_t seed;             /* PRNG seed: same input and seed, same map */
+} polyc_config;
+
+/* Upper bounds that size the memory block. */
+typedef struct polyc_limits {
+    uint32_t max_scans;        /* scans that may be added */
+    uint32_t max_beams;        /* beams, summed over all scans */
+    uint32_t max_grid_cells;   /* grid cells the map may touch (allocated in
+                                  tiles of 32 x 32 cells as beams reach them) */
+    uint32_t max_vertices;     /* polyline vertices (0: derived from max_beams) */
+} polyc_limits;
+
+/* One scan, as the laser saw it. Beam i points at
+ * pose_theta_rad + start_angle_rad + i * angle_step_rad. A range outside
+ * [min_range_m, max_range_m) is a beam with no return (free space only). */
+typedef struct polyc_scan {
+    double pose_x_m;
+    double pose_y_m;
+    double pose_theta_rad;
+    float start_angle_rad;
+    float angle_step_rad;
+    float min_range_m;
+    float max_range_m;
+    uint32_t beam_count;
+    uint32_t reserved;         /* must be 0 */
+    const float *range_m;      /* beam_count ranges; copied by polyc_add_scan */
+} polyc_scan;
+
+/* Axis-aligned box in metres. */
+typedef struct polyc_box {
+    double min_x_m, min_y_m, max_x_m, max_y_m;
+} polyc_box;
+
+/* One polyline of the result; points belong to the context and stay valid
+ * until the next call that changes the map (build, optimise, reset). */
+typedef struct polyc_polyline {
+    const float *xy_m;         /* point_count (x, y) pairs, interleaved */
+    uint32_t point_count;
+    uint32_t closed;           /* 1: the last point connects to the first */
+} polyc_polyline;
+
+typedef struct polyc_stats {
+    uint64_t beams;            /* beams added */
+    uint64_t beams_skipped;    /* beams dropped: NaN/inf range (counted, not data) */
+    uint64_t hits;             /* beams that returned inside the valid interval */
+    uint64_t data_points;      /* endpoints kept as data (hits in non-free cells) */
+    uint64_t memory_used_bytes;/* high-water mark of the block */
+    uint64_t memory_size_bytes;/* size of the block */
+    uint64_t grid_bytes;       /* memory the grid took (directory and tiles) */
+    double bic;                /* BIC of the current map (after optimise) */
+    double error_sq_m2;        /* sum of squared point distances (current map) */
+    uint32_t scans;
+    uint32_t grid_width;       /* grid size in cells */
+    uint32_t grid_height;
+    uint32_t grid_tiles;       /* tiles allocated */
+    uint32_t contour_cells;
+    uint32_t initial_polylines;
+    uint32_t initial_vertices;
+    uint32_t polylines;        /* current map */
+    uint32_t vertices;
+    uint32_t weighted_points;  /* data points as stored (cells or raw) */
+    uint32_t iterations;       /* optimiser iterations run */
+    uint32_t reserved;
+} polyc_stats;
+
+/* What the optimiser reports after each iteration (the paper's Fig. 10). */
+typedef struct polyc_iteration {
+    uint32_t iteration;
+    uint32_t vertices;
+    uint32_t polylines;
+    uint32_t reserved;
+    double bic;                /* BIC of the model at the end of this iteration */
+    double best_bic;           /* best BIC so far */
+    double noise_m;            /* vertex noise used in this iteration */
+} polyc_iteration;
+
+/* Called after each optimiser iteration; return non-zero to stop (the best
+ * map so far is kept and polyc_optimize returns POLYC_ERR_STOPPED). This is
+ * how a caller imposes a deadline: the library has no clock. */
+typedef int (*polyc_progress_fn)(void *user, const polyc_iteration *it);
+
+typedef struct polyc_ctx polyc_ctx;
+
+/* Version of the library actually linked (POLYC_VERSION format). */
+POLYC_API uint32_t polyc_version(void);
+/* Static, never NULL. */
+POLYC_API const char *polyc_status_str(polyc_status status);
+/* sizeof of the public struct named by `name` ("polyc_config", "polyc_limits",
+ * "polyc_scan", "polyc_box", "polyc_polyline", "polyc_stats",
+ * "polyc_iteration"), 0 if unknown: lets bindings detect ABI drift. */
+POLYC_API size_t polyc_struct_size(const char *name);
+
+/* The paper's parameters and this library's defaults. */
+POLYC_API void polyc_config_default(polyc_config *config);
+/* POLYC_OK or POLYC_ERR_CONFIG; *why (if not NULL) names the bad field. */
+POLYC_API polyc_status polyc_config_check(const polyc_config *config, const char **why);
+
+/* Limits for a known set of scans: counts and a grid bound from the extent
+ * of their endpoints (the same rule the grid uses). Pure; no memory. */
+POLYC_API polyc_status polyc_limits_for_scans(const polyc_config *config,
+                                              const polyc_scan *scans, uint32_t scan_count,
+                                              polyc_limits *out);
+/* Extends *box by the endpoints and pose of one scan (the extent rule). */
+POLYC_API void polyc_scan_extent(const polyc_config *config, const polyc_scan *scan,
+                                 polyc_box *box);
+
+/* Bytes needed for a context with these limits; 0 if config or limits are
+ * invalid or the size would overflow size_t. */
+POLYC_API size_t polyc_memory_size(const polyc_config *config, const polyc_limits *limits);
+
+/* Places a context in `block` (any alignment; `size` bytes, owned by the
+ * caller and untouched outside). The block must stay alive while the
+ * context is used; there is nothing to free. Copies config and limits. */
+POLYC_API polyc_status polyc_init(void *block, size_t size, const polyc_config *config,
+                                  const polyc_limits *limits, polyc_ctx **out);
+/* Forget scans and results; keep config, limits and block. */
+POLYC_API polyc_status polyc_reset(polyc_ctx *ctx);
+
+/* Copies one scan in. POLYC_ERR_SCAN for bad geometry (NaN pose, zero or
+ * negative step with beams, beam_count 0 is allowed and adds nothing);
+ * NaN/inf ranges are counted in stats.beams_skipped. */
+POLYC_API polyc_status polyc_add_scan(polyc_ctx *ctx, const polyc_scan *scan);
+
+/* Stage by stage (each runs the earlier ones if needed), or all at once. */
+POLYC_API polyc_status polyc_build_grid(polyc_ctx *ctx);   /* hit/miss grid */
+POLYC_API polyc_status polyc_extract_contour(polyc_ctx *ctx);
+POLYC_API polyc_status polyc_trace(polyc_ctx *ctx);        /* initial polylines */
+/* Optimise the current polylines; progress may be NULL. */
+POLYC_API polyc_status polyc_optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *user);
+/* build_grid + extract_contour + trace + optimize (if max_iterations > 0). */
+POLYC_API polyc_status polyc_build(polyc_ctx *ctx, polyc_progress_fn progress, void *user);
+
+/* Results: the current map. */
+POLYC_API uint32_t polyc_polyline_count(const polyc_ctx *ctx);
+POLYC_API polyc_status polyc_get_polyline(const polyc_ctx *ctx, uint32_t index,
+                                          polyc_polyline *out);
+/* Copies polyline `index` into xy_m (2 * capacity floats); *count gets its
+ * point count. xy_m may be NULL to ask for the count only. */
+POLYC_API polyc_status polyc_copy_polyline(const polyc_ctx *ctx, uint32_t index, float *xy_m,
+                                           uint32_t capacity, uint32_t *count,
+                                           uint32_t *closed);
+POLYC_API polyc_status polyc_get_stats(const polyc_ctx *ctx, polyc_stats *out);
+/* Current BIC of the map and its parts, recomputed from scratch. */
+POLYC_API polyc_status polyc_score(polyc_ctx *ctx, double *bic, double *error_sq_m2);
+
+/* The grid (after polyc_build_grid): origin of cell (0, 0)'s lower-left
+ * corner, size, and one cell's counters (0, 0 for cells never reached). */
+POLYC_API polyc_status polyc_grid_info(const polyc_ctx *ctx, double *origin_x_m,
+                                       double *origin_y_m, float *cell_m, uint32_t *width,
+                                       uint32_t *height);
+POLYC_API polyc_status polyc_grid_cell(const polyc_ctx *ctx, uint32_t ix, uint32_t iy,
+                                       uint32_t *hits, uint32_t *misses, uint32_t *contour);
+
+/* First error's static message and, for scans, the scan index (or -1). */
+POLYC_API const char *polyc_last_error(const polyc_ctx *ctx);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* POLYC_H */

@@ -1,0 +1,147 @@
+/* adjust.c - vertex positions (paper IV.D and IV.F).
+ * Takes: the optimiser state. Gives: hill climbing of each vertex in 8
+ * directions with a fixed step while the BIC falls, evaluated on the points
+ * near its two segments only; and Gaussian noise on all vertices. */
+#include "optimize.h"
+
+#include <math.h>
+
+static const float DIR_X[8] = {1.0f, 0.70710678f, 0.0f, -0.70710678f, -1.0f, -0.70710678f, 0.0f, 0.70710678f};
+static const float DIR_Y[8] = {0.0f, 0.70710678f, 1.0f, 0.70710678f, 0.0f, -0.70710678f, -1.0f, -0.70710678f};
+
+/* 1 - p(turn at b) for the path a -> b -> c */
+double polyc__turn_cost(const polyc__opt *o, float ax, float ay, float bx, float by, float cx, float cy)
+{
+    float ux = bx - ax, uy = by - ay, wx = cx - bx, wy = cy - by;
+    float turn = atan2f(fabsf(ux * wy - uy * wx), ux * wx + uy * wy);
+    return 1.0 - (double)polyc__prior_p(&o->prior, bx, by, turn);
+}
+
+/* Angle terms of v's neighbourhood with v at (x, y). */
+static double local_angles(const polyc__opt *o, int32_t v, float x, float y)
+{
+    if (o->cfg->gamma <= 0.0f)
+        return 0.0;
+    const polyc__vertex *V = o->s->v;
+    int32_t p = V[v].prev, n = V[v].next;
+    double sum = 0.0;
+    if (p != POLYC__NONE && n != POLYC__NONE)
+        sum += polyc__turn_cost(o, V[p].x, V[p].y, x, y, V[n].x, V[n].y);
+    if (p != POLYC__NONE && V[p].prev != POLYC__NONE && V[p].prev != v)
+        sum += polyc__turn_cost(o, V[V[p].prev].x, V[V[p].prev].y, V[p].x, V[p].y, x, y);
+    if (n != POLYC__NONE && V[n].next != POLYC__NONE && V[n].next != v)
+        sum += polyc__turn_cost(o, x, y, V[n].x, V[n].y, V[V[n].next].x, V[V[n].next].y);
+    return sum;
+}
+
+static int segs_at(const polyc__opt *o, int32_t v, float x, float y, float *xy)
+{
+    const polyc__vertex *V = o->s->v;
+    int n = 0;
+    if (V[v].prev != POLYC__NONE) {
+        xy[4 * n] = V[V[v].prev].x;
+        xy[4 * n + 1] = V[V[v].prev].y;
+        xy[4 * n + 2] = x;
+        xy[4 * n + 3] = y;
+        n++;
+    }
+    if (V[v].next != POLYC__NONE) {
+        xy[4 * n] = x;
+        xy[4 * n + 1] = y;
+        xy[4 * n + 2] = V[V[v].next].x;
+        xy[4 * n + 3] = V[V[v].next].y;
+        n++;
+    }
+    return n;
+}
+
+/* Moves v by steps of step_m while the local score (error plus gamma times
+ * the angle terms) falls; the move is then committed as one change. */
+int polyc__hill_climb(polyc__opt *o, int32_t v)
+{
+    const polyc__vertex *V = o->s->v;
+    if (V[v].line == POLYC__NONE || (V[v].prev == POLYC__NONE && V[v].next == POLYC__NONE))
+        return 0;
+    float step = o->cfg->step_m, gamma = o->cfg->gamma;
+    float reach = 0.05f - step; /* the hash buckets cover this much movement */
+    float x0 = V[v].x, y0 = V[v].y, x = x0, y = y0;
+    int32_t old[2] = {V[v].prev, V[v].next != POLYC__NONE ? v : POLYC__NONE};
+    float xy[8];
+    int ns = segs_at(o, v, x, y, xy);
+    polyc__local_prepare(o, old, 2, xy, ns, reach + step);
+    double cur = polyc__local_current(o) + (double)gamma * local_angles(o, v, x, y);
+    int moved = 0;
+    for (int it = 0; it < 64; it++) {
+        double best = cur;
+        int best_d = -1;
+        for (int d = 0; d < 8; d++) {
+            float cx = x + step * DIR_X[d], cy = y + step * DIR_Y[d];
+            if ((cx - x0) * (cx - x0) + (cy - y0) * (cy - y0) > reach * reach)
+                continue;
+            ns = segs_at(o, v, cx, cy, xy);
+            double e = polyc__local_eval(o, xy, ns) + (double)gamma * local_angles(o, v, cx, cy);
+            if (e < best - 1e-12 * (1.0 + fabs(best))) {
+                best = e;
+                best_d = d;
+            }
+        }
+        if (best_d < 0)
+            break;
+        x += step * DIR_X[best_d];
+        y += step * DIR_Y[best_d];
+        cur = best;
+        moved = 1;
+    }
+    if (!moved)
+        return 0;
+    polyc__chg_begin(o);
+    polyc__op_move(o, v, x, y);
+    polyc__chg_commit(o);
+    return 1;
+}
+
+/* Rounds of hill climbing; after the first, only vertices next to one that
+ * moved in the previous round are climbed again. */
+int polyc__op_adjust(polyc__opt *o, int max_rounds)
+{
+    const polyc__store *s = o->s;
+    int total = 0;
+    uint32_t stamp = ++o->work_stamp;
+    for (int32_t v = 0; v < s->v_high; v++)
+        o->v_work[v] = stamp;
+    for (int r = 0; r < max_rounds; r++) {
+        uint32_t next = ++o->work_stamp;
+        int moved = 0;
+        for (int32_t v = 0; v < s->v_high; v++) {
+            if (o->v_work[v] != stamp || s->v[v].line == POLYC__NONE)
+                continue;
+            if (!polyc__hill_climb(o, v))
+                continue;
+            moved++;
+            o->v_work[v] = next;
+            int32_t nb[4] = {s->v[v].prev, s->v[v].next, POLYC__NONE, POLYC__NONE};
+            if (nb[0] != POLYC__NONE) nb[2] = s->v[nb[0]].prev;
+            if (nb[1] != POLYC__NONE) nb[3] = s->v[nb[1]].next;
+            for (int k = 0; k < 4; k++)
+                if (nb[k] != POLYC__NONE && o->v_work[nb[k]] != stamp)
+                    o->v_work[nb[k]] = next;
+        }
+        total += moved;
+        stamp = next;
+        if (!moved)
+            break;
+    }
+    return total;
+}
+
+/* Gaussian noise of std-dev sigma on every vertex, then a fresh score. */
+void polyc__op_noise(polyc__opt *o, double sigma_m)
+{
+    polyc__store *s = o->s;
+    for (int32_t v = 0; v < s->v_high; v++) {
+        if (s->v[v].line == POLYC__NONE)
+            continue;
+        s->v[v].x += (float)(sigma_m * polyc__rng_normal(&o->rng));
+        s->v[v].y += (float)(sigma_m * polyc__rng_normal(&o->rng));
+    }
+}

@@ -1,0 +1,468 @@
+/* angle_prior.c - the angle prior p(turn | x, y) of the paper's eq. (2), section IV.
+ * Takes: the stored scans and the grid's extent. Gives: per prior cell (one per
+ * 32 x 32 grid tile) a histogram of turn angles between lines fitted in single scans.
+ *
+ * Learning (polyc__prior_build). For every scan, the hits (min_m <= r < max_m),
+ * in beam order, are cut into clusters of consecutive hits; a cluster breaks at a
+ * beam that is not a hit or where two consecutive endpoints are more than
+ * GAP_M + GAP_STEPS * r * |step| apart (r the larger of the two ranges); the
+ * first and last beams of a 360 degree scan are not joined.
+ * Each cluster is cut into lines by split-and-merge: iterative end-point fit,
+ * splitting an interval at its farthest point when that point is more than
+ * TOL_M + TOL_REL * r off the chord (explicit stack, depth <= MAX_DEPTH); an
+ * interval still off at that depth is rejected. A line is kept when it has at
+ * least MIN_POINTS points and its chord is at least MIN_LEN_M long; adjacent kept
+ * lines whose union passes the chord test are merged; each line's direction is
+ * refined by a principal-axis (least-squares) fit of its points. Observations:
+ *  - corner: two kept lines of a cluster that share their split point give the
+ *    turn angle between their directions (0 = straight on, pi = folding back),
+ *    recorded at the split point's endpoint with weight CORNER_COUNT = 8;
+ *  - straight: every kept line gives turn 0, weight 1, at n = max(1, floor(L /
+ *    STRAIGHT_M)) points spread evenly along its fitted extent L.
+ * A corner weighs as much as 2 m of straight evidence: a scan that sees a corner
+ * also leaves about that much straight evidence of its two walls within reach of
+ * the query's 3 x 3 cells, so at a corner its angle holds about half the mass,
+ * while along a wall turn 0 holds nearly all of it.
+ * Bin b of a cell counts observations whose turn is nearest to b * 10 degrees
+ * (b = 0..17; bin 17 takes 165..180 degrees). A counter that would pass 65535
+ * halves all 18 counters of its cell first (the shares are kept).
+ *
+ * Query (polyc__prior_p), the formula:
+ *   C_b  = sum_j w_j c_j[b]   over the cell j0 containing (x, y) and its 8
+ *          neighbours (cells outside the grid contribute nothing), w = 4 for the
+ *          centre, 2 for the 4 edge neighbours, 1 for the 4 corner neighbours;
+ *   N    = sum_b C_b          (kept per cell, so no 18-bin loop at query time);
+ *   u    = turn / 10 degrees  (turn clamped to [0, pi], u to [0, 17]), k = round(u),
+ *          d = u - k in [-0.5, 0.5];
+ *   K    = triangular kernel of half-width 1.5 bins: K_{k-1} = 0.5 - d,
+ *          K_k = 1.5 - |d|, K_{k+1} = 0.5 + d (terms for bins outside 0..17 dropped),
+ *          S = sum of the K used;
+ *   p    = (sum_b K_b (C_b + EPS)) / (S * (N + 18 * EPS)),   EPS = 1 (pseudo-count).
+ * p is the kernel-weighted average over the bins next to `turn` of the smoothed
+ * share (C_b + EPS) / (N + 18 EPS): the share of the observations near (x, y)
+ * whose turn angle is within about 10 degrees of `turn`. It lies in (0, 1),
+ * is continuous in turn and never 0. Where there is no evidence (no observation
+ * within one cell, outside the grid, empty prior, NaN position) every share is
+ * 1/18, so p = 1/18 for every angle: a uniform prior, which leaves the choice of
+ * angles there to the data term.
+ *
+ * Memory: one arena block of cells * (18 uint16 counters + 1 uint32 total): the
+ * counters are p->hist, the totals follow them in the same block. The prior grid
+ * is the tile grid; if that grid has more cells than polyc__prior_bytes allows for
+ * (a long diagonal extent under a tight limits.max_grid_cells), prior cells are
+ * made K x K tiles for the smallest K that fits. */
+#include "internal.h"
+
+#include <math.h>
+#include <string.h>
+
+#define BINS POLYC__ANGLE_BINS
+#define BINS_PER_RAD 5.729577951f   /* 18 / pi: 10 degree bins */
+
+#define GAP_M 0.15f                 /* cluster break: fixed part */
+#define GAP_STEPS 3.0f              /* cluster break: beam spacings at range r */
+#define TOL_M 0.03f                 /* split tolerance: fixed part */
+#define TOL_REL 0.01f               /* split tolerance: share of the range */
+#define MIN_POINTS 4u               /* a line needs this many endpoints */
+#define MIN_LEN_M 0.10f             /* and a chord this long */
+#define STRAIGHT_M 0.25f            /* one straight observation per this length */
+#define MAX_DEPTH 16                /* split depth bound (no recursion) */
+#define CORNER_COUNT 8u             /* a corner counts as 2 m of straight evidence */
+#define EPS 1.0f                    /* pseudo-count per bin, in centre-weight / 4 units */
+
+/* Cells the prior may have: the bound grid.c puts on its directory when the
+ * extent is within 4x the tile budget. */
+static size_t cell_cap(const polyc_limits *lim)
+{
+    size_t tiles = ((size_t)lim->max_grid_cells + POLYC__TILE_CELLS - 1) / POLYC__TILE_CELLS;
+    return tiles * 4 + 64;
+}
+
+#define CELL_BYTES (BINS * sizeof(uint16_t) + sizeof(uint32_t))
+
+size_t polyc__prior_bytes(const polyc_limits *lim)
+{
+    return polyc__bytes(cell_cap(lim), CELL_BYTES);
+}
+
+/* per-cell totals, stored after the counters */
+static uint32_t *totals(const polyc__prior *p)
+{
+    return (uint32_t *)(void *)(p->hist + (size_t)p->w * (size_t)p->h * BINS);
+}
+
+/* ---- learning ---- */
+
+typedef struct fit_line {
+    uint32_t a, b;                 /* first and last beam */
+    float mx, my;                  /* centroid (frame metres) */
+    float dx, dy;                  /* unit direction, in beam order */
+    float t0, t1;                  /* extent along d from the centroid */
+    int ok;
+} fit_line;
+
+typedef struct prior_pass {
+    polyc__prior *p;
+    const polyc_ctx *ctx;
+    const polyc__scan *s;
+    float ox, oy;                  /* prior origin (frame metres) */
+    fit_line last, pend;           /* last emitted line, line pending a merge */
+    int have_last, have_pend;
+} prior_pass;
+
+static int is_hit(const polyc__scan *s, float r)
+{
+    return r >= s->min_m && r < s->max_m; /* false for NaN */
+}
+
+/* endpoint of beam i of the scan (frame metres), the beam angle as grid.c has it */
+static void endpoint(const prior_pass *q, uint32_t i, float *x, float *y, float *r)
+{
+    const polyc__scan *s = q->s;
+    float rr = q->ctx->ranges[s->first + i];
+    float a = s->theta_rad + s->start_rad + (float)i * s->step_rad;
+    *x = s->x_m + rr * cosf(a);
+    *y = s->y_m + rr * sinf(a);
+    *r = rr;
+}
+
+/* Adds `inc` to bin `bin` of the cell at (x, y); 0 when outside the grid. A
+ * counter that would pass 65535 halves its cell's counters first. */
+static int record(prior_pass *q, float x, float y, int bin, uint32_t inc)
+{
+    polyc__prior *p = q->p;
+    float fx = (x - q->ox) * p->inv_cell, fy = (y - q->oy) * p->inv_cell;
+    if (!(fx >= 0.0f && fy >= 0.0f && fx < (float)p->w && fy < (float)p->h))
+        return 0;
+    int32_t ix = (int32_t)fx, iy = (int32_t)fy;
+    if (ix >= p->w || iy >= p->h)
+        return 0;
+    uint16_t *c = p->hist + ((size_t)iy * (size_t)p->w + (size_t)ix) * BINS;
+    if (c[bin] > UINT16_MAX - inc)
+        for (int k = 0; k < BINS; k++)
+            c[k] = (uint16_t)(c[k] >> 1);
+    c[bin] = (uint16_t)(c[bin] + inc);
+    return 1;
+}
+
+/* Farthest endpoint strictly between a and b from the chord a-b; returns
+ * non-zero when it is off by more than the tolerance (*k gets it). */
+static int off_chord(const prior_pass *q, uint32_t a, uint32_t b, uint32_t *k)
+{
+    float ax, ay, bx, by, r;
+    endpoint(q, a, &ax, &ay, &r);
+    endpoint(q, b, &bx, &by, &r);
+    float tx = bx - ax, ty = by - ay;
+    float len = sqrtf(tx * tx + ty * ty);
+    float ux = 1.0f, uy = 0.0f;
+    int chord = len > 1e-6f;
+    if (chord) {
+        ux = tx / len;
+        uy = ty / len;
+    }
+    float best = -1.0f, best_tol = 0.0f;
+    *k = a;
+    for (uint32_t i = a + 1; i < b; i++) {
+        float x, y;
+        endpoint(q, i, &x, &y, &r);
+        float vx = x - ax, vy = y - ay;
+        float dist = chord ? fabsf(ux * vy - uy * vx) : sqrtf(vx * vx + vy * vy);
+        if (dist > best) {
+            best = dist;
+            best_tol = TOL_M + TOL_REL * r;
+            *k = i;
+        }
+    }
+    return best > best_tol;
+}
+
+/* Principal-axis fit of the endpoints a..b (two passes: mean, then moments). */
+static void fit(const prior_pass *q, uint32_t a, uint32_t b, fit_line *l)
+{
+    float ax, ay, bx, by, r;
+    endpoint(q, a, &ax, &ay, &r);
+    endpoint(q, b, &bx, &by, &r);
+    float n = (float)(b - a + 1);
+    float sx = 0.0f, sy = 0.0f;
+    for (uint32_t i = a; i <= b; i++) {
+        float x, y;
+        endpoint(q, i, &x, &y, &r);
+        sx += x - ax;
+        sy += y - ay;
+    }
+    float mx = sx / n, my = sy / n; /* relative to endpoint a */
+    float cxx = 0.0f, cxy = 0.0f, cyy = 0.0f;
+    for (uint32_t i = a; i <= b; i++) {
+        float x, y;
+        endpoint(q, i, &x, &y, &r);
+        float vx = x - ax - mx, vy = y - ay - my;
+        cxx += vx * vx;
+        cxy += vx * vy;
+        cyy += vy * vy;
+    }
+    /* major eigenvector of [[cxx, cxy], [cxy, cyy]] */
+    float half = 0.5f * (cxx - cyy);
+    float lam = 0.5f * (cxx + cyy) + sqrtf(half * half + cxy * cxy);
+    float v1x = lam - cyy, v1y = cxy, v2x = cxy, v2y = lam - cxx;
+    float n1 = v1x * v1x + v1y * v1y, n2 = v2x * v2x + v2y * v2y;
+    float dx = n1 >= n2 ? v1x : v2x, dy = n1 >= n2 ? v1y : v2y;
+    float nn = sqrtf(dx * dx + dy * dy);
+    float cx = bx - ax, cy = by - ay;
+    if (!(nn > 1e-12f)) { /* degenerate: the chord's direction */
+        dx = cx;
+        dy = cy;
+        nn = sqrtf(dx * dx + dy * dy);
+        if (!(nn > 1e-12f)) {
+            dx = 1.0f;
+            dy = 0.0f;
+            nn = 1.0f;
+        }
+    }
+    dx /= nn;
+    dy /= nn;
+    if (dx * cx + dy * cy < 0.0f) {
+        dx = -dx;
+        dy = -dy;
+    }
+    l->a = a;
+    l->b = b;
+    l->mx = ax + mx;
+    l->my = ay + my;
+    l->dx = dx;
+    l->dy = dy;
+    l->t0 = -(mx * dx + my * dy);
+    l->t1 = (cx - mx) * dx + (cy - my) * dy;
+    l->ok = b - a + 1 >= MIN_POINTS && sqrtf(cx * cx + cy * cy) >= MIN_LEN_M;
+}
+
+/* A final line: the corner with the line before it, straight evidence along it. */
+static void emit(prior_pass *q, const fit_line *l)
+{
+    polyc__prior *p = q->p;
+    if (q->have_last && q->last.b == l->a) {
+        float dot = q->last.dx * l->dx + q->last.dy * l->dy;
+        float cr = q->last.dx * l->dy - q->last.dy * l->dx;
+        float turn = atan2f(fabsf(cr), dot);
+        int bin = (int)(turn * BINS_PER_RAD + 0.5f);
+        if (bin > BINS - 1)
+            bin = BINS - 1;
+        float x, y, r;
+        endpoint(q, l->a, &x, &y, &r);
+        if (record(q, x, y, bin, CORNER_COUNT) && p->corners < UINT32_MAX)
+            p->corners++;
+    }
+    float len = l->t1 - l->t0;
+    uint32_t n = len > STRAIGHT_M ? (uint32_t)(len / STRAIGHT_M) : 1u;
+    float step = len / (float)n;
+    for (uint32_t j = 0; j < n; j++) {
+        float t = l->t0 + ((float)j + 0.5f) * step;
+        if (record(q, l->mx + t * l->dx, l->my + t * l->dy, 0, 1u) && p->straights < UINT32_MAX)
+            p->straights++;
+    }
+    q->last = *l;
+    q->have_last = 1;
+}
+
+static void flush(prior_pass *q)
+{
+    if (q->have_pend)
+        emit(q, &q->pend);
+    q->have_pend = 0;
+}
+
+/* One leaf of the end-point fit, in beam order: merge it into the pending line
+ * when their union passes the chord test (short leaves too), else emit the
+ * pending line and make the leaf pending if it is a line itself. */
+static void leaf(prior_pass *q, uint32_t a, uint32_t b, int fits)
+{
+    uint32_t k;
+    if (fits && q->have_pend && q->pend.b == a && !off_chord(q, q->pend.a, b, &k)) {
+        fit(q, q->pend.a, b, &q->pend);
+        return;
+    }
+    fit_line l;
+    l.ok = 0;
+    if (fits && b - a + 1 >= MIN_POINTS)
+        fit(q, a, b, &l);
+    flush(q);
+    if (!l.ok) {
+        q->have_last = 0; /* the chain of lines breaks here */
+        return;
+    }
+    q->pend = l;
+    q->have_pend = 1;
+}
+
+/* Split-and-merge of the cluster of beams i0..i1 (all hits). */
+static void cluster(prior_pass *q, uint32_t i0, uint32_t i1)
+{
+    struct { uint32_t a, b, depth; } st[MAX_DEPTH + 2];
+    int top = 0;
+    if (i1 - i0 + 1 < MIN_POINTS)
+        return;
+    q->have_last = q->have_pend = 0;
+    st[top].a = i0;
+    st[top].b = i1;
+    st[top].depth = 0;
+    top++;
+    while (top > 0) {
+        top--;
+        uint32_t a = st[top].a, b = st[top].b, depth = st[top].depth, k;
+        if (!off_chord(q, a, b, &k)) {
+            leaf(q, a, b, 1);
+            continue;
+        }
+        if (b - a + 1 < MIN_POINTS || depth >= MAX_DEPTH) {
+            leaf(q, a, b, 0); /* too short to hold a line, or too deep */
+            continue;
+        }
+        /* right half below the left: leaves come out in beam order; the stack
+         * holds at most one pending right half per level */
+        POLYC_ASSERT(top + 2 <= MAX_DEPTH + 2);
+        st[top].a = k;
+        st[top].b = b;
+        st[top].depth = depth + 1;
+        top++;
+        st[top].a = a;
+        st[top].b = k;
+        st[top].depth = depth + 1;
+        top++;
+    }
+    flush(q);
+}
+
+static void learn_scan(prior_pass *q)
+{
+    const polyc__scan *s = q->s;
+    const float *rr = q->ctx->ranges + s->first;
+    float gap_per_m = GAP_STEPS * fabsf(s->step_rad);
+    uint32_t start = 0;
+    int open = 0;
+    float px = 0.0f, py = 0.0f, pr = 0.0f;
+    for (uint32_t i = 0; i < s->count; i++) {
+        if (!is_hit(s, rr[i])) {
+            if (open)
+                cluster(q, start, i - 1);
+            open = 0;
+            continue;
+        }
+        float x, y, r;
+        endpoint(q, i, &x, &y, &r);
+        if (open) {
+            float dx = x - px, dy = y - py, rm = r > pr ? r : pr;
+            float gap = GAP_M + gap_per_m * rm;
+            if (dx * dx + dy * dy > gap * gap) {
+                cluster(q, start, i - 1);
+                open = 0;
+            }
+        }
+        if (!open) {
+            start = i;
+            open = 1;
+        }
+        px = x;
+        py = y;
+        pr = r;
+    }
+    if (open)
+        cluster(q, start, s->count - 1);
+}
+
+polyc_status polyc__prior_build(polyc_ctx *ctx, polyc__prior *p)
+{
+    const polyc__grid *g = &ctx->grid;
+    memset(p, 0, sizeof *p);
+    if (g->width <= 0 || g->height <= 0 || g->tiles_x <= 0 || g->tiles_y <= 0)
+        return POLYC_OK; /* no data: an empty prior, uniform everywhere */
+
+    /* prior cells of K x K tiles, K = 1 unless the tile grid is too large */
+    uint64_t cap = (uint64_t)cell_cap(&ctx->lim);
+    uint64_t tx = (uint64_t)g->tiles_x, ty = (uint64_t)g->tiles_y, k = 1;
+    while (((tx + k - 1) / k) * ((ty + k - 1) / k) > cap)
+        k++;
+    p->w = (int32_t)((tx + k - 1) / k);
+    p->h = (int32_t)((ty + k - 1) / k);
+    p->cell_m = g->cell_m * (float)POLYC__TILE_SIDE * (float)k;
+    p->inv_cell = 1.0f / p->cell_m;
+    p->origin_x = g->origin_x_m - ctx->frame_x;
+    p->origin_y = g->origin_y_m - ctx->frame_y;
+    size_t cells = (size_t)p->w * (size_t)p->h;
+    p->hist = polyc__alloc_zero(&ctx->arena, cells, CELL_BYTES);
+    if (!p->hist) {
+        memset(p, 0, sizeof *p);
+        return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the angle prior");
+    }
+
+    prior_pass q;
+    memset(&q, 0, sizeof q);
+    q.p = p;
+    q.ctx = ctx;
+    q.ox = (float)p->origin_x;
+    q.oy = (float)p->origin_y;
+    for (uint32_t si = 0; si < ctx->scan_count; si++) {
+        q.s = &ctx->scans[si];
+        learn_scan(&q);
+    }
+
+    uint32_t *tot = totals(p);
+    for (size_t c = 0; c < cells; c++) {
+        uint32_t n = 0;
+        for (int b = 0; b < BINS; b++)
+            n += p->hist[c * BINS + (size_t)b];
+        tot[c] = n;
+    }
+    return POLYC_OK;
+}
+
+/* ---- query (the optimiser's hot loop: no trigonometry, 9 cells x 3 bins) ---- */
+
+float polyc__prior_p(const polyc__prior *p, float x, float y, float turn_rad)
+{
+    const float uniform = 1.0f / (float)BINS;
+    if (p->w <= 0 || p->h <= 0 || !p->hist)
+        return uniform;
+    float fx = (x - (float)p->origin_x) * p->inv_cell;
+    float fy = (y - (float)p->origin_y) * p->inv_cell;
+    /* more than a cell outside (or NaN): no neighbour inside either */
+    if (!(fx >= -1.0f && fy >= -1.0f && fx < (float)p->w + 1.0f && fy < (float)p->h + 1.0f))
+        return uniform;
+    int32_t cx = (int32_t)floorf(fx), cy = (int32_t)floorf(fy);
+
+    float u = turn_rad * BINS_PER_RAD;
+    if (!(u > 0.0f)) /* also NaN */
+        u = 0.0f;
+    if (u > (float)(BINS - 1))
+        u = (float)(BINS - 1);
+    int k = (int)(u + 0.5f);
+    float d = u - (float)k;
+    float kl = 0.5f - d, kc = 1.5f - fabsf(d), kr = 0.5f + d;
+    if (k == 0)
+        kl = 0.0f;
+    if (k == BINS - 1)
+        kr = 0.0f;
+    int bl = k > 0 ? k - 1 : k, br = k < BINS - 1 ? k + 1 : k;
+
+    const uint32_t *tot = totals(p);
+    uint32_t cl = 0, cc = 0, cr = 0, n = 0; /* weighted sums (fit: 16 * 18 * 65535) */
+    for (int32_t j = -1; j <= 1; j++) {
+        int32_t iy = cy + j;
+        if (iy < 0 || iy >= p->h)
+            continue;
+        for (int32_t i = -1; i <= 1; i++) {
+            int32_t ix = cx + i;
+            if (ix < 0 || ix >= p->w)
+                continue;
+            uint32_t w = (uint32_t)(4 >> ((i != 0) + (j != 0)));
+            size_t c = (size_t)iy * (size_t)p->w + (size_t)ix;
+            const uint16_t *h = p->hist + c * BINS;
+            cl += w * h[bl];
+            cc += w * h[k];
+            cr += w * h[br];
+            n += w * tot[c];
+        }
+    }
+    float s = kl + kc + kr;
+    float num = kl * ((float)cl + EPS) + kc * ((float)cc + EPS) + kr * ((float)cr + EPS);
+    float pr = num / (s * ((float)n + (float)BINS * EPS));
+    return pr < 1.0f ? pr : 1.0f;
+}

@@ -1,0 +1,271 @@
+/* grid.c - the hit/miss grid (paper section III, eq. 1).
+ * Takes: the stored scans. Gives: per cell hits and misses, counted by exact
+ * traversal of every beam (Amanatides-Woo), in 32 x 32 tiles allocated only
+ * where beams pass, over the extent of the data. */
+#include "internal.h"
+
+#include <math.h>
+#include <string.h>
+
+/* A cell's two counters saturate by halving both, which keeps m = h/(h+m). */
+static void count_inc(polyc__count *a, polyc__count *b)
+{
+    if (*a == POLYC__COUNT_MAX) {
+        *a = (polyc__count)(*a >> 1);
+        *b = (polyc__count)(*b >> 1);
+    }
+    (*a)++;
+}
+
+size_t polyc__grid_budget_bytes(const polyc_limits *lim)
+{
+    size_t tiles = ((size_t)lim->max_grid_cells + POLYC__TILE_CELLS - 1) / POLYC__TILE_CELLS;
+    /* directory: one entry per tile of the bounding box; a bounding box up to
+     * 4x the tile budget (plus a small fixed part) fits */
+    size_t dir = polyc__bytes(tiles * 4 + 64, sizeof(uint32_t));
+    return polyc__add(polyc__bytes(tiles, sizeof(polyc__tile)), dir);
+}
+
+int polyc__cell_occupied(const polyc__tile *t, int idx, float threshold)
+{
+    unsigned h = t->hits[idx];
+    unsigned m = t->misses[idx];
+    return h > 0 && (float)h > threshold * (float)(h + m);
+}
+
+polyc__tile *polyc__grid_tile(const polyc__grid *g, int32_t ix, int32_t iy)
+{
+    if (ix < 0 || iy < 0 || ix >= g->width || iy >= g->height)
+        return NULL;
+    uint32_t d = g->dir[(iy >> POLYC__TILE_SHIFT) * g->tiles_x + (ix >> POLYC__TILE_SHIFT)];
+    return d ? &g->tiles[d - 1] : NULL;
+}
+
+/* Distance along the direction (dx, dy) from (sx, sy), inside the box
+ * [0, w] x [0, h], before leaving it (sx, sy inside). */
+static float exit_distance(float sx, float sy, float dx, float dy, float w, float h)
+{
+    float t = 1e30f;
+    if (dx > 0.0f) t = fminf(t, (w - sx) / dx);
+    if (dx < 0.0f) t = fminf(t, -sx / dx);
+    if (dy > 0.0f) t = fminf(t, (h - sy) / dy);
+    if (dy < 0.0f) t = fminf(t, -sy / dy);
+    return t < 0.0f ? 0.0f : t;
+}
+
+static int range_is_hit(const polyc__scan *s, float r)
+{
+    return r >= s->min_m && r < s->max_m;
+}
+
+/* sin of the incidence angle of beam i on the surface it hit, from the two
+ * neighbouring endpoints when the three are nearly collinear (a surface);
+ * 1 when unknown. No trigonometry: done in the beam's own frame. */
+static float incidence_sin(const polyc_ctx *ctx, const polyc__scan *s, uint32_t i, float r)
+{
+    if (i == 0 || i + 1 >= s->count)
+        return 1.0f;
+    const float *rr = ctx->ranges + s->first;
+    float rm = rr[i - 1], rp = rr[i + 1];
+    if (!range_is_hit(s, rm) || !range_is_hit(s, rp))
+        return 1.0f;
+    float cs = cosf(s->step_rad), sn = sinf(s->step_rad);
+    float ax = rm * cs, ay = -rm * sn; /* neighbour before */
+    float cx = rp * cs, cy = rp * sn;  /* neighbour after */
+    float tx = cx - ax, ty = cy - ay;
+    float len = sqrtf(tx * tx + ty * ty);
+    if (len < 1e-6f)
+        return 1.0f;
+    /* middle point (r, 0) must lie within 3 cm + 2% of the chord */
+    float off = fabsf(tx * (0.0f - ay) - ty * (r - ax)) / len;
+    if (off > 0.03f + 0.02f * r)
+        return 1.0f;
+    return fabsf(ty) / len;
+}
+
+int polyc__beam_get(const polyc_ctx *ctx, const polyc__scan *s, uint32_t i, polyc__beam *b)
+{
+    const polyc__grid *g = &ctx->grid;
+    float r = ctx->ranges[s->first + i];
+    if (!(r == r) || r < 0.0f)
+        return 0; /* NaN or negative: skipped (counted at add time) */
+    float a = s->theta_rad + s->start_rad + (float)i * s->step_rad;
+    float dx = cosf(a), dy = sinf(a);
+    float ox = (float)((double)s->x_m - (g->origin_x_m - ctx->frame_x));
+    float oy = (float)((double)s->y_m - (g->origin_y_m - ctx->frame_y));
+    b->sx = ox * g->inv_cell;
+    b->sy = oy * g->inv_cell;
+    float len_m;
+    if (range_is_hit(s, r)) {
+        b->hit = 1;
+        len_m = r;
+    } else if (r >= s->max_m && ctx->cfg.free_range_m > 0.0f) {
+        b->hit = 0;
+        len_m = fminf(ctx->cfg.free_range_m, r < 1e30f ? r : 1e30f);
+    } else {
+        return 0; /* too short, or no return with free-space marking off */
+    }
+    float len = len_m * g->inv_cell;
+    if (!b->hit) {
+        /* no-return beams mark free space only inside the data's extent */
+        float w = (float)g->width - 0.001f, h = (float)g->height - 0.001f;
+        float t = exit_distance(b->sx, b->sy, dx, dy, w, h);
+        if (t < len)
+            len = t;
+    }
+    b->ex = b->sx + dx * len;
+    b->ey = b->sy + dy * len;
+    b->miss_end = 1.0f;
+    if (b->hit && ctx->cfg.grazing_cells > 0.0f && !(ctx->cfg.flags & POLYC_FLAG_NO_GRAZING)) {
+        /* The last cell / sin(incidence) of a beam runs within a cell of the
+         * surface it hits: a grazing beam would count misses in the wall's
+         * own cells there. Misses stop before that stretch. */
+        float sn = fmaxf(incidence_sin(ctx, s, i, r), 0.05f);
+        float skip = fminf(ctx->cfg.grazing_cells / sn, 0.5f * len);
+        b->miss_end = len > 0.0f ? 1.0f - skip / len : 0.0f;
+    }
+    return 1;
+}
+
+/* Exact traversal of the cells from (sx, sy) to (ex, ey); `visit` gets each
+ * cell with the beam parameter t at which the beam enters it. Returns early
+ * when visit returns non-zero. The step count is fixed in advance, so the walk
+ * always ends in the end cell whatever the rounding. */
+void polyc__traverse(const polyc__beam *b, polyc__cell_fn visit, void *u)
+{
+    int32_t ix = (int32_t)floorf(b->sx), iy = (int32_t)floorf(b->sy);
+    int32_t ex = (int32_t)floorf(b->ex), ey = (int32_t)floorf(b->ey);
+    float dx = b->ex - b->sx, dy = b->ey - b->sy;
+    int32_t stx = dx > 0.0f ? 1 : -1, sty = dy > 0.0f ? 1 : -1;
+    float tdx = dx != 0.0f ? fabsf(1.0f / dx) : 1e30f;
+    float tdy = dy != 0.0f ? fabsf(1.0f / dy) : 1e30f;
+    float tmx = dx > 0.0f ? ((float)ix + 1.0f - b->sx) * tdx : (b->sx - (float)ix) * tdx;
+    float tmy = dy > 0.0f ? ((float)iy + 1.0f - b->sy) * tdy : (b->sy - (float)iy) * tdy;
+    if (dx == 0.0f) tmx = 1e30f;
+    if (dy == 0.0f) tmy = 1e30f;
+    int32_t n = (ex > ix ? ex - ix : ix - ex) + (ey > iy ? ey - iy : iy - ey);
+    float t = 0.0f;
+    for (int32_t k = 0; k < n; k++) {
+        if (visit(u, ix, iy, t, 0))
+            return;
+        if (tmx < tmy) {
+            t = tmx;
+            tmx += tdx;
+            ix += stx;
+        } else {
+            t = tmy;
+            tmy += tdy;
+            iy += sty;
+        }
+    }
+    visit(u, ex, ey, t, 1);
+}
+
+typedef struct count_pass {
+    polyc_ctx *ctx;
+    const polyc__beam *beam;
+    int32_t last_dir;
+    polyc__tile *last_tile;
+} count_pass;
+
+static polyc__tile *tile_for(count_pass *p, int32_t ix, int32_t iy)
+{
+    polyc__grid *g = &p->ctx->grid;
+    if (ix < 0 || iy < 0 || ix >= g->width || iy >= g->height)
+        return NULL;
+    int32_t d = (iy >> POLYC__TILE_SHIFT) * g->tiles_x + (ix >> POLYC__TILE_SHIFT);
+    if (d == p->last_dir)
+        return p->last_tile;
+    if (g->dir[d] == 0) {
+        if (g->tile_count >= g->tile_cap) {
+            g->out_of_tiles = 1;
+            return NULL;
+        }
+        polyc__tile *t = polyc__alloc_zero(&p->ctx->arena, 1, sizeof(polyc__tile));
+        if (!t || t != g->tiles + g->tile_count) {
+            g->out_of_tiles = 1;
+            return NULL;
+        }
+        g->dir[d] = ++g->tile_count;
+    }
+    p->last_dir = d;
+    p->last_tile = &g->tiles[g->dir[d] - 1];
+    return p->last_tile;
+}
+
+static int count_cell(void *u, int32_t ix, int32_t iy, float t_enter, int last)
+{
+    count_pass *p = u;
+    polyc__tile *t = tile_for(p, ix, iy);
+    if (!t)
+        return 1;
+    int idx = polyc__cell_index(ix, iy);
+    if (last && p->beam->hit)
+        count_inc(&t->hits[idx], &t->misses[idx]);
+    else if (t_enter < p->beam->miss_end)
+        count_inc(&t->misses[idx], &t->hits[idx]);
+    return 0;
+}
+
+polyc_status polyc__grid_build(polyc_ctx *ctx)
+{
+    polyc__grid *g = &ctx->grid;
+    memset(g, 0, sizeof *g);
+    if (!ctx->have_extent)
+        return POLYC_OK; /* no data: an empty grid */
+    float cell = ctx->cfg.cell_m;
+    double cell_d = (double)cell, ext = (double)ctx->cfg.max_extent_m;
+    double pad = 2.0 * cell_d;
+    double w_m = ctx->ext_max_x - ctx->ext_min_x + 2.0 * pad;
+    double h_m = ctx->ext_max_y - ctx->ext_min_y + 2.0 * pad;
+    if (w_m > ext || h_m > ext)
+        return polyc__fail(ctx, POLYC_ERR_EXTENT,
+                           "the data span more than config.max_extent_m (a far-away scan?)");
+    g->cell_m = cell;
+    g->inv_cell = 1.0f / cell;
+    g->origin_x_m = ctx->frame_x + ctx->ext_min_x - pad;
+    g->origin_y_m = ctx->frame_y + ctx->ext_min_y - pad;
+    double wc = ceil(w_m / cell_d), hc = ceil(h_m / cell_d);
+    if (wc > 2147483000.0 || hc > 2147483000.0)
+        return polyc__fail(ctx, POLYC_ERR_EXTENT, "grid too large for 32-bit cell indices");
+    g->width = (int32_t)wc;
+    g->height = (int32_t)hc;
+    g->tiles_x = (g->width + POLYC__TILE_SIDE - 1) / POLYC__TILE_SIDE;
+    g->tiles_y = (g->height + POLYC__TILE_SIDE - 1) / POLYC__TILE_SIDE;
+
+    size_t budget = polyc__grid_budget_bytes(&ctx->lim);
+    size_t dir_n = (size_t)g->tiles_x * (size_t)g->tiles_y;
+    size_t dir_bytes = polyc__bytes(dir_n, sizeof(uint32_t));
+    if (dir_bytes == 0 || dir_bytes >= budget)
+        return polyc__fail(ctx, POLYC_ERR_NOMEM, "grid extent too large for limits.max_grid_cells");
+    g->dir = polyc__alloc_zero(&ctx->arena, dir_n, sizeof(uint32_t));
+    if (!g->dir)
+        return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the grid directory");
+    g->tile_cap = (uint32_t)((budget - dir_bytes) / sizeof(polyc__tile));
+    /* tiles are allocated one by one as beams reach them; they stay
+     * contiguous because nothing else allocates during this pass */
+    g->tiles = (polyc__tile *)(ctx->arena.base + ctx->arena.used);
+
+    count_pass p;
+    memset(&p, 0, sizeof p);
+    p.ctx = ctx;
+    p.last_dir = -1;
+    for (uint32_t si = 0; si < ctx->scan_count; si++) {
+        const polyc__scan *s = &ctx->scans[si];
+        for (uint32_t i = 0; i < s->count; i++) {
+            polyc__beam b;
+            if (!polyc__beam_get(ctx, s, i, &b))
+                continue;
+            p.beam = &b;
+            polyc__traverse(&b, count_cell, &p);
+            if (g->out_of_tiles)
+                return polyc__fail(ctx, POLYC_ERR_NOMEM,
+                                   "grid needs more cells than limits.max_grid_cells");
+        }
+    }
+    ctx->stats.grid_width = (uint32_t)g->width;
+    ctx->stats.grid_height = (uint32_t)g->height;
+    ctx->stats.grid_tiles = g->tile_count;
+    ctx->stats.grid_bytes = (uint64_t)dir_bytes + (uint64_t)g->tile_count * sizeof(polyc__tile);
+    return POLYC_OK;
+}

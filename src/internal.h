@@ -1,0 +1,269 @@
+/* internal.h - shared private types of libpolyc (never installed).
+ * Everything here lives inside the caller's memory block. */
+#ifndef POLYC_INTERNAL_H
+#define POLYC_INTERNAL_H
+
+#include "polyc.h"
+
+#ifndef POLYC_ASSERT
+#include <assert.h>
+#define POLYC_ASSERT(x) assert(x)
+#endif
+
+/* Counter width of the hit/miss grid: 16 bits by default; 8 for tiny targets. */
+#ifndef POLYC_COUNTER_BITS
+#define POLYC_COUNTER_BITS 16
+#endif
+#if POLYC_COUNTER_BITS == 8
+typedef uint8_t polyc__count;
+#define POLYC__COUNT_MAX 255u
+#else
+typedef uint16_t polyc__count;
+#define POLYC__COUNT_MAX 65535u
+#endif
+
+#define POLYC__NONE (-1)
+
+/* ---- arena.c: bump allocation inside the caller's block ---- */
+typedef struct polyc__arena {
+    unsigned char *base;
+    size_t size;
+    size_t used;
+    size_t peak;
+} polyc__arena;
+
+void *polyc__alloc(polyc__arena *a, size_t count, size_t elem_size);
+void *polyc__alloc_zero(polyc__arena *a, size_t count, size_t elem_size);
+/* size of count * elem_size rounded up to the arena alignment; 0 on overflow */
+size_t polyc__bytes(size_t count, size_t elem_size);
+/* a + b, saturating at SIZE_MAX (so a size query overflows to "too big") */
+size_t polyc__add(size_t a, size_t b);
+
+/* ---- rng.c: the library's own PRNG (splitmix64), identical on every platform ---- */
+typedef struct polyc__rng {
+    uint64_t state;
+} polyc__rng;
+uint64_t polyc__rng_next(polyc__rng *r);
+double polyc__rng_uniform(polyc__rng *r);   /* [0, 1) */
+double polyc__rng_normal(polyc__rng *r);    /* N(0, 1) */
+
+/* ---- grid.c: hit/miss grid in 32 x 32 tiles ---- */
+#define POLYC__TILE_SHIFT 5
+#define POLYC__TILE_SIDE 32
+#define POLYC__TILE_CELLS 1024
+
+typedef struct polyc__tile {
+    polyc__count hits[POLYC__TILE_CELLS];
+    polyc__count misses[POLYC__TILE_CELLS];
+    uint32_t contour[POLYC__TILE_SIDE]; /* bit per cell: labelled contour */
+    uint32_t mark[POLYC__TILE_SIDE];    /* bit per cell: scratch (tracing, data cells) */
+    uint32_t mark_base;                 /* index of this tile's first marked cell */
+    uint16_t mark_row[POLYC__TILE_SIDE];/* marked cells in earlier rows of the tile */
+    uint32_t pad[3];                    /* size a multiple of 16 (contiguous tiles) */
+} polyc__tile;
+
+typedef struct polyc__grid {
+    double origin_x_m, origin_y_m; /* lower-left corner of cell (0, 0) */
+    float cell_m, inv_cell;
+    int32_t width, height;         /* cells */
+    int32_t tiles_x, tiles_y;
+    uint32_t *dir;                 /* tiles_x * tiles_y; 0 = untouched, else index + 1 */
+    polyc__tile *tiles;            /* contiguous, tile_count used of tile_cap */
+    uint32_t tile_count, tile_cap;
+    int out_of_tiles;              /* set when a beam needed a tile past tile_cap */
+} polyc__grid;
+
+/* ---- scans as stored ---- */
+typedef struct polyc__scan {
+    float x_m, y_m, theta_rad;     /* pose relative to ctx->frame origin */
+    float start_rad, step_rad;
+    float min_m, max_m;
+    uint32_t first;                /* index of the first range in ctx->ranges */
+    uint32_t count;
+} polyc__scan;
+
+/* ---- polyline store (polyline.c): vertices in doubly linked lists ---- */
+typedef struct polyc__vertex {
+    float x, y;
+    int32_t prev, next;            /* POLYC__NONE at the ends of an open polyline */
+    int32_t line;                  /* owning polyline, POLYC__NONE when free */
+} polyc__vertex;
+
+typedef struct polyc__line {
+    int32_t head;                  /* first vertex (any vertex when closed) */
+    int32_t tail;                  /* last vertex (head->prev when closed) */
+    int32_t count;
+    int32_t closed;                /* POLYC__NONE when the slot is free */
+} polyc__line;
+
+typedef struct polyc__store {
+    polyc__vertex *v;
+    polyc__line *l;
+    int32_t v_cap, l_cap;
+    int32_t v_free, l_free;        /* free lists (through .next / .head) */
+    int32_t v_live, l_live;
+    int32_t v_high, l_high;        /* slots in use are among [0, high) */
+} polyc__store;
+
+/* ---- flattened map, the form results are read in ---- */
+typedef struct polyc__flat {
+    float *xy;                     /* 2 floats per point */
+    uint32_t *start;               /* point offset of each polyline, count + 1 entries */
+    uint8_t *closed;
+    uint32_t count, points;
+    uint32_t cap_lines, cap_points;
+} polyc__flat;
+
+/* ---- data points (points.c): one weighted point per cell, or raw points ----
+ * Moments let the sum of squared distances of all points of a cell to a line
+ * be computed exactly: sum (n.(p-a))^2 = w (n.(m-a))^2 + n^T C n. */
+typedef struct polyc__point {
+    float x, y;                    /* mean */
+    float cxx, cxy, cyy;           /* central second moments (sums, not averages) */
+    float w;                       /* number of endpoints */
+} polyc__point;
+
+/* ---- spatial hash (spatial_hash.c): uniform buckets over the map ---- */
+typedef struct polyc__hash_entry {
+    int32_t seg;                   /* segment = its start vertex */
+    int32_t next;
+} polyc__hash_entry;
+
+typedef struct polyc__hash {
+    float origin_x, origin_y, bucket_m, inv_bucket;
+    int32_t bx, by;                /* buckets per axis */
+    int32_t *seg_head;             /* bx * by lists of segment entries */
+    polyc__hash_entry *entries;
+    int32_t entry_cap, entry_free, entry_live;
+    uint32_t *pt_start;            /* bx * by + 1: points sorted by bucket */
+    int32_t *pt_order;             /* unused when points are stored sorted */
+    int out_of_entries;
+} polyc__hash;
+
+/* ---- angle prior (angle_prior.c) ----
+ * p(turn angle | x, y) from corners between lines fitted in single scans.
+ * The prior grid is the tile grid: one cell per 32 x 32 grid cells. */
+#define POLYC__ANGLE_BINS 18       /* 10 degree bins of the turn angle, 0..180 */
+typedef struct polyc__prior {
+    double origin_x, origin_y;     /* frame-relative lower-left corner */
+    float cell_m, inv_cell;
+    int32_t w, h;
+    uint16_t *hist;                /* w * h * POLYC__ANGLE_BINS counts, saturating */
+    uint32_t corners, straights;   /* observations recorded */
+} polyc__prior;
+
+size_t polyc__prior_bytes(const polyc_limits *lim);
+/* Learns the prior from the stored scans (needs the grid for its extent). */
+polyc_status polyc__prior_build(polyc_ctx *ctx, polyc__prior *p);
+/* p(turn | x, y) in [0, 1]; x, y frame-relative metres; turn in [0, pi]. */
+float polyc__prior_p(const polyc__prior *p, float x, float y, float turn_rad);
+
+typedef enum polyc__stage {
+    POLYC__STAGE_SCANS = 0,
+    POLYC__STAGE_GRID,
+    POLYC__STAGE_CONTOUR,
+    POLYC__STAGE_TRACE,
+    POLYC__STAGE_OPTIMIZED
+} polyc__stage;
+
+struct polyc_ctx {
+    uint32_t magic;
+    polyc_config cfg;
+    polyc_limits lim;
+    polyc__arena arena;
+    size_t scans_mark;             /* arena use after the fixed scan storage */
+    polyc__stage stage;
+    const char *error;
+    int32_t error_scan;
+
+    double frame_x, frame_y;       /* first pose: stored floats are relative to it */
+    int have_frame;
+    polyc__scan *scans;
+    float *ranges;
+    uint32_t scan_count, range_count;
+    double ext_min_x, ext_min_y, ext_max_x, ext_max_y; /* frame-relative extent */
+    int have_extent;
+
+    polyc__grid grid;
+    int32_t *contour_xy;           /* 2 per contour cell */
+    uint32_t contour_count;
+    size_t grid_mark;              /* arena use after the grid */
+    size_t contour_mark;           /* arena use after the contour */
+
+    polyc__store store;
+    polyc__flat flat;
+    size_t trace_mark;             /* arena use after the initial polylines */
+
+    polyc__point *points;
+    uint32_t point_count;
+    double point_weight;           /* n of the BIC: every endpoint counts */
+
+    polyc_stats stats;
+};
+
+#define POLYC__MAGIC 0x706f6c79u   /* "poly" */
+
+/* errors: keep the first message of an operation */
+polyc_status polyc__fail(polyc_ctx *ctx, polyc_status st, const char *msg);
+
+/* grid.c */
+size_t polyc__grid_budget_bytes(const polyc_limits *lim);
+polyc_status polyc__grid_build(polyc_ctx *ctx);
+polyc__tile *polyc__grid_tile(const polyc__grid *g, int32_t ix, int32_t iy);
+/* NULL for cells outside the grid or in untouched tiles */
+static inline int polyc__cell_index(int32_t ix, int32_t iy)
+{
+    return ((iy & (POLYC__TILE_SIDE - 1)) << POLYC__TILE_SHIFT) | (ix & (POLYC__TILE_SIDE - 1));
+}
+/* m > threshold, evaluated without division: hits > t * (hits + misses) */
+int polyc__cell_occupied(const polyc__tile *t, int idx, float threshold);
+/* beam geometry shared by the grid and contour passes */
+typedef struct polyc__beam {
+    float sx, sy, ex, ey;          /* grid coordinates (cells) of sensor and end */
+    int hit;                       /* the end is a reflection */
+    float miss_end;                /* misses stop at this fraction of the beam */
+} polyc__beam;
+int polyc__beam_get(const polyc_ctx *ctx, const polyc__scan *s, uint32_t i, polyc__beam *b);
+/* Exact traversal (Amanatides-Woo) of the cells from the sensor to the end;
+ * visit gets each cell with the beam parameter at which the beam enters it
+ * and `last` set for the end cell; a non-zero return stops the walk. */
+typedef int (*polyc__cell_fn)(void *u, int32_t ix, int32_t iy, float t_enter, int last);
+void polyc__traverse(const polyc__beam *b, polyc__cell_fn visit, void *u);
+
+/* contour.c */
+size_t polyc__contour_bytes(const polyc_limits *lim);
+polyc_status polyc__contour_build(polyc_ctx *ctx);
+
+/* polyline.c */
+size_t polyc__store_bytes(const polyc_limits *lim);
+polyc_status polyc__store_init(polyc_ctx *ctx, polyc__store *s, int32_t v_cap);
+void polyc__store_clear(polyc__store *s);
+int32_t polyc__line_new(polyc__store *s);
+void polyc__line_free(polyc__store *s, int32_t line);
+int32_t polyc__vertex_append(polyc__store *s, int32_t line, float x, float y);
+int32_t polyc__vertex_insert_after(polyc__store *s, int32_t v, float x, float y);
+void polyc__vertex_remove(polyc__store *s, int32_t v);
+void polyc__line_close(polyc__store *s, int32_t line);
+void polyc__line_reverse(polyc__store *s, int32_t line);
+int32_t polyc__line_cut(polyc__store *s, int32_t u, int *ok);
+void polyc__line_join(polyc__store *s, int32_t tail, int32_t head);
+size_t polyc__flat_bytes(const polyc_limits *lim);
+polyc_status polyc__flat_init(polyc_ctx *ctx, polyc__flat *f, uint32_t cap_lines, uint32_t cap_points);
+void polyc__flat_from_store(polyc__flat *f, const polyc__store *s);
+polyc_status polyc__store_from_flat(polyc__store *s, const polyc__flat *f);
+
+/* trace.c */
+polyc_status polyc__trace_build(polyc_ctx *ctx);
+
+/* points.c */
+size_t polyc__points_bytes(const polyc_limits *lim);
+polyc_status polyc__points_build(polyc_ctx *ctx);
+
+/* optimize.c */
+size_t polyc__optimizer_bytes(const polyc_config *cfg, const polyc_limits *lim);
+polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *user);
+polyc_status polyc__score(polyc_ctx *ctx, double *bic, double *err);
+
+int32_t polyc__max_vertices(const polyc_limits *lim);
+
+#endif

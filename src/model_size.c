@@ -1,0 +1,228 @@
+/* model_size.c - the number of vertices (paper IV.G).
+ * Takes: the optimiser state. Gives: vertices removed best-first while a
+ * removal lowers the BIC (a lazy priority queue: every candidate is
+ * re-evaluated before it is applied), and vertices added on the segments
+ * with the largest mean squared distance when that lowers the BIC. */
+#include "optimize.h"
+
+#include <math.h>
+
+
+static void heap_push(polyc__opt *o, double delta, int32_t v)
+{
+    if (o->heap_n >= o->heap_cap)
+        return; /* full: the candidate is simply not retried */
+    polyc__heap_entry *h = o->heap;
+    int32_t i = o->heap_n++;
+    while (i > 0) {
+        int32_t p = (i - 1) / 2;
+        if (h[p].delta <= delta)
+            break;
+        h[i] = h[p];
+        i = p;
+    }
+    h[i].delta = delta;
+    h[i].v = v;
+    h[i].pad = 0;
+}
+
+static polyc__heap_entry heap_pop(polyc__opt *o)
+{
+    polyc__heap_entry *h = o->heap;
+    polyc__heap_entry top = h[0], last = h[--o->heap_n];
+    int32_t i = 0;
+    for (;;) {
+        int32_t c = 2 * i + 1;
+        if (c >= o->heap_n)
+            break;
+        if (c + 1 < o->heap_n && h[c + 1].delta < h[c].delta)
+            c++;
+        if (last.delta <= h[c].delta)
+            break;
+        h[i] = h[c];
+        i = c;
+    }
+    h[i] = last;
+    return top;
+}
+
+/* Change of the BIC if v is removed (see polyc__op_remove for the cases). */
+static double removal_delta(polyc__opt *o, int32_t v)
+{
+    const polyc__store *s = o->s;
+    const polyc__vertex *V = s->v;
+    const polyc__line *ln = &s->l[V[v].line];
+    int32_t p = V[v].prev, n = V[v].next;
+    double gamma = (double)o->cfg->gamma;
+    int32_t old[3];
+    int n_old = 0;
+    float xy[4];
+    int n_new = 0;
+    double dk, dangle;
+    if (!ln->closed && ln->count == 2) {
+        old[n_old++] = p != POLYC__NONE ? p : v;
+        dk = -2.0;
+        dangle = 0.0;
+    } else if (p == POLYC__NONE || n == POLYC__NONE) {
+        int32_t nb = p == POLYC__NONE ? n : p;
+        old[n_old++] = p == POLYC__NONE ? v : p;
+        dk = -1.0;
+        dangle = -o->acost[nb]; /* the neighbour becomes an end: no angle */
+    } else {
+        old[n_old++] = p;
+        old[n_old++] = v;
+        if (ln->closed && ln->count == 3)
+            old[n_old++] = n; /* the triangle opens into one segment */
+        xy[0] = V[p].x;
+        xy[1] = V[p].y;
+        xy[2] = V[n].x;
+        xy[3] = V[n].y;
+        n_new = 1;
+        dk = -1.0;
+        dangle = -o->acost[p] - o->acost[v] - o->acost[n];
+        if (!(ln->closed && ln->count == 3) && gamma > 0.0) {
+            /* new angles at p and n with v gone */
+            int32_t pp = V[p].prev, nn = V[n].next;
+            if (pp != POLYC__NONE && pp != n)
+                dangle += polyc__turn_cost(o, V[pp].x, V[pp].y, V[p].x, V[p].y, V[n].x, V[n].y);
+            if (nn != POLYC__NONE && nn != p)
+                dangle += polyc__turn_cost(o, V[p].x, V[p].y, V[n].x, V[n].y, V[nn].x, V[nn].y);
+        }
+    }
+    polyc__local_prepare(o, old, n_old, xy, n_new, 0.0f);
+    double derr = polyc__local_eval(o, xy, n_new) - polyc__local_current(o);
+    return (double)o->cfg->alpha * (derr + gamma * dangle) + dk * o->log_n;
+}
+
+int polyc__op_remove_vertices(polyc__opt *o)
+{
+    polyc__store *s = o->s;
+    o->heap_n = 0;
+    for (int32_t v = 0; v < s->v_high; v++) {
+        if (s->v[v].line == POLYC__NONE)
+            continue;
+        double d = removal_delta(o, v);
+        if (d < 0.0)
+            heap_push(o, d, v);
+    }
+    int removed = 0;
+    while (o->heap_n > 0) {
+        polyc__heap_entry e = heap_pop(o);
+        if (s->v[e.v].line == POLYC__NONE)
+            continue;
+        double d = removal_delta(o, e.v);
+        if (d >= 0.0)
+            continue;
+        if (o->heap_n > 0 && d > o->heap[0].delta + 1e-9) {
+            heap_push(o, d, e.v); /* no longer the best: back in line */
+            continue;
+        }
+        int32_t p = s->v[e.v].prev, n = s->v[e.v].next;
+        polyc__chg_begin(o);
+        polyc__op_remove(o, e.v);
+        polyc__chg_commit(o);
+        removed++;
+        /* the neighbours' removals changed: offer them again */
+        int32_t nb[2] = {p, n};
+        for (int k = 0; k < 2; k++) {
+            if (nb[k] == POLYC__NONE || s->v[nb[k]].line == POLYC__NONE)
+                continue;
+            double dn = removal_delta(o, nb[k]);
+            if (dn < 0.0)
+                heap_push(o, dn, nb[k]);
+        }
+    }
+    return removed;
+}
+
+/* Per segment: summed cost and weight of its points, and its farthest point. */
+static void segment_stats(polyc__opt *o)
+{
+    for (int32_t v = 0; v < o->s->v_high; v++) {
+        o->seg_sum[v] = 0.0;
+        o->seg_w[v] = 0.0;
+        o->seg_far[v] = POLYC__NONE;
+        o->seg_far_d[v] = -1.0;
+    }
+    for (int32_t i = 0; i < o->np; i++) {
+        int32_t sg = o->pt_seg[i];
+        if (sg == POLYC__NONE)
+            continue;
+        double w = (double)o->pts[i].w;
+        o->seg_sum[sg] += o->pt_cost[i];
+        o->seg_w[sg] += w;
+        if (o->pt_cost[i] / w > o->seg_far_d[sg]) {
+            o->seg_far_d[sg] = o->pt_cost[i] / w;
+            o->seg_far[sg] = i;
+        }
+    }
+}
+
+#define ADD_CANDIDATES 8
+
+/* Tries a vertex at the farthest point of the worst segments (largest mean
+ * squared distance); each is adjusted with its neighbours and kept only if
+ * the BIC falls. */
+int polyc__op_add_vertices(polyc__opt *o, int max_tries)
+{
+    polyc__store *s = o->s;
+    int added = 0;
+    for (int round = 0; round < max_tries; round++) {
+        segment_stats(o);
+        int32_t cand[ADD_CANDIDATES];
+        double score[ADD_CANDIDATES];
+        int nc = 0;
+        for (int32_t v = 0; v < s->v_high; v++) {
+            if (s->v[v].line == POLYC__NONE || s->v[v].next == POLYC__NONE || o->seg_w[v] < 4.0 ||
+                o->seg_far[v] == POLYC__NONE)
+                continue;
+            double m = o->seg_sum[v] / o->seg_w[v];
+            if (nc == ADD_CANDIDATES && m <= score[nc - 1])
+                continue;
+            int k = nc < ADD_CANDIDATES ? nc++ : nc - 1;
+            while (k > 0 && score[k - 1] < m) {
+                score[k] = score[k - 1];
+                cand[k] = cand[k - 1];
+                k--;
+            }
+            score[k] = m;
+            cand[k] = v;
+        }
+        int any = 0;
+        for (int c = 0; c < nc; c++) {
+            int32_t u = cand[c];
+            if (s->v[u].line == POLYC__NONE || s->v[u].next == POLYC__NONE)
+                continue;
+            int32_t w = s->v[u].next;
+            int32_t far = o->seg_far[u];
+            if (o->pt_seg[far] != u)
+                continue; /* stale after an earlier addition */
+            double before = polyc__bic(o);
+            float ux = s->v[u].x, uy = s->v[u].y, wx = s->v[w].x, wy = s->v[w].y;
+            polyc__chg_begin(o);
+            int32_t v = polyc__op_insert_after(o, u, o->pts[far].x, o->pts[far].y);
+            polyc__chg_commit(o);
+            if (v == POLYC__NONE)
+                return added;
+            for (int k = 0; k < 2; k++) {
+                polyc__hill_climb(o, v);
+                polyc__hill_climb(o, u);
+                polyc__hill_climb(o, w);
+            }
+            if (polyc__bic(o) < before - 1e-9 * fabs(before)) {
+                added++;
+                any = 1;
+                continue;
+            }
+            /* not better: undo */
+            polyc__chg_begin(o);
+            polyc__op_remove(o, v);
+            polyc__op_move(o, u, ux, uy);
+            polyc__op_move(o, w, wx, wy);
+            polyc__chg_commit(o);
+        }
+        if (!any)
+            break;
+    }
+    return added;
+}

@@ -1,0 +1,438 @@
+/* operators.c - edits of the map and the structural operators (paper IV.A,
+ * B, C, E). Takes: the optimiser state. Gives: overlapping polyline ends
+ * zipped, close ends merged (or a polyline closed), segments split where a
+ * long stretch has no data, hairpin zigzags removed. Every edit records the
+ * segments it takes out and puts in, so the score stays exact. */
+#include "optimize.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+/* ---- edits ---- */
+
+static int32_t prev_of(const polyc__opt *o, int32_t v)
+{
+    return o->s->v[v].prev;
+}
+
+static int32_t next_of(const polyc__opt *o, int32_t v)
+{
+    return o->s->v[v].next;
+}
+
+/* Every segment and vertex angle of a polyline out of the score. */
+static void line_out(polyc__opt *o, int32_t l)
+{
+    const polyc__line *ln = &o->s->l[l];
+    int32_t v = ln->head;
+    for (int32_t k = 0; k < ln->count; k++) {
+        polyc__chg_seg_out(o, v);
+        polyc__chg_dirty(o, v);
+        v = next_of(o, v);
+    }
+}
+
+static void line_in(polyc__opt *o, int32_t l)
+{
+    const polyc__line *ln = &o->s->l[l];
+    int32_t v = ln->head;
+    for (int32_t k = 0; k < ln->count; k++) {
+        polyc__chg_seg_in(o, v);
+        polyc__chg_dirty(o, v);
+        v = next_of(o, v);
+    }
+}
+
+void polyc__op_move(polyc__opt *o, int32_t v, float x, float y)
+{
+    int32_t p = prev_of(o, v), n = next_of(o, v);
+    polyc__chg_seg_out(o, p);
+    polyc__chg_seg_out(o, v);
+    polyc__chg_dirty(o, p);
+    polyc__chg_dirty(o, v);
+    polyc__chg_dirty(o, n);
+    o->s->v[v].x = x;
+    o->s->v[v].y = y;
+    polyc__chg_seg_in(o, p);
+    polyc__chg_seg_in(o, v);
+}
+
+/* Removes v; a polyline left with one vertex goes too (it explains nothing). */
+void polyc__op_remove(polyc__opt *o, int32_t v)
+{
+    polyc__store *s = o->s;
+    int32_t l = s->v[v].line;
+    if (s->l[l].closed && s->l[l].count <= 3) {
+        line_out(o, l); /* the polyline opens: every link may change */
+        polyc__vertex_remove(s, v);
+        line_in(o, l);
+        return;
+    }
+    int32_t p = prev_of(o, v), n = next_of(o, v);
+    polyc__chg_seg_out(o, p);
+    polyc__chg_seg_out(o, v);
+    polyc__chg_dirty(o, p);
+    polyc__chg_dirty(o, v);
+    polyc__chg_dirty(o, n);
+    polyc__vertex_remove(s, v);
+    if (s->l[l].count == 1) {
+        int32_t last = s->l[l].head;
+        polyc__chg_dirty(o, last);
+        polyc__line_free(s, l);
+        return;
+    }
+    if (s->l[l].count == 0) {
+        polyc__line_free(s, l);
+        return;
+    }
+    polyc__chg_seg_in(o, p);
+}
+
+int32_t polyc__op_insert_after(polyc__opt *o, int32_t u, float x, float y)
+{
+    int32_t w = next_of(o, u);
+    polyc__chg_seg_out(o, u);
+    polyc__chg_dirty(o, u);
+    polyc__chg_dirty(o, w);
+    int32_t v = polyc__vertex_insert_after(o->s, u, x, y);
+    if (v == POLYC__NONE) {
+        polyc__chg_seg_in(o, u);
+        return v;
+    }
+    o->acost[v] = 0.0;
+    o->v_dirty[v] = 0;
+    o->seg_in[v] = 0;
+    polyc__chg_dirty(o, v);
+    polyc__chg_seg_in(o, u);
+    polyc__chg_seg_in(o, v);
+    return v;
+}
+
+/* A piece of one vertex left by a cut explains nothing: it goes. */
+static void drop_if_single(polyc__opt *o, int32_t l)
+{
+    if (l != POLYC__NONE && o->s->l[l].closed != POLYC__NONE && o->s->l[l].count == 1)
+        polyc__op_remove(o, o->s->l[l].head);
+}
+
+void polyc__op_cut(polyc__opt *o, int32_t u)
+{
+    int32_t w = next_of(o, u);
+    if (w == POLYC__NONE)
+        return;
+    int32_t l = o->s->v[u].line;
+    polyc__chg_seg_out(o, u);
+    polyc__chg_dirty(o, u);
+    polyc__chg_dirty(o, w);
+    int ok;
+    int32_t l2 = polyc__line_cut(o->s, u, &ok);
+    if (!ok) {
+        polyc__chg_seg_in(o, u);
+        return;
+    }
+    drop_if_single(o, l);
+    drop_if_single(o, l2);
+}
+
+static void reverse_line(polyc__opt *o, int32_t l)
+{
+    line_out(o, l);
+    polyc__line_reverse(o->s, l);
+    line_in(o, l);
+}
+
+/* Links two open ends: tail of one polyline to head of another (or closes). */
+int polyc__op_link(polyc__opt *o, int32_t tail, int32_t head)
+{
+    polyc__store *s = o->s;
+    if (s->v[tail].line == s->v[head].line && s->l[s->v[tail].line].count < 3)
+        return 0;
+    polyc__chg_dirty(o, tail);
+    polyc__chg_dirty(o, head);
+    polyc__line_join(s, tail, head);
+    polyc__chg_seg_in(o, tail);
+    return 1;
+}
+
+/* ---- geometry helpers ---- */
+
+static float seg_dist2(float px, float py, float ax, float ay, float bx, float by)
+{
+    float dx = bx - ax, dy = by - ay, mx = px - ax, my = py - ay;
+    float l2 = dx * dx + dy * dy;
+    float t = l2 > 0.0f ? (mx * dx + my * dy) / l2 : 0.0f;
+    t = t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
+    float ex = mx - t * dx, ey = my - t * dy;
+    return ex * ex + ey * ey;
+}
+
+/* Is segment `seg` within `hops` links of vertex v on the same polyline? */
+static int near_on_line(const polyc__opt *o, int32_t v, int32_t seg, int hops)
+{
+    if (o->s->v[v].line != o->s->v[seg].line)
+        return 0;
+    int32_t a = v, b = v;
+    for (int k = 0; k <= hops; k++) {
+        if (a == seg || b == seg)
+            return 1;
+        if (a != POLYC__NONE) a = o->s->v[a].prev;
+        if (b != POLYC__NONE) b = o->s->v[b].next;
+    }
+    return 0;
+}
+
+/* Squared distance from (x, y) to the nearest segment not near vertex v on
+ * its own polyline (searched within the hash's reach). */
+static float other_dist2(const polyc__opt *o, float x, float y, int32_t v)
+{
+    const polyc__hash *h = &o->h;
+    float best = 1e30f;
+    int32_t b = polyc__bucket_of(h, x, y);
+    int32_t bx = b % h->bx, by = b / h->bx;
+    for (int32_t yy = by - 1; yy <= by + 1; yy++)
+        for (int32_t xx = bx - 1; xx <= bx + 1; xx++) {
+            if (xx < 0 || yy < 0 || xx >= h->bx || yy >= h->by)
+                continue;
+            for (int32_t e = h->seg_head[yy * h->bx + xx]; e != POLYC__NONE; e = h->entries[e].next) {
+                int32_t sg = h->entries[e].seg;
+                if (near_on_line(o, v, sg, 3))
+                    continue;
+                const polyc__vertex *a = &o->s->v[sg], *c = &o->s->v[a->next];
+                float d = seg_dist2(x, y, a->x, a->y, c->x, c->y);
+                if (d < best)
+                    best = d;
+            }
+        }
+    return best;
+}
+
+/* ---- A: overlaps ---- */
+
+/* An open polyline whose end segment runs along another polyline (both of
+ * its vertices within overlap_m of it) loses that end vertex, repeatedly:
+ * the duplicate stretch is zipped away and the ends are left for merging. */
+int polyc__op_overlaps(polyc__opt *o)
+{
+    polyc__store *s = o->s;
+    float lim2 = o->cfg->overlap_m * o->cfg->overlap_m;
+    int changed = 0;
+    if (lim2 <= 0.0f)
+        return 0;
+    for (int32_t l = 0; l < s->l_high; l++) {
+        for (int side = 0; side < 2; side++) {
+            for (;;) {
+                const polyc__line *ln = &s->l[l];
+                if (ln->closed != 0 || ln->count < 2)
+                    break;
+                int32_t e = side ? ln->tail : ln->head;
+                int32_t e2 = side ? s->v[e].prev : s->v[e].next;
+                if (other_dist2(o, s->v[e].x, s->v[e].y, e) > lim2 ||
+                    other_dist2(o, s->v[e2].x, s->v[e2].y, e2) > lim2)
+                    break;
+                polyc__chg_begin(o);
+                polyc__op_remove(o, e);
+                polyc__chg_commit(o);
+                changed++;
+            }
+        }
+    }
+    return changed;
+}
+
+/* ---- B: merge ---- */
+
+/* The nearest open end (head or tail of another polyline, or the other end
+ * of its own when that would close a polyline of 3 or more) within reach. */
+static int32_t nearest_end(const polyc__opt *o, int32_t e, float lim2)
+{
+    const polyc__hash *h = &o->h;
+    const polyc__store *s = o->s;
+    int32_t best_v = POLYC__NONE;
+    float best = lim2;
+    float x = s->v[e].x, y = s->v[e].y;
+    int32_t b = polyc__bucket_of(h, x, y);
+    int32_t bx = b % h->bx, by = b / h->bx;
+    for (int32_t yy = by - 1; yy <= by + 1; yy++)
+        for (int32_t xx = bx - 1; xx <= bx + 1; xx++) {
+            if (xx < 0 || yy < 0 || xx >= h->bx || yy >= h->by)
+                continue;
+            for (int32_t en = h->seg_head[yy * h->bx + xx]; en != POLYC__NONE; en = h->entries[en].next) {
+                int32_t sg = h->entries[en].seg;
+                int32_t cand[2] = {sg, s->v[sg].next};
+                for (int k = 0; k < 2; k++) {
+                    int32_t f = cand[k];
+                    const polyc__vertex *fv = &s->v[f];
+                    if (f == e || (fv->prev != POLYC__NONE && fv->next != POLYC__NONE))
+                        continue; /* not an open end */
+                    if (fv->line == s->v[e].line && s->l[fv->line].count < 3)
+                        continue;
+                    float dx = fv->x - x, dy = fv->y - y, d = dx * dx + dy * dy;
+                    if (d < best) {
+                        best = d;
+                        best_v = f;
+                    }
+                }
+            }
+        }
+    return best_v;
+}
+
+static int is_head(const polyc__opt *o, int32_t v)
+{
+    return o->s->v[v].prev == POLYC__NONE;
+}
+
+/* Ends closer than merge_dist_m are linked by a segment; the vertex
+ * removal operator later fuses the two ends when that lowers the BIC. */
+int polyc__op_merge(polyc__opt *o)
+{
+    polyc__store *s = o->s;
+    float lim2 = o->cfg->merge_dist_m * o->cfg->merge_dist_m;
+    int changed = 0;
+    for (int32_t l = 0; l < s->l_high; l++) {
+        for (int side = 0; side < 2; side++) {
+            const polyc__line *ln = &s->l[l];
+            if (ln->closed != 0 || ln->count < 2)
+                continue;
+            int32_t e = side ? ln->tail : ln->head;
+            int32_t f = nearest_end(o, e, lim2);
+            if (f == POLYC__NONE)
+                continue;
+            polyc__chg_begin(o);
+            int32_t le = s->v[e].line, lf = s->v[f].line;
+            if (le == lf) {
+                int32_t t = is_head(o, e) ? f : e;
+                polyc__op_link(o, t, t == e ? f : e);
+            } else {
+                /* orient so that e ends its polyline and f starts its own */
+                if (is_head(o, e) && !is_head(o, f)) {
+                    int32_t t = e;
+                    e = f;
+                    f = t;
+                } else if (is_head(o, e)) {
+                    reverse_line(o, le);
+                } else if (!is_head(o, f)) {
+                    reverse_line(o, lf);
+                }
+                polyc__op_link(o, e, f);
+            }
+            polyc__chg_commit(o);
+            changed++;
+        }
+    }
+    return changed;
+}
+
+/* ---- C: split ---- */
+
+static int cmp_float(const void *a, const void *b)
+{
+    float x = *(const float *)a, y = *(const float *)b;
+    return (x > y) - (x < y);
+}
+
+/* A segment with a stretch longer than split_gap_m onto which no data point
+ * projects is cut there: the polyline ends on either side of the gap. */
+int polyc__op_split(polyc__opt *o)
+{
+    polyc__store *s = o->s;
+    int32_t nv = s->v_high;
+    int32_t *off = o->split_off;
+    float *t = o->split_t;
+    for (int32_t v = 0; v <= nv; v++)
+        off[v] = 0;
+    for (int32_t i = 0; i < o->np; i++)
+        if (o->pt_seg[i] != POLYC__NONE)
+            off[o->pt_seg[i] + 1]++;
+    for (int32_t v = 0; v < nv; v++)
+        off[v + 1] += off[v];
+    /* fill: positions along the segment, metres */
+    for (int32_t i = 0; i < o->np; i++) {
+        int32_t sg = o->pt_seg[i];
+        if (sg == POLYC__NONE)
+            continue;
+        const polyc__vertex *a = &s->v[sg], *b = &s->v[a->next];
+        float dx = b->x - a->x, dy = b->y - a->y;
+        float len = sqrtf(dx * dx + dy * dy);
+        float u = len > 0.0f ? ((o->pts[i].x - a->x) * dx + (o->pts[i].y - a->y) * dy) / len : 0.0f;
+        t[off[sg]++] = u < 0.0f ? 0.0f : (u > len ? len : u);
+    }
+    for (int32_t v = nv; v > 0; v--)
+        off[v] = off[v - 1];
+    off[0] = 0;
+    /* find the gaps first, then cut (cuts change the assignment) */
+    int32_t n_cut = 0;
+    float gap_min = o->cfg->split_gap_m;
+    for (int32_t v = 0; v < nv; v++) {
+        const polyc__vertex *a = &s->v[v];
+        if (a->line == POLYC__NONE || a->next == POLYC__NONE)
+            continue;
+        const polyc__vertex *b = &s->v[a->next];
+        float len = sqrtf((b->x - a->x) * (b->x - a->x) + (b->y - a->y) * (b->y - a->y));
+        if (len <= gap_min)
+            continue;
+        int32_t lo = off[v], hi = off[v + 1];
+        qsort(t + lo, (size_t)(hi - lo), sizeof(float), cmp_float);
+        float prev = 0.0f, best = 0.0f, g0 = 0.0f;
+        for (int32_t k = lo; k <= hi; k++) {
+            float cur = k < hi ? t[k] : len;
+            if (cur - prev > best) {
+                best = cur - prev;
+                g0 = prev;
+            }
+            prev = cur;
+        }
+        if (best > gap_min && n_cut < o->cut_cap) {
+            o->cut_seg[n_cut] = v;
+            o->cut_next[n_cut] = a->next;
+            o->cut_t0[n_cut] = g0 / len;
+            o->cut_t1[n_cut] = (g0 + best) / len;
+            n_cut++;
+        }
+    }
+    for (int32_t k = 0; k < n_cut; k++) {
+        int32_t u = o->cut_seg[k];
+        if (s->v[u].line == POLYC__NONE || s->v[u].next != o->cut_next[k])
+            continue; /* changed by an earlier cut */
+        const polyc__vertex *a = &s->v[u], *b = &s->v[a->next];
+        float ax = a->x, ay = a->y, dx = b->x - a->x, dy = b->y - a->y;
+        float t0 = o->cut_t0[k], t1 = o->cut_t1[k];
+        polyc__chg_begin(o);
+        int32_t c = u;
+        if (t0 > 1e-3f)
+            c = polyc__op_insert_after(o, u, ax + t0 * dx, ay + t0 * dy);
+        if (c != POLYC__NONE && t1 < 1.0f - 1e-3f)
+            if (polyc__op_insert_after(o, c, ax + t1 * dx, ay + t1 * dy) == POLYC__NONE)
+                c = POLYC__NONE;
+        if (c != POLYC__NONE)
+            polyc__op_cut(o, c);
+        polyc__chg_commit(o);
+    }
+    return n_cut;
+}
+
+/* ---- E: zigzags ---- */
+
+/* A vertex where the polyline folds back on itself (turn above 150 degrees)
+ * is a zigzag left by vertex moves: it goes. */
+int polyc__op_zigzag(polyc__opt *o)
+{
+    polyc__store *s = o->s;
+    int changed = 0;
+    for (int32_t v = 0; v < s->v_high; v++) {
+        const polyc__vertex *c = &s->v[v];
+        if (c->line == POLYC__NONE || c->prev == POLYC__NONE || c->next == POLYC__NONE)
+            continue;
+        const polyc__vertex *a = &s->v[c->prev], *b = &s->v[c->next];
+        float ux = c->x - a->x, uy = c->y - a->y, wx = b->x - c->x, wy = b->y - c->y;
+        float lu = sqrtf(ux * ux + uy * uy), lw = sqrtf(wx * wx + wy * wy);
+        /* (a zero-length segment counts: its vertex is a duplicate) */
+        if (lu * lw > 0.0f && (ux * wx + uy * wy) > -0.866f * lu * lw)
+            continue;
+        polyc__chg_begin(o);
+        polyc__op_remove(o, v);
+        polyc__chg_commit(o);
+        changed++;
+    }
+    return changed;
+}

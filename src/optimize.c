@@ -1,0 +1,191 @@
+/* optimize.c - the search (paper section IV): local search on the BIC.
+ * Takes: the initial polylines, the grid and the scans. Gives: the best map
+ * found by repeating the operators (overlaps, merge, split, vertex moves,
+ * zigzags, noise, vertex count) until `patience` iterations bring no better
+ * BIC, or the iteration cap or the caller's progress callback stops it. */
+#include "optimize.h"
+
+#include <math.h>
+#include <string.h>
+
+#define ADJUST_ROUNDS 20
+#define ADD_ROUNDS 4
+#define ADDED_CAP 64
+
+
+size_t polyc__optimizer_bytes(const polyc_config *cfg, const polyc_limits *lim)
+{
+    size_t P = (size_t)polyc__points_bound(cfg, lim);
+    size_t V = (size_t)polyc__max_vertices(lim);
+    size_t NB = (size_t)polyc__hash_bucket_cap(lim);
+    size_t NE = (size_t)polyc__hash_entry_cap(lim);
+    size_t n = 0;
+    n = polyc__add(n, polyc__bytes(P * 2, sizeof(polyc__point))); /* sorted + unsorted */
+    n = polyc__add(n, polyc__bytes(P, sizeof(int32_t)));          /* pt_seg */
+    n = polyc__add(n, polyc__bytes(P, sizeof(double)));           /* pt_cost */
+    n = polyc__add(n, polyc__bytes(P, sizeof(int32_t)));          /* loc_pt */
+    n = polyc__add(n, polyc__bytes(P, sizeof(double)));           /* loc_base */
+    n = polyc__add(n, polyc__bytes(P, sizeof(float)));            /* split_t */
+    n = polyc__add(n, polyc__bytes(V + 1, sizeof(int32_t)));      /* split_off */
+    n = polyc__add(n, polyc__bytes(V, 4 * sizeof(float) + 2 * sizeof(int32_t))); /* cuts */
+    n = polyc__add(n, polyc__bytes(V, 4 * sizeof(double)));       /* acost, seg stats */
+    n = polyc__add(n, polyc__bytes(V, 5 * sizeof(int32_t) + 1));  /* marks, lists, seg_in */
+    n = polyc__add(n, polyc__bytes(V * 3 + 16, sizeof(polyc__heap_entry)));
+    n = polyc__add(n, polyc__bytes(ADDED_CAP, sizeof(int32_t)));
+    n = polyc__add(n, polyc__bytes(NB, 4 * sizeof(int32_t)));     /* heads, starts, marks, list */
+    n = polyc__add(n, polyc__bytes(NE, sizeof(polyc__hash_entry)));
+    n = polyc__add(n, polyc__flat_bytes(lim));                    /* best model */
+    return polyc__add(n, 32 * 16);                                /* alignment slack */
+}
+
+#define ALLOC(ptr, count) \
+    do { if (!((ptr) = polyc__alloc(&ctx->arena, (size_t)(count), sizeof *(ptr)))) goto nomem; } while (0)
+
+/* Everything the optimiser needs, carved from the arena after the trace. */
+static polyc_status setup(polyc_ctx *ctx, polyc__opt *o)
+{
+    memset(o, 0, sizeof *o);
+    o->ctx = ctx;
+    o->cfg = &ctx->cfg;
+    o->s = &ctx->store;
+    o->R = ctx->cfg.search_radius_m;
+    o->R2 = o->R * o->R;
+    o->rng.state = ctx->cfg.seed;
+    int32_t V = o->s->v_cap;
+    polyc_status st = polyc__prior_build(ctx, &o->prior);
+    if (st != POLYC_OK)
+        return st;
+    if ((st = polyc__hash_init(o)) != POLYC_OK)
+        return st;
+    if ((st = polyc__points_collect(o)) != POLYC_OK)
+        return st;
+    o->log_n = log(o->n > 1.0 ? o->n : 1.0);
+    int32_t P = o->np > 0 ? o->np : 1;
+    ALLOC(o->pt_seg, P);
+    ALLOC(o->pt_cost, P);
+    ALLOC(o->loc_pt, P);
+    ALLOC(o->loc_base, P);
+    ALLOC(o->split_t, P);
+    ALLOC(o->split_off, V + 1);
+    ALLOC(o->cut_seg, V);
+    ALLOC(o->cut_next, V);
+    ALLOC(o->cut_t0, V);
+    ALLOC(o->cut_t1, V);
+    o->cut_cap = V;
+    ALLOC(o->acost, V);
+    ALLOC(o->seg_sum, V);
+    ALLOC(o->seg_w, V);
+    ALLOC(o->seg_far_d, V);
+    ALLOC(o->seg_far, V);
+    ALLOC(o->seg_dead, V);
+    ALLOC(o->v_dirty, V);
+    ALLOC(o->dirty_list, V);
+    ALLOC(o->seg_in, V);
+    ALLOC(o->v_work, V);
+    memset(o->v_work, 0, (size_t)V * sizeof(uint32_t));
+    ALLOC(o->heap, V * 3 + 16);
+    o->heap_cap = V * 3 + 16;
+    ALLOC(o->added, ADDED_CAP);
+    o->added_cap = ADDED_CAP;
+    o->dirty_cap = V;
+    memset(o->seg_dead, 0, (size_t)V * sizeof(uint32_t));
+    memset(o->v_dirty, 0, (size_t)V * sizeof(uint32_t));
+    memset(o->seg_in, 0, (size_t)V);
+    int32_t vcap = V;
+    if ((st = polyc__flat_init(ctx, &o->best, (uint32_t)(vcap / 2 + 16), (uint32_t)vcap)) != POLYC_OK)
+        return st;
+    return polyc__rebuild(o);
+nomem:
+    return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the optimiser");
+}
+
+static void fill_stats(polyc__opt *o)
+{
+    polyc_stats *st = &o->ctx->stats;
+    st->bic = polyc__bic(o);
+    st->error_sq_m2 = o->err;
+}
+
+static int32_t live_lines(const polyc__store *s)
+{
+    return s->l_live;
+}
+
+polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *user)
+{
+    polyc__opt o;
+    polyc_status st = setup(ctx, &o);
+    if (st != POLYC_OK)
+        return st;
+    const polyc_config *cfg = &ctx->cfg;
+    polyc__flat_from_store(&o.best, o.s);
+    double best = polyc__bic(&o);
+    double sigma = cfg->noise_m;
+    uint32_t quiet = 0, it;
+    polyc_status result = POLYC_OK;
+    for (it = 0; it < cfg->max_iterations; it++) {
+        if (it > 0 && sigma > 0.0) {
+            /* F: leave local minima; the noise shrinks every iteration */
+            polyc__op_noise(&o, sigma);
+            if ((st = polyc__rebuild(&o)) != POLYC_OK)
+                return st;
+        }
+        polyc__op_overlaps(&o);          /* A */
+        polyc__op_merge(&o);             /* B */
+        polyc__op_split(&o);             /* C */
+        polyc__op_adjust(&o, ADJUST_ROUNDS); /* D */
+        polyc__op_zigzag(&o);            /* E */
+        polyc__op_remove_vertices(&o);   /* G, fewer vertices */
+        polyc__op_add_vertices(&o, ADD_ROUNDS); /* G, more vertices */
+        polyc__op_adjust(&o, ADJUST_ROUNDS);
+        if (o.h.out_of_entries)
+            return polyc__fail(ctx, POLYC_ERR_NOMEM, "spatial hash full");
+        double bic = polyc__bic(&o);
+        if (bic < best - 1e-9 * fabs(best)) {
+            best = bic;
+            polyc__flat_from_store(&o.best, o.s);
+            quiet = 0;
+        } else {
+            quiet++;
+        }
+        polyc_iteration rep;
+        memset(&rep, 0, sizeof rep);
+        rep.iteration = it;
+        rep.vertices = (uint32_t)o.s->v_live;
+        rep.polylines = (uint32_t)live_lines(o.s);
+        rep.bic = bic;
+        rep.best_bic = best;
+        rep.noise_m = it > 0 ? sigma / (double)cfg->noise_decay : 0.0;
+        if (it > 0)
+            sigma *= (double)cfg->noise_decay;
+        if (progress && progress(user, &rep)) {
+            result = POLYC_ERR_STOPPED;
+            it++;
+            break;
+        }
+        if (quiet >= cfg->patience)
+            break;
+    }
+    ctx->stats.iterations = it < cfg->max_iterations ? it + (result == POLYC_OK) : it;
+    /* the best model found is the result */
+    if (polyc__store_from_flat(o.s, &o.best) != POLYC_OK)
+        return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room to restore the best map");
+    if ((st = polyc__rebuild(&o)) != POLYC_OK)
+        return st;
+    fill_stats(&o);
+    return result;
+}
+
+polyc_status polyc__score(polyc_ctx *ctx, double *bic, double *err)
+{
+    polyc__opt o;
+    polyc_status st = setup(ctx, &o);
+    if (st != POLYC_OK)
+        return st;
+    fill_stats(&o);
+    if (bic)
+        *bic = polyc__bic(&o);
+    if (err)
+        *err = o.err;
+    return POLYC_OK;
+}

@@ -1,0 +1,130 @@
+/* optimize.h - private state of the BIC optimiser (paper section IV),
+ * shared by score.c, spatial_hash.c, operators.c, model_size.c and optimize.c. */
+#ifndef POLYC_OPTIMIZE_H
+#define POLYC_OPTIMIZE_H
+
+#include "internal.h"
+
+typedef struct polyc__heap_entry {
+    double delta;                  /* change of the BIC if the vertex goes */
+    int32_t v;
+    int32_t pad;
+} polyc__heap_entry;
+
+typedef struct polyc__opt {
+    polyc_ctx *ctx;
+    const polyc_config *cfg;
+    polyc__store *s;
+
+    /* data: weighted points sorted by hash bucket, and their assignment */
+    polyc__point *pts;
+    int32_t np;
+    int32_t *pt_seg;               /* nearest segment (its start vertex) or NONE */
+    double *pt_cost;               /* capped cost of the point's endpoints */
+    double n, log_n;               /* BIC's n: every endpoint */
+    float R, R2;                   /* search radius: the cost of a point is capped at w R^2 */
+
+    /* model terms, kept incrementally */
+    double err;                    /* sum of pt_cost */
+    double angle;                  /* sum over vertices of (1 - p(turn | x, y)) */
+    double *acost;                 /* per vertex: 1 - p */
+    polyc__prior prior;
+
+    polyc__hash h;
+    uint8_t *seg_in;               /* per vertex: its segment is in the hash */
+    int32_t cur_seg;               /* segment being entered or removed */
+
+    /* one change (a batch of edits) being recorded */
+    uint32_t epoch;
+    uint32_t *seg_dead;            /* per vertex: == epoch when its segment changed */
+    uint32_t *v_dirty;             /* per vertex: == epoch when its angle is pending */
+    int32_t *dirty_list, dirty_n;
+    int32_t *added, added_n;       /* segments inserted in this change */
+    uint32_t *bucket_mark;         /* per bucket: == epoch when listed */
+    int32_t *bucket_list, bucket_n;
+    int32_t added_cap, dirty_cap;
+
+    /* local evaluation scratch */
+    int32_t *loc_pt;               /* points near the edited segments */
+    double *loc_base;              /* their cost without the edited segments */
+    int32_t loc_n;
+    double loc_fixed, loc_fixed_cur; /* pruned points: base and current sums */
+
+    /* split scratch: per segment offsets, positions of its points */
+    int32_t *split_off;
+    float *split_t;
+    int32_t *cut_seg, *cut_next, cut_cap;
+    float *cut_t0, *cut_t1;
+
+    /* model size scratch: per segment sums, farthest point; removal heap */
+    double *seg_sum, *seg_w, *seg_far_d;
+    int32_t *seg_far;
+    polyc__heap_entry *heap;
+    int32_t heap_n, heap_cap;
+
+    uint32_t *v_work;              /* per vertex: == round stamp when to be climbed */
+    uint32_t work_stamp;
+    polyc__rng rng;
+    polyc__flat best;
+    double noise_m;
+} polyc__opt;
+
+/* points.c */
+int32_t polyc__points_bound(const polyc_config *cfg, const polyc_limits *lim);
+polyc_status polyc__points_collect(polyc__opt *o);
+
+/* spatial_hash.c */
+int32_t polyc__hash_bucket_cap(const polyc_limits *lim);
+int32_t polyc__hash_entry_cap(const polyc_limits *lim);
+polyc_status polyc__hash_init(polyc__opt *o);
+int polyc__hash_insert(polyc__opt *o, int32_t seg);
+void polyc__hash_remove(polyc__opt *o, int32_t seg);
+void polyc__hash_clear(polyc__opt *o);
+int32_t polyc__bucket_of(const polyc__hash *h, float x, float y);
+/* calls fn for every bucket within one bucket of the segment a-b */
+typedef void (*polyc__bucket_fn)(polyc__opt *o, int32_t bucket);
+void polyc__segment_buckets(polyc__opt *o, float ax, float ay, float bx, float by, int dilate,
+                            polyc__bucket_fn fn);
+
+/* score.c */
+double polyc__cost(const polyc__point *p, float ax, float ay, float bx, float by);
+double polyc__cost_seg(const polyc__opt *o, const polyc__point *p, int32_t seg);
+/* nearest segment within reach, skipping up to n_skip segments */
+double polyc__nearest(const polyc__opt *o, int32_t pi, const int32_t *skip, int n_skip,
+                      int32_t *seg);
+double polyc__vertex_angle_cost(const polyc__opt *o, int32_t v);
+double polyc__bic(const polyc__opt *o);
+polyc_status polyc__rebuild(polyc__opt *o);          /* hash and assignment from scratch */
+/* recording a change: segments out before an edit, in after it */
+void polyc__chg_begin(polyc__opt *o);
+void polyc__chg_seg_out(polyc__opt *o, int32_t seg);
+int polyc__chg_seg_in(polyc__opt *o, int32_t seg);
+void polyc__chg_dirty(polyc__opt *o, int32_t v);
+void polyc__chg_commit(polyc__opt *o);
+/* local evaluation of replacing `old` segments by candidate geometry */
+void polyc__local_prepare(polyc__opt *o, const int32_t *old, int n_old, const float *seg_xy,
+                          int n_new, float reach);
+double polyc__local_eval(const polyc__opt *o, const float *seg_xy, int n_new);
+double polyc__local_current(const polyc__opt *o);
+
+/* edits (operators.c): each records its change; call chg_begin/commit around */
+void polyc__op_move(polyc__opt *o, int32_t v, float x, float y);
+void polyc__op_remove(polyc__opt *o, int32_t v);
+int32_t polyc__op_insert_after(polyc__opt *o, int32_t u, float x, float y);
+void polyc__op_cut(polyc__opt *o, int32_t u);                 /* cut link u -> next */
+int polyc__op_link(polyc__opt *o, int32_t tail, int32_t head); /* join or close */
+
+/* the operators (paper IV.A-G) */
+int polyc__op_overlaps(polyc__opt *o);
+int polyc__op_merge(polyc__opt *o);
+int polyc__op_split(polyc__opt *o);
+int polyc__op_adjust(polyc__opt *o, int max_rounds);
+int polyc__op_zigzag(polyc__opt *o);
+void polyc__op_noise(polyc__opt *o, double sigma_m);
+int polyc__op_remove_vertices(polyc__opt *o);
+int polyc__op_add_vertices(polyc__opt *o, int max_tries);
+int polyc__hill_climb(polyc__opt *o, int32_t v);
+double polyc__turn_cost(const polyc__opt *o, float ax, float ay, float bx, float by, float cx,
+                        float cy);
+
+#endif

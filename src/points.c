@@ -1,0 +1,195 @@
+/* points.c - the data points d_i of the BIC (paper eq. 2).
+ * Takes: the grid and the scans. Gives: the reflected endpoints that fall in
+ * a cell the grid does not judge free (m >= data_min_m), as one weighted point
+ * per grid cell (count, mean, second moments: squared distances to a line
+ * stay exact) or, with POLYC_FLAG_EXACT_POINTS, one point per endpoint;
+ * sorted by spatial-hash bucket. */
+#include "optimize.h"
+
+#include <math.h>
+#include <string.h>
+
+typedef struct endpoint {
+    int32_t ix, iy;
+    float fx, fy;                  /* offset from the cell centre, metres */
+} endpoint;
+
+static int endpoint_of(const polyc_ctx *ctx, const polyc__scan *s, uint32_t i, endpoint *e)
+{
+    polyc__beam b;
+    if (!polyc__beam_get(ctx, s, i, &b) || !b.hit)
+        return 0;
+    float fx = floorf(b.ex), fy = floorf(b.ey);
+    e->ix = (int32_t)fx;
+    e->iy = (int32_t)fy;
+    e->fx = (b.ex - fx - 0.5f) * ctx->grid.cell_m;
+    e->fy = (b.ey - fy - 0.5f) * ctx->grid.cell_m;
+    /* Data if the endpoint's own cell is not judged free. (A looser rule,
+     * accepting points next to solid cells, lets people walking along walls
+     * in: measured on the corridor scene, it tripled the vertex count.) */
+    const polyc__tile *t = polyc__grid_tile(&ctx->grid, e->ix, e->iy);
+    if (!t)
+        return 0;
+    int idx = polyc__cell_index(e->ix, e->iy);
+    unsigned h = t->hits[idx], m = t->misses[idx];
+    return h > 0 && (float)h >= ctx->cfg.data_min_m * (float)(h + m);
+}
+
+static float cell_centre(double origin, int32_t i, float cell)
+{
+    return (float)(origin + ((double)i + 0.5) * (double)cell);
+}
+
+/* One weighted point per marked cell: mark cells, number them, accumulate. */
+static polyc_status collect_cells(polyc__opt *o, polyc__point *tmp, int32_t cap, int32_t *n_out)
+{
+    polyc_ctx *ctx = o->ctx;
+    polyc__grid *g = &ctx->grid;
+    for (uint32_t k = 0; k < g->tile_count; k++)
+        memset(g->tiles[k].mark, 0, sizeof g->tiles[k].mark);
+    endpoint e;
+    for (uint32_t si = 0; si < ctx->scan_count; si++)
+        for (uint32_t i = 0; i < ctx->scans[si].count; i++)
+            if (endpoint_of(ctx, &ctx->scans[si], i, &e))
+                polyc__grid_tile(g, e.ix, e.iy)->mark[e.iy & 31] |= 1u << (e.ix & 31);
+    uint32_t n = 0;
+    for (uint32_t k = 0; k < g->tile_count; k++) {
+        polyc__tile *t = &g->tiles[k];
+        t->mark_base = n;
+        uint32_t in_tile = 0;
+        for (int r = 0; r < POLYC__TILE_SIDE; r++) {
+            t->mark_row[r] = (uint16_t)in_tile;
+            uint32_t bits = t->mark[r];
+            while (bits) {
+                bits &= bits - 1;
+                in_tile++;
+            }
+        }
+        n += in_tile;
+    }
+    if (n > (uint32_t)cap)
+        return polyc__fail(ctx, POLYC_ERR_NOMEM, "more data cells than the memory bound");
+    memset(tmp, 0, (size_t)n * sizeof *tmp);
+    for (uint32_t si = 0; si < ctx->scan_count; si++)
+        for (uint32_t i = 0; i < ctx->scans[si].count; i++) {
+            if (!endpoint_of(ctx, &ctx->scans[si], i, &e))
+                continue;
+            const polyc__tile *t = polyc__grid_tile(g, e.ix, e.iy);
+            uint32_t row = t->mark[e.iy & 31], col = (uint32_t)(e.ix & 31);
+            uint32_t below = row & ((1u << col) - 1u);
+            uint32_t c = 0;
+            while (below) {
+                below &= below - 1;
+                c++;
+            }
+            polyc__point *p = &tmp[t->mark_base + t->mark_row[e.iy & 31] + c];
+            /* sums of offsets from the cell centre: small numbers, float is exact enough */
+            p->w += 1.0f;
+            p->x += e.fx;
+            p->y += e.fy;
+            p->cxx += e.fx * e.fx;
+            p->cxy += e.fx * e.fy;
+            p->cyy += e.fy * e.fy;
+        }
+    /* means and central moments; the cell of each point is found again by
+     * walking the directory in the numbering order of the marks */
+    double ox = g->origin_x_m - ctx->frame_x, oy = g->origin_y_m - ctx->frame_y;
+    int32_t dir_n = g->tiles_x * g->tiles_y;
+    for (int32_t d = 0; d < dir_n; d++) {
+        if (!g->dir[d])
+            continue;
+        const polyc__tile *t = &g->tiles[g->dir[d] - 1];
+        int32_t tx = (d % g->tiles_x) << POLYC__TILE_SHIFT, ty = (d / g->tiles_x) << POLYC__TILE_SHIFT;
+        uint32_t k = t->mark_base;
+        for (int r = 0; r < POLYC__TILE_SIDE; r++)
+            for (int c = 0; c < POLYC__TILE_SIDE; c++) {
+                if (!((t->mark[r] >> c) & 1u))
+                    continue;
+                polyc__point *p = &tmp[k++];
+                float mx = p->x / p->w, my = p->y / p->w;
+                p->cxx -= p->w * mx * mx;
+                p->cxy -= p->w * mx * my;
+                p->cyy -= p->w * my * my;
+                if (p->cxx < 0.0f) p->cxx = 0.0f;
+                if (p->cyy < 0.0f) p->cyy = 0.0f;
+                p->x = cell_centre(ox, tx + c, g->cell_m) + mx;
+                p->y = cell_centre(oy, ty + r, g->cell_m) + my;
+            }
+    }
+    *n_out = (int32_t)n;
+    return POLYC_OK;
+}
+
+static polyc_status collect_raw(polyc__opt *o, polyc__point *tmp, int32_t cap, int32_t *n_out)
+{
+    polyc_ctx *ctx = o->ctx;
+    polyc__grid *g = &ctx->grid;
+    double ox = g->origin_x_m - ctx->frame_x, oy = g->origin_y_m - ctx->frame_y;
+    int32_t n = 0;
+    endpoint e;
+    for (uint32_t si = 0; si < ctx->scan_count; si++)
+        for (uint32_t i = 0; i < ctx->scans[si].count; i++) {
+            if (!endpoint_of(ctx, &ctx->scans[si], i, &e))
+                continue;
+            if (n >= cap)
+                return polyc__fail(ctx, POLYC_ERR_NOMEM, "more data points than the memory bound");
+            polyc__point *p = &tmp[n++];
+            memset(p, 0, sizeof *p);
+            p->x = cell_centre(ox, e.ix, g->cell_m) + e.fx;
+            p->y = cell_centre(oy, e.iy, g->cell_m) + e.fy;
+            p->w = 1.0f;
+        }
+    *n_out = n;
+    return POLYC_OK;
+}
+
+int32_t polyc__points_bound(const polyc_config *cfg, const polyc_limits *lim)
+{
+    uint32_t b = lim->max_beams;
+    if (!(cfg->flags & POLYC_FLAG_EXACT_POINTS) && lim->max_grid_cells < b)
+        b = lim->max_grid_cells;
+    return b > 0x3fffffffu ? 0x3fffffff : (int32_t)b;
+}
+
+polyc_status polyc__points_collect(polyc__opt *o)
+{
+    polyc_ctx *ctx = o->ctx;
+    int32_t cap = polyc__points_bound(o->cfg, &ctx->lim);
+    /* final array first, the unsorted one after it (released at the end) */
+    o->pts = polyc__alloc(&ctx->arena, (size_t)cap, sizeof(polyc__point));
+    size_t mark = ctx->arena.used;
+    polyc__point *tmp = polyc__alloc(&ctx->arena, (size_t)cap, sizeof(polyc__point));
+    if (!o->pts || !tmp)
+        return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the data points");
+    int32_t n = 0;
+    polyc_status st = (o->cfg->flags & POLYC_FLAG_EXACT_POINTS) ? collect_raw(o, tmp, cap, &n)
+                                                                 : collect_cells(o, tmp, cap, &n);
+    if (st != POLYC_OK)
+        return st;
+    /* counting sort by bucket: points of one bucket are contiguous */
+    polyc__hash *h = &o->h;
+    int32_t nb = h->bx * h->by;
+    memset(h->pt_start, 0, ((size_t)nb + 1) * sizeof(uint32_t));
+    double total = 0.0;
+    for (int32_t i = 0; i < n; i++) {
+        h->pt_start[polyc__bucket_of(h, tmp[i].x, tmp[i].y) + 1]++;
+        total += (double)tmp[i].w;
+    }
+    for (int32_t b = 0; b < nb; b++)
+        h->pt_start[b + 1] += h->pt_start[b];
+    for (int32_t i = 0; i < n; i++) {
+        int32_t b = polyc__bucket_of(h, tmp[i].x, tmp[i].y);
+        uint32_t at = h->pt_start[b]++;
+        o->pts[at] = tmp[i];
+    }
+    for (int32_t b = nb; b > 0; b--)
+        h->pt_start[b] = h->pt_start[b - 1];
+    h->pt_start[0] = 0;
+    ctx->arena.used = mark;
+    o->np = n;
+    o->n = total;
+    ctx->point_weight = total;
+    ctx->stats.data_points = (uint64_t)total;
+    ctx->stats.weighted_points = (uint32_t)n;
+    return POLYC_OK;
+}

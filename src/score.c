@@ -1,0 +1,341 @@
+/* score.c - the BIC (paper eqs. 2, 3, 5) and its incremental bookkeeping.
+ * Takes: data points, polylines, the spatial hash, the angle prior. Gives:
+ * each point's nearest segment and capped cost, the model's error and angle
+ * terms, updated after an edit by rescoring only the points near the
+ * segments that changed; and a read-only local evaluation for trial moves. */
+#include "optimize.h"
+
+#include <math.h>
+
+/* Sum of squared distances of a weighted point's endpoints to segment a-b,
+ * all of them taken to fall in the region (interior or end) of their mean. */
+double polyc__cost(const polyc__point *p, float ax, float ay, float bx, float by)
+{
+    double dx = (double)bx - (double)ax, dy = (double)by - (double)ay;
+    double mx = (double)p->x - (double)ax, my = (double)p->y - (double)ay;
+    double l2 = dx * dx + dy * dy;
+    double trace = (double)p->cxx + (double)p->cyy;
+    double t = l2 > 1e-18 ? (mx * dx + my * dy) / l2 : 0.0;
+    if (t <= 0.0)
+        return (double)p->w * (mx * mx + my * my) + trace;
+    if (t >= 1.0) {
+        double ex = (double)p->x - (double)bx, ey = (double)p->y - (double)by;
+        return (double)p->w * (ex * ex + ey * ey) + trace;
+    }
+    double inv = 1.0 / sqrt(l2);
+    double nx = -dy * inv, ny = dx * inv;
+    double d = nx * mx + ny * my;
+    return (double)p->w * d * d +
+           (nx * nx * (double)p->cxx + 2.0 * nx * ny * (double)p->cxy + ny * ny * (double)p->cyy);
+}
+
+double polyc__cost_seg(const polyc__opt *o, const polyc__point *p, int32_t seg)
+{
+    const polyc__vertex *a = &o->s->v[seg];
+    const polyc__vertex *b = &o->s->v[a->next];
+    return polyc__cost(p, a->x, a->y, b->x, b->y);
+}
+
+static double cap_of(const polyc__opt *o, const polyc__point *p)
+{
+    return (double)p->w * (double)o->R2;
+}
+
+double polyc__nearest(const polyc__opt *o, int32_t pi, const int32_t *skip, int n_skip,
+                      int32_t *seg)
+{
+    const polyc__hash *h = &o->h;
+    const polyc__point *p = &o->pts[pi];
+    double best = cap_of(o, p);
+    int32_t best_seg = POLYC__NONE;
+    int32_t b = polyc__bucket_of(h, p->x, p->y);
+    int32_t bx = b % h->bx, by = b / h->bx;
+    for (int32_t y = by - 1; y <= by + 1; y++) {
+        if (y < 0 || y >= h->by)
+            continue;
+        for (int32_t x = bx - 1; x <= bx + 1; x++) {
+            if (x < 0 || x >= h->bx)
+                continue;
+            for (int32_t e = h->seg_head[y * h->bx + x]; e != POLYC__NONE; e = h->entries[e].next) {
+                int32_t sg = h->entries[e].seg;
+                int skipped = 0;
+                for (int k = 0; k < n_skip; k++)
+                    skipped |= skip[k] == sg;
+                if (skipped)
+                    continue;
+                double c = polyc__cost_seg(o, p, sg);
+                if (c < best) {
+                    best = c;
+                    best_seg = sg;
+                }
+            }
+        }
+    }
+    if (seg)
+        *seg = best_seg;
+    return best;
+}
+
+/* 1 - p(turn | x, y) at v; open ends have no angle. */
+double polyc__vertex_angle_cost(const polyc__opt *o, int32_t v)
+{
+    if (o->cfg->gamma <= 0.0f)
+        return 0.0;
+    const polyc__vertex *c = &o->s->v[v];
+    if (c->prev == POLYC__NONE || c->next == POLYC__NONE)
+        return 0.0;
+    const polyc__vertex *a = &o->s->v[c->prev], *b = &o->s->v[c->next];
+    return polyc__turn_cost(o, a->x, a->y, c->x, c->y, b->x, b->y);
+}
+
+double polyc__bic(const polyc__opt *o)
+{
+    return (double)o->cfg->alpha * (o->err + (double)o->cfg->gamma * o->angle) +
+           (double)o->s->v_live * o->log_n;
+}
+
+polyc_status polyc__rebuild(polyc__opt *o)
+{
+    polyc__store *s = o->s;
+    polyc__hash_clear(o);
+    o->angle = 0.0;
+    for (int32_t v = 0; v < s->v_high; v++) {
+        o->acost[v] = 0.0;
+        if (s->v[v].line == POLYC__NONE)
+            continue;
+        if (s->v[v].next != POLYC__NONE && !polyc__hash_insert(o, v))
+            return polyc__fail(o->ctx, POLYC_ERR_NOMEM, "spatial hash full");
+        o->acost[v] = polyc__vertex_angle_cost(o, v);
+        o->angle += o->acost[v];
+    }
+    o->err = 0.0;
+    for (int32_t i = 0; i < o->np; i++) {
+        o->pt_cost[i] = polyc__nearest(o, i, NULL, 0, &o->pt_seg[i]);
+        o->err += o->pt_cost[i];
+    }
+    return POLYC_OK;
+}
+
+/* ---- recording a change ---- */
+
+static void list_bucket(polyc__opt *o, int32_t b)
+{
+    if (o->bucket_mark[b] == o->epoch)
+        return;
+    o->bucket_mark[b] = o->epoch;
+    o->bucket_list[o->bucket_n++] = b;
+}
+
+static void mark_segment_region(polyc__opt *o, int32_t seg)
+{
+    const polyc__vertex *a = &o->s->v[seg];
+    const polyc__vertex *b = &o->s->v[a->next];
+    polyc__segment_buckets(o, a->x, a->y, b->x, b->y, 1, list_bucket);
+}
+
+void polyc__chg_begin(polyc__opt *o)
+{
+    o->epoch++;
+    o->bucket_n = 0;
+    o->added_n = 0;
+    o->dirty_n = 0;
+}
+
+void polyc__chg_seg_out(polyc__opt *o, int32_t seg)
+{
+    if (seg == POLYC__NONE || !o->seg_in[seg])
+        return;
+    mark_segment_region(o, seg);
+    polyc__hash_remove(o, seg);
+    o->seg_dead[seg] = o->epoch;
+}
+
+int polyc__chg_seg_in(polyc__opt *o, int32_t seg)
+{
+    if (seg == POLYC__NONE || o->seg_in[seg] || o->s->v[seg].next == POLYC__NONE)
+        return 1;
+    int ok = polyc__hash_insert(o, seg);
+    mark_segment_region(o, seg);
+    if (o->added_n < o->added_cap)
+        o->added[o->added_n++] = seg;
+    else
+        o->seg_dead[seg] = o->epoch; /* too many: fall back to full queries */
+    return ok;
+}
+
+void polyc__chg_dirty(polyc__opt *o, int32_t v)
+{
+    if (v == POLYC__NONE || o->v_dirty[v] == o->epoch || o->dirty_n >= o->dirty_cap)
+        return;
+    o->v_dirty[v] = o->epoch;
+    o->angle -= o->acost[v];
+    o->acost[v] = 0.0;
+    o->dirty_list[o->dirty_n++] = v;
+}
+
+void polyc__chg_commit(polyc__opt *o)
+{
+    const polyc__hash *h = &o->h;
+    for (int32_t k = 0; k < o->bucket_n; k++) {
+        int32_t b = o->bucket_list[k];
+        for (uint32_t i = h->pt_start[b]; i < h->pt_start[b + 1]; i++) {
+            double old = o->pt_cost[i], c;
+            int32_t seg = o->pt_seg[i];
+            if (seg != POLYC__NONE && o->seg_dead[seg] == o->epoch) {
+                c = polyc__nearest(o, (int32_t)i, NULL, 0, &seg);
+            } else {
+                c = old;
+                for (int32_t a = 0; a < o->added_n; a++) {
+                    int32_t sg = o->added[a];
+                    if (!o->seg_in[sg])
+                        continue;
+                    double ca = polyc__cost_seg(o, &o->pts[i], sg);
+                    if (ca < c) {
+                        c = ca;
+                        seg = sg;
+                    }
+                }
+            }
+            o->pt_cost[i] = c;
+            o->pt_seg[i] = seg;
+            o->err += c - old;
+        }
+    }
+    for (int32_t k = 0; k < o->dirty_n; k++) {
+        int32_t v = o->dirty_list[k];
+        if (o->s->v[v].line == POLYC__NONE)
+            continue;
+        o->acost[v] = polyc__vertex_angle_cost(o, v);
+        o->angle += o->acost[v];
+    }
+    o->bucket_n = o->added_n = o->dirty_n = 0;
+}
+
+/* ---- local evaluation (read-only) ---- */
+
+/* A segment prepared for many cost evaluations. */
+typedef struct seg_pre {
+    double ax, ay, bx, by, dx, dy, inv_l2, nx, ny;
+} seg_pre;
+
+static void seg_prepare(seg_pre *q, const float *xy)
+{
+    q->ax = (double)xy[0];
+    q->ay = (double)xy[1];
+    q->bx = (double)xy[2];
+    q->by = (double)xy[3];
+    q->dx = q->bx - q->ax;
+    q->dy = q->by - q->ay;
+    double l2 = q->dx * q->dx + q->dy * q->dy;
+    q->inv_l2 = l2 > 1e-18 ? 1.0 / l2 : 0.0;
+    double inv = l2 > 1e-18 ? 1.0 / sqrt(l2) : 0.0;
+    q->nx = -q->dy * inv;
+    q->ny = q->dx * inv;
+}
+
+/* Same value as polyc__cost, without the per-call divisions. */
+static double seg_cost(const seg_pre *q, const polyc__point *p)
+{
+    double mx = (double)p->x - q->ax, my = (double)p->y - q->ay;
+    double t = (mx * q->dx + my * q->dy) * q->inv_l2;
+    if (t <= 0.0 || q->inv_l2 == 0.0)
+        return (double)p->w * (mx * mx + my * my) + ((double)p->cxx + (double)p->cyy);
+    if (t >= 1.0) {
+        double ex = (double)p->x - q->bx, ey = (double)p->y - q->by;
+        return (double)p->w * (ex * ex + ey * ey) + ((double)p->cxx + (double)p->cyy);
+    }
+    double d = q->nx * mx + q->ny * my;
+    return (double)p->w * d * d + (q->nx * q->nx * (double)p->cxx +
+                                   2.0 * q->nx * q->ny * (double)p->cxy + q->ny * q->ny * (double)p->cyy);
+}
+
+static double point_seg_dist(const polyc__point *p, const float *xy)
+{
+    double dx = (double)xy[2] - (double)xy[0], dy = (double)xy[3] - (double)xy[1];
+    double mx = (double)p->x - (double)xy[0], my = (double)p->y - (double)xy[1];
+    double l2 = dx * dx + dy * dy;
+    double t = l2 > 1e-18 ? (mx * dx + my * dy) / l2 : 0.0;
+    t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
+    double ex = mx - t * dx, ey = my - t * dy;
+    return sqrt(ex * ex + ey * ey);
+}
+
+/* Collects the points near the `old` segments and the candidate geometry,
+ * with their cost when the old segments are gone (loc_base). With reach > 0
+ * the candidates stay within `reach` of seg_xy: a point whose base cost is
+ * below any cost it could get from them never changes, and is summed once
+ * into loc_fixed instead of being listed. */
+void polyc__local_prepare(polyc__opt *o, const int32_t *old, int n_old, const float *seg_xy,
+                          int n_new, float reach)
+{
+    const polyc__hash *h = &o->h;
+    o->epoch++;
+    o->bucket_n = 0;
+    for (int k = 0; k < n_old; k++)
+        if (old[k] != POLYC__NONE)
+            mark_segment_region(o, old[k]);
+    for (int k = 0; k < n_new; k++) {
+        const float *q = seg_xy + 4 * k;
+        polyc__segment_buckets(o, q[0], q[1], q[2], q[3], 1, list_bucket);
+    }
+    o->loc_n = 0;
+    o->loc_fixed = 0.0;
+    o->loc_fixed_cur = 0.0;
+    for (int32_t k = 0; k < o->bucket_n; k++) {
+        int32_t b = o->bucket_list[k];
+        for (uint32_t i = h->pt_start[b]; i < h->pt_start[b + 1]; i++) {
+            int32_t seg = o->pt_seg[i];
+            int hit = 0;
+            for (int j = 0; j < n_old; j++)
+                hit |= seg != POLYC__NONE && seg == old[j];
+            double base = hit ? polyc__nearest(o, (int32_t)i, old, n_old, NULL) : o->pt_cost[i];
+            if (reach > 0.0f) {
+                const polyc__point *p = &o->pts[i];
+                double dmin = 1e30;
+                for (int j = 0; j < n_new; j++) {
+                    double d = point_seg_dist(p, seg_xy + 4 * j);
+                    if (d < dmin)
+                        dmin = d;
+                }
+                dmin -= (double)reach;
+                if (dmin > 0.0 && base <= (double)p->w * dmin * dmin) {
+                    o->loc_fixed += base;
+                    o->loc_fixed_cur += o->pt_cost[i];
+                    continue;
+                }
+            }
+            o->loc_pt[o->loc_n] = (int32_t)i;
+            o->loc_base[o->loc_n] = base;
+            o->loc_n++;
+        }
+    }
+    o->bucket_n = 0;
+}
+
+double polyc__local_eval(const polyc__opt *o, const float *seg_xy, int n_new)
+{
+    seg_pre q[4];
+    POLYC_ASSERT(n_new <= 4);
+    for (int j = 0; j < n_new; j++)
+        seg_prepare(&q[j], seg_xy + 4 * j);
+    double sum = o->loc_fixed;
+    for (int32_t k = 0; k < o->loc_n; k++) {
+        const polyc__point *p = &o->pts[o->loc_pt[k]];
+        double c = o->loc_base[k];
+        for (int j = 0; j < n_new; j++) {
+            double cj = seg_cost(&q[j], p);
+            if (cj < c)
+                c = cj;
+        }
+        sum += c;
+    }
+    return sum;
+}
+
+double polyc__local_current(const polyc__opt *o)
+{
+    double sum = o->loc_fixed_cur;
+    for (int32_t k = 0; k < o->loc_n; k++)
+        sum += o->pt_cost[o->loc_pt[k]];
+    return sum;
+}

@@ -1,0 +1,183 @@
+/* spatial_hash.c - uniform buckets for nearest-segment queries.
+ * Takes: the grid extent and the polyline segments. Gives: per bucket the
+ * segments passing through it (a segment is entered in every bucket its
+ * path crosses) and the data points lying in it. With buckets at least as
+ * wide as the search radius, every segment within reach of a point passes
+ * through the 3 x 3 buckets around it. */
+#include "optimize.h"
+
+#include <math.h>
+#include <string.h>
+
+#define HASH_MARGIN_M 2.0f /* vertices may wander a little outside the grid */
+
+int32_t polyc__hash_bucket_cap(const polyc_limits *lim)
+{
+    size_t tiles = ((size_t)lim->max_grid_cells + POLYC__TILE_CELLS - 1) / POLYC__TILE_CELLS;
+    size_t cap = 16 * (tiles * 4 + 64) + 1024;
+    return cap > 0x3fffffff ? 0x3fffffff : (int32_t)cap;
+}
+
+int32_t polyc__hash_entry_cap(const polyc_limits *lim)
+{
+    int64_t v = polyc__max_vertices(lim);
+    int64_t cap = 4 * v + 4096;
+    return cap > 0x3fffffff ? 0x3fffffff : (int32_t)cap;
+}
+
+polyc_status polyc__hash_init(polyc__opt *o)
+{
+    polyc_ctx *ctx = o->ctx;
+    polyc__hash *h = &o->h;
+    const polyc__grid *g = &ctx->grid;
+    memset(h, 0, sizeof *h);
+    int32_t cap = polyc__hash_bucket_cap(&ctx->lim);
+    float w_m = (float)g->width * g->cell_m + 2.0f * HASH_MARGIN_M;
+    float h_m = (float)g->height * g->cell_m + 2.0f * HASH_MARGIN_M;
+    /* at least the search radius plus the reach of one hill-climbing round */
+    float b = o->R + 0.05f;
+    while ((double)ceilf(w_m / b) * (double)ceilf(h_m / b) > (double)cap)
+        b *= 1.25f;
+    h->bucket_m = b;
+    h->inv_bucket = 1.0f / b;
+    h->bx = (int32_t)ceilf(w_m / b);
+    h->by = (int32_t)ceilf(h_m / b);
+    h->origin_x = (float)(g->origin_x_m - ctx->frame_x) - HASH_MARGIN_M;
+    h->origin_y = (float)(g->origin_y_m - ctx->frame_y) - HASH_MARGIN_M;
+    size_t nb = (size_t)h->bx * (size_t)h->by;
+    h->seg_head = polyc__alloc(&ctx->arena, nb, sizeof(int32_t));
+    h->pt_start = polyc__alloc(&ctx->arena, nb + 1, sizeof(uint32_t));
+    h->entry_cap = polyc__hash_entry_cap(&ctx->lim);
+    h->entries = polyc__alloc(&ctx->arena, (size_t)h->entry_cap, sizeof(polyc__hash_entry));
+    o->bucket_mark = polyc__alloc_zero(&ctx->arena, nb, sizeof(uint32_t));
+    o->bucket_list = polyc__alloc(&ctx->arena, nb, sizeof(int32_t));
+    if (!h->seg_head || !h->pt_start || !h->entries || !o->bucket_mark || !o->bucket_list)
+        return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the spatial hash");
+    polyc__hash_clear(o);
+    return POLYC_OK;
+}
+
+void polyc__hash_clear(polyc__opt *o)
+{
+    polyc__hash *h = &o->h;
+    for (int32_t i = 0; i < h->bx * h->by; i++)
+        h->seg_head[i] = POLYC__NONE;
+    for (int32_t i = 0; i < h->entry_cap; i++)
+        h->entries[i].next = i + 1 < h->entry_cap ? i + 1 : POLYC__NONE;
+    h->entry_free = h->entry_cap ? 0 : POLYC__NONE;
+    h->entry_live = 0;
+    h->out_of_entries = 0;
+    if (o->seg_in)
+        memset(o->seg_in, 0, (size_t)o->s->v_cap);
+}
+
+static int32_t clampi(int32_t v, int32_t hi)
+{
+    return v < 0 ? 0 : (v > hi ? hi : v);
+}
+
+int32_t polyc__bucket_of(const polyc__hash *h, float x, float y)
+{
+    float fx = (x - h->origin_x) * h->inv_bucket, fy = (y - h->origin_y) * h->inv_bucket;
+    int32_t ix = fx < 0.0f ? 0 : (fx >= (float)h->bx ? h->bx - 1 : (int32_t)fx);
+    int32_t iy = fy < 0.0f ? 0 : (fy >= (float)h->by ? h->by - 1 : (int32_t)fy);
+    return iy * h->bx + ix;
+}
+
+typedef struct walk_ctx {
+    polyc__opt *o;
+    polyc__bucket_fn fn;
+    int dilate;
+} walk_ctx;
+
+static int visit_bucket(void *u, int32_t ix, int32_t iy, float t_enter, int last)
+{
+    (void)t_enter;
+    (void)last;
+    walk_ctx *w = u;
+    const polyc__hash *h = &w->o->h;
+    if (!w->dilate) {
+        w->fn(w->o, clampi(iy, h->by - 1) * h->bx + clampi(ix, h->bx - 1));
+        return 0;
+    }
+    for (int32_t dy = -1; dy <= 1; dy++)
+        for (int32_t dx = -1; dx <= 1; dx++) {
+            int32_t x = ix + dx, y = iy + dy;
+            if (x >= 0 && y >= 0 && x < h->bx && y < h->by)
+                w->fn(w->o, y * h->bx + x);
+        }
+    return 0;
+}
+
+static float clampf(float v, float hi)
+{
+    return v < 0.0f ? 0.0f : (v > hi ? hi : v);
+}
+
+void polyc__segment_buckets(polyc__opt *o, float ax, float ay, float bx, float by, int dilate,
+                            polyc__bucket_fn fn)
+{
+    const polyc__hash *h = &o->h;
+    float wx = (float)h->bx - 0.001f, wy = (float)h->by - 0.001f;
+    polyc__beam b;
+    b.sx = clampf((ax - h->origin_x) * h->inv_bucket, wx);
+    b.sy = clampf((ay - h->origin_y) * h->inv_bucket, wy);
+    b.ex = clampf((bx - h->origin_x) * h->inv_bucket, wx);
+    b.ey = clampf((by - h->origin_y) * h->inv_bucket, wy);
+    b.hit = 1;
+    b.miss_end = 1.0f;
+    walk_ctx w = {o, fn, dilate};
+    polyc__traverse(&b, visit_bucket, &w);
+}
+
+/* The bucket callbacks get the segment id through o->cur_seg. */
+static void insert_in_bucket(polyc__opt *o, int32_t bucket)
+{
+    polyc__hash *h = &o->h;
+    if (h->entry_free == POLYC__NONE) {
+        h->out_of_entries = 1;
+        return;
+    }
+    int32_t e = h->entry_free;
+    h->entry_free = h->entries[e].next;
+    h->entries[e].seg = o->cur_seg;
+    h->entries[e].next = h->seg_head[bucket];
+    h->seg_head[bucket] = e;
+    h->entry_live++;
+}
+
+static void remove_from_bucket(polyc__opt *o, int32_t bucket)
+{
+    polyc__hash *h = &o->h;
+    int32_t *link = &h->seg_head[bucket];
+    while (*link != POLYC__NONE) {
+        int32_t e = *link;
+        if (h->entries[e].seg == o->cur_seg) {
+            *link = h->entries[e].next;
+            h->entries[e].next = h->entry_free;
+            h->entry_free = e;
+            h->entry_live--;
+            return;
+        }
+        link = &h->entries[e].next;
+    }
+}
+
+int polyc__hash_insert(polyc__opt *o, int32_t seg)
+{
+    const polyc__vertex *a = &o->s->v[seg];
+    const polyc__vertex *b = &o->s->v[a->next];
+    o->cur_seg = seg;
+    polyc__segment_buckets(o, a->x, a->y, b->x, b->y, 0, insert_in_bucket);
+    o->seg_in[seg] = 1;
+    return !o->h.out_of_entries;
+}
+
+void polyc__hash_remove(polyc__opt *o, int32_t seg)
+{
+    const polyc__vertex *a = &o->s->v[seg];
+    const polyc__vertex *b = &o->s->v[a->next];
+    o->cur_seg = seg;
+    polyc__segment_buckets(o, a->x, a->y, b->x, b->y, 0, remove_from_bucket);
+    o->seg_in[seg] = 0;
+}

@@ -1,0 +1,266 @@
+/* trace.c - initial polylines from the contour (paper section III, step 3).
+ * Takes: contour cells (8-connected), thinned to one cell. Gives: polylines
+ * in the store, started at contour endpoints, then the remaining cycles; points whose removal
+ * leaves the polyline's length unchanged (collinear, in cell units) dropped. */
+#include "internal.h"
+
+#include <string.h>
+
+static const int32_t NB_X[8] = {1, 0, -1, 0, 1, -1, -1, 1}; /* 4-neighbours first */
+static const int32_t NB_Y[8] = {0, 1, 0, -1, 1, 1, -1, -1};
+
+static int unvisited(const polyc__grid *g, int32_t ix, int32_t iy)
+{
+    const polyc__tile *t = polyc__grid_tile(g, ix, iy);
+    return t && ((t->mark[iy & 31] >> (ix & 31)) & 1u);
+}
+
+static void set_visited(const polyc__grid *g, int32_t ix, int32_t iy)
+{
+    polyc__tile *t = polyc__grid_tile(g, ix, iy);
+    t->mark[iy & 31] &= ~(1u << (ix & 31));
+}
+
+static int contour_degree(const polyc__grid *g, int32_t ix, int32_t iy)
+{
+    int d = 0;
+    for (int k = 0; k < 8; k++) {
+        const polyc__tile *t = polyc__grid_tile(g, ix + NB_X[k], iy + NB_Y[k]);
+        int32_t x = ix + NB_X[k], y = iy + NB_Y[k];
+        d += t && ((t->contour[y & 31] >> (x & 31)) & 1u);
+    }
+    return d;
+}
+
+static int unvisited_degree(const polyc__grid *g, int32_t ix, int32_t iy)
+{
+    int d = 0;
+    for (int k = 0; k < 8; k++)
+        d += unvisited(g, ix + NB_X[k], iy + NB_Y[k]);
+    return d;
+}
+
+/* The next cell of a walk: an unvisited neighbour, 4-neighbours before
+ * diagonal ones, and among those the one with the fewest unvisited
+ * neighbours of its own (it keeps the walk on the rim of thick contours).
+ * From an isolated contour cell (no contour neighbour at all) the walk
+ * continues to the nearest isolated unvisited cell within `link` cells: sparse data
+ * (far walls, single scans) leave such gaps, which the merge operator would
+ * close anyway; dense chains are never bridged here. */
+static int next_cell(const polyc__grid *g, int32_t link, int32_t ix, int32_t iy, int32_t *nx,
+                     int32_t *ny)
+{
+    for (int pass = 0; pass < 2; pass++) {
+        int best = 99;
+        for (int k = pass * 4; k < pass * 4 + 4; k++) {
+            int32_t cx = ix + NB_X[k], cy = iy + NB_Y[k];
+            if (!unvisited(g, cx, cy))
+                continue;
+            int d = unvisited_degree(g, cx, cy);
+            if (d < best) {
+                best = d;
+                *nx = cx;
+                *ny = cy;
+            }
+        }
+        if (best < 99)
+            return 1;
+    }
+    if (contour_degree(g, ix, iy) > 0)
+        return 0; /* dense contour: chains end where they end */
+    int32_t best2 = link * link + 1;
+    for (int32_t dy = -link; dy <= link; dy++)
+        for (int32_t dx = -link; dx <= link; dx++) {
+            int32_t d2 = dx * dx + dy * dy;
+            if (d2 >= best2 || d2 <= 2 || !unvisited(g, ix + dx, iy + dy) ||
+                contour_degree(g, ix + dx, iy + dy) > 0)
+                continue;
+            best2 = d2;
+            *nx = ix + dx;
+            *ny = iy + dy;
+        }
+    return best2 <= link * link;
+}
+
+/* ---- thinning (Zhang-Suen) of the cells to trace ----
+ * Pose errors and range noise make contours two or three cells thick; a
+ * walk along such a band goes back and forth and leaves overlapping
+ * pieces. Thinning the band to one cell first gives clean chains. */
+
+static int mark_at(const polyc__grid *g, int32_t ix, int32_t iy)
+{
+    return unvisited(g, ix, iy);
+}
+
+/* p2..p9: N, NE, E, SE, S, SW, W, NW */
+static const int32_t ZS_X[8] = {0, 1, 1, 1, 0, -1, -1, -1};
+static const int32_t ZS_Y[8] = {1, 1, 0, -1, -1, -1, 0, 1};
+
+static int zs_deletable(const polyc__grid *g, int32_t ix, int32_t iy, int sub)
+{
+    int p[8], b = 0, a = 0;
+    for (int k = 0; k < 8; k++) {
+        p[k] = mark_at(g, ix + ZS_X[k], iy + ZS_Y[k]);
+        b += p[k];
+    }
+    for (int k = 0; k < 8; k++)
+        a += !p[k] && p[(k + 1) & 7];
+    if (b < 2 || b > 6 || a != 1)
+        return 0;
+    /* p2 = N (0), p4 = E (2), p6 = S (4), p8 = W (6) */
+    if (sub == 0)
+        return !(p[0] && p[2] && p[4]) && !(p[2] && p[4] && p[6]);
+    return !(p[0] && p[2] && p[6]) && !(p[0] && p[4] && p[6]);
+}
+
+static void thin(const polyc_ctx *ctx, int32_t *del, uint32_t cap)
+{
+    const polyc__grid *g = &ctx->grid;
+    for (int changed = 1; changed;) {
+        changed = 0;
+        for (int sub = 0; sub < 2; sub++) {
+            uint32_t n = 0;
+            for (uint32_t i = 0; i < ctx->contour_count && n < cap; i++) {
+                int32_t ix = ctx->contour_xy[2 * i], iy = ctx->contour_xy[2 * i + 1];
+                if (mark_at(g, ix, iy) && zs_deletable(g, ix, iy, sub))
+                    del[n++] = (int32_t)i;
+            }
+            for (uint32_t k = 0; k < n; k++)
+                set_visited(g, ctx->contour_xy[2 * del[k]], ctx->contour_xy[2 * del[k] + 1]);
+            changed |= n > 0;
+        }
+    }
+}
+
+typedef struct walk {
+    int32_t *xy;     /* scratch: cells of the current walk, 2 per cell */
+    uint32_t n, cap;
+} walk;
+
+static void walk_from(const polyc__grid *g, int32_t link, walk *w, int32_t ix, int32_t iy)
+{
+    while (w->n < w->cap) {
+        w->xy[2 * w->n] = ix;
+        w->xy[2 * w->n + 1] = iy;
+        w->n++;
+        set_visited(g, ix, iy);
+        if (!next_cell(g, link, ix, iy, &ix, &iy))
+            break;
+    }
+}
+
+static void reverse_cells(int32_t *xy, uint32_t n)
+{
+    for (uint32_t i = 0, j = n - 1; i < j; i++, j--) {
+        int32_t tx = xy[2 * i], ty = xy[2 * i + 1];
+        xy[2 * i] = xy[2 * j];
+        xy[2 * i + 1] = xy[2 * j + 1];
+        xy[2 * j] = tx;
+        xy[2 * j + 1] = ty;
+    }
+}
+
+/* b lies on segment a-c: removing it does not change the length. */
+static int redundant(const int32_t *a, const int32_t *b, const int32_t *c)
+{
+    int64_t ux = b[0] - a[0], uy = b[1] - a[1];
+    int64_t vx = c[0] - b[0], vy = c[1] - b[1];
+    return ux * vy - uy * vx == 0 && ux * vx + uy * vy >= 0;
+}
+
+static polyc_status emit(polyc_ctx *ctx, walk *w, int closed)
+{
+    const polyc__grid *g = &ctx->grid;
+    polyc__store *s = &ctx->store;
+    if (w->n < 2)
+        return POLYC_OK; /* a lone cell gives no segment */
+    /* drop redundant points in place */
+    uint32_t m = 1;
+    for (uint32_t i = 1; i < w->n; i++) {
+        int is_last = i + 1 == w->n;
+        if (!is_last && redundant(&w->xy[2 * (m - 1)], &w->xy[2 * i], &w->xy[2 * (i + 1)]))
+            continue;
+        w->xy[2 * m] = w->xy[2 * i];
+        w->xy[2 * m + 1] = w->xy[2 * i + 1];
+        m++;
+    }
+    if (closed && m >= 4) {
+        /* the joins of a cycle: last-first-second, and second-last-last-first */
+        if (redundant(&w->xy[2 * (m - 1)], &w->xy[0], &w->xy[2])) {
+            memmove(w->xy, w->xy + 2, (size_t)(m - 1) * 2 * sizeof(int32_t));
+            m--;
+        }
+        if (m >= 4 && redundant(&w->xy[2 * (m - 2)], &w->xy[2 * (m - 1)], &w->xy[0]))
+            m--;
+    }
+    if (closed && m < 3)
+        closed = 0;
+    int32_t l = polyc__line_new(s);
+    if (l == POLYC__NONE)
+        return polyc__fail(ctx, POLYC_ERR_NOMEM, "too many polylines for limits.max_vertices");
+    /* store coordinates relative to the frame (first pose) */
+    double ox = g->origin_x_m - ctx->frame_x, oy = g->origin_y_m - ctx->frame_y;
+    for (uint32_t i = 0; i < m; i++) {
+        float x = (float)(ox + ((double)w->xy[2 * i] + 0.5) * (double)g->cell_m);
+        float y = (float)(oy + ((double)w->xy[2 * i + 1] + 0.5) * (double)g->cell_m);
+        if (polyc__vertex_append(s, l, x, y) == POLYC__NONE)
+            return polyc__fail(ctx, POLYC_ERR_NOMEM, "too many vertices for limits.max_vertices");
+    }
+    if (closed)
+        polyc__line_close(s, l);
+    return POLYC_OK;
+}
+
+static int adjacent(const int32_t *a, const int32_t *b, int32_t link)
+{
+    int32_t dx = a[0] - b[0], dy = a[1] - b[1];
+    return dx * dx + dy * dy <= (link > 1 ? link * link : 2);
+}
+
+polyc_status polyc__trace_build(polyc_ctx *ctx)
+{
+    const polyc__grid *g = &ctx->grid;
+    polyc_status st = polyc__store_init(ctx, &ctx->store, polyc__max_vertices(&ctx->lim));
+    if (st != POLYC_OK)
+        return st;
+    size_t after_store = ctx->arena.used; /* the walk scratch is released at the end */
+    walk w;
+    w.cap = ctx->contour_count + 1;
+    w.n = 0;
+    w.xy = polyc__alloc(&ctx->arena, (size_t)w.cap * 2, sizeof(int32_t));
+    if (!w.xy)
+        return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for tracing");
+    for (uint32_t k = 0; k < g->tile_count; k++)
+        memcpy(g->tiles[k].mark, g->tiles[k].contour, sizeof g->tiles[k].mark);
+    thin(ctx, w.xy, w.cap); /* the walk buffer is free until the walks start */
+
+    float link_f = ctx->cfg.merge_dist_m / g->cell_m;
+    int32_t link = link_f < 1.0f ? 1 : (link_f > 8.0f ? 8 : (int32_t)link_f);
+    /* endpoints first (walking can create new ones: repeat until none), then
+     * the rest, which are cycles or knots of them; each walk also goes
+     * backwards from its start when cells are left on that side */
+    for (int phase = 0; phase < 2; phase++) {
+        int found = 1;
+        while (found) {
+            found = 0;
+            for (uint32_t i = 0; i < ctx->contour_count; i++) {
+                int32_t ix = ctx->contour_xy[2 * i], iy = ctx->contour_xy[2 * i + 1];
+                if (!unvisited(g, ix, iy) || (phase == 0 && unvisited_degree(g, ix, iy) > 1))
+                    continue;
+                w.n = 0;
+                walk_from(g, link, &w, ix, iy);
+                int closed = phase == 1 && w.n >= 4 && adjacent(&w.xy[0], &w.xy[2 * (w.n - 1)], link);
+                int32_t nx, ny;
+                if (!closed && next_cell(g, link, ix, iy, &nx, &ny)) {
+                    reverse_cells(w.xy, w.n);
+                    walk_from(g, link, &w, nx, ny);
+                }
+                if ((st = emit(ctx, &w, closed)) != POLYC_OK)
+                    return st;
+                found = phase == 0;
+            }
+        }
+    }
+    ctx->arena.used = after_store;
+    return POLYC_OK;
+}

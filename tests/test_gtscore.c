@@ -1,0 +1,325 @@
+/* test_gtscore.c - the scorer on hand cases with known answers, its
+ * segment index against brute force, and its reader's error messages. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gtscore.h"
+#include "scansim.h"
+
+#define assert_near(a, b, tol) \
+    near_check((double)(a), (double)(b), (double)(tol), #a, __FILE__, __LINE__)
+
+static void near_check(double a, double b, double tol, const char *what, const char *file,
+                       int line)
+{
+    if (!(fabs(a - b) <= tol))
+        fail_msg("%s:%d: %s = %.9g, expected %.9g +- %.3g", file, line, what, a, b, tol);
+}
+
+/* Reads truth from text; fails the test on error. */
+static void truth_from_text(gtscore_truth *t, const char *text)
+{
+    char err[256];
+    FILE *f = fmemopen((void *)(uintptr_t)text, strlen(text), "r");
+    assert_non_null(f);
+    if (gtscore_truth_read(t, f, "hand.gt.txt", err, sizeof err) != 0)
+        fail_msg("truth: %s", err);
+    fclose(f);
+}
+
+/* The error message of a truth text that must fail. */
+static void truth_error(const char *text, char *err, size_t err_size)
+{
+    gtscore_truth t;
+    FILE *f = fmemopen((void *)(uintptr_t)text, strlen(text), "r");
+    assert_non_null(f);
+    assert_int_equal(gtscore_truth_read(&t, f, "bad.gt.txt", err, err_size), -1);
+    gtscore_truth_free(&t);
+    fclose(f);
+}
+
+/* A 4 m x 3 m room with its seen samples every 2 cm all round. */
+static char *room_text(void)
+{
+    size_t cap = 1u << 20, len = 0;
+    char *text = malloc(cap);
+    int k;
+    assert_non_null(text);
+    len += (size_t)snprintf(text + len, cap - len,
+                            "# a room\nideal 4\n\nwall closed 0 0 4 0 4 3 0 3\n");
+    for (k = 0; k < 200; k++) /* bottom, y = 0, and top, y = 3 */
+        len += (size_t)snprintf(text + len, cap - len, "seen %.2f 0\nseen %.2f 3\n",
+                                0.02 * k, 4.0 - 0.02 * k);
+    for (k = 0; k < 150; k++) /* right, x = 4, and left, x = 0 */
+        len += (size_t)snprintf(text + len, cap - len, "seen 4 %.2f\nseen 0 %.2f\n",
+                                0.02 * k, 3.0 - 0.02 * k);
+    return text;
+}
+
+static void test_truth_as_map(void **state)
+{
+    static const float room[] = {0, 0, 4, 0, 4, 3, 0, 3};
+    polyc_polyline line = {room, 4, 1};
+    gtscore_truth t;
+    gtscore_map_score sc;
+    char *text = room_text();
+    (void)state;
+    truth_from_text(&t, text);
+    assert_int_equal(t.wall_count, 1);
+    assert_int_equal(t.seen_count, 700);
+    assert_int_equal(t.ideal, 4);
+    assert_int_equal(gtscore_score_map(&t, &line, 1, &sc), 0);
+    assert_near(sc.precision_rms_m, 0.0, 1e-9);
+    assert_near(sc.precision_max_m, 0.0, 1e-9);
+    assert_int_equal(sc.precision_samples, 1400); /* 14 m every 1 cm */
+    assert_near(sc.completeness, 1.0, 0.0);
+    assert_int_equal(sc.vertices, 4);
+    assert_near(sc.vertex_ratio, 1.0, 0.0);
+    gtscore_truth_free(&t);
+    free(text);
+}
+
+/* A map 1 cm beside a straight wall: every sample is 1 cm off. */
+static void test_shifted_map(void **state)
+{
+    static const float map[] = {0.0f, 0.01f, 10.0f, 0.01f};
+    polyc_polyline line = {map, 2, 0};
+    gtscore_truth t;
+    gtscore_map_score sc;
+    (void)state;
+    truth_from_text(&t, "wall open 0 0 10 0\nseen 5 0\nseen 5.02 0\n");
+    assert_int_equal(gtscore_score_map(&t, &line, 1, &sc), 0);
+    assert_int_equal(sc.precision_samples, 1001);
+    assert_near(sc.precision_rms_m, 0.01, 1e-6);
+    assert_near(sc.precision_p95_m, 0.01, 1e-6);
+    assert_near(sc.precision_max_m, 0.01, 1e-6);
+    assert_near(sc.completeness, 1.0, 0.0);
+    assert_int_equal(sc.ideal, 0); /* no ideal line: ratio 0 */
+    assert_near(sc.vertex_ratio, 0.0, 0.0);
+    gtscore_truth_free(&t);
+}
+
+/* The map lacks the top wall: the top samples farther than 5 cm from the
+ * side walls' ends are missed. */
+static void test_missing_wall(void **state)
+{
+    static const float three_sides[] = {0, 3, 0, 0, 4, 0, 4, 3};
+    polyc_polyline line = {three_sides, 4, 0};
+    gtscore_truth t;
+    gtscore_map_score sc;
+    char *text = room_text();
+    uint32_t k, missed = 0;
+    (void)state;
+    truth_from_text(&t, text);
+    for (k = 0; k < 200; k++) { /* top samples at x = 4 - 0.02 k */
+        double x = 4.0 - 0.02 * k;
+        if (x > 0.05 + 1e-9 && x < 4.0 - 0.05 - 1e-9)
+            missed++;
+    }
+    assert_int_equal(missed, 200 - 3 - 2); /* x = 4, 3.98, 3.96 and 0.02, 0.04 */
+    assert_int_equal(gtscore_score_map(&t, &line, 1, &sc), 0);
+    assert_int_equal(sc.seen_covered, 700 - missed);
+    assert_near(sc.completeness, (700.0 - missed) / 700.0, 1e-12);
+    assert_near(sc.precision_rms_m, 0.0, 1e-9);
+    gtscore_truth_free(&t);
+    free(text);
+}
+
+/* p95 by nearest rank, and a map sample far from every wall. */
+static void test_percentile_and_far(void **state)
+{
+    static const float far[] = {0.0f, 3.0f};
+    static const float on[] = {0.0f, 0.0f, 1.0f, 0.0f};
+    polyc_polyline lines[2] = {{on, 2, 0}, {far, 1, 0}};
+    gtscore_truth t;
+    gtscore_map_score sc;
+    (void)state;
+    truth_from_text(&t, "wall open 0 0 1 0\n");
+    assert_int_equal(gtscore_score_map(&t, lines, 2, &sc), 0);
+    /* 101 samples on the wall (0 .. 1 m) and one 3 m away */
+    assert_int_equal(sc.precision_samples, 102);
+    assert_near(sc.precision_max_m, 3.0, 1e-6);
+    assert_near(sc.precision_p95_m, 0.0, 1e-9);
+    assert_near(sc.precision_rms_m, sqrt(9.0 / 102.0), 1e-6);
+    assert_int_equal(sc.vertices, 3);
+    assert_int_equal(sc.polylines, 2);
+    assert_near(sc.completeness, 1.0, 0.0); /* no seen samples */
+    gtscore_truth_free(&t);
+}
+
+/* Five beams at a wall x = 2, |y| <= 1: two hit it with known errors, two
+ * pass beside it, one returns nothing. */
+static void test_single_scan(void **state)
+{
+    static const float wall[] = {2.0f, -1.0f, 2.0f, 1.0f};
+    float range[5];
+    polyc_scan scan;
+    gtscore_index map;
+    gtscore_scan_score acc;
+    uint64_t within, total;
+    (void)state;
+    range[0] = 2.3f;                              /* -0.5 rad: beside the wall */
+    range[1] = (float)(2.0 / cos(0.25) + 0.03);   /* hits, error +3 cm */
+    range[2] = 1.96f;                             /* hits, error -4 cm */
+    range[3] = 8.0f;                              /* no return */
+    range[4] = 2.5f;                              /* beside the wall */
+    memset(&scan, 0, sizeof scan);
+    scan.start_angle_rad = -0.5f;
+    scan.angle_step_rad = 0.25f;
+    scan.min_range_m = 0.02f;
+    scan.max_range_m = 8.0f;
+    scan.beam_count = 5;
+    scan.range_m = range;
+    gtscore_index_init(&map);
+    assert_int_equal(gtscore_index_add_f(&map, wall, 2, 0), 0);
+    assert_int_equal(gtscore_index_build(&map, 0.1), 0);
+
+    memset(&acc, 0, sizeof acc);
+    gtscore_score_scan(&map, &scan, &acc);
+    assert_int_equal(acc.reflected, 4);
+    assert_int_equal(acc.hits, 2);
+    assert_near(acc.f, 0.5, 0.0);
+    assert_near(acc.ray_rmse_m, sqrt((0.03 * 0.03 + 0.04 * 0.04) / 2.0), 2e-6);
+
+    /* the same scene moved and turned: the same scores */
+    {
+        const double c = cos(1.0), s = sin(1.0);
+        float moved[4];
+        gtscore_scan_score acc2;
+        int k;
+        for (k = 0; k < 2; k++) {
+            moved[2 * k] = (float)(5.0 + c * (double)wall[2 * k] - s * (double)wall[2 * k + 1]);
+            moved[2 * k + 1] = (float)(-3.0 + s * (double)wall[2 * k] + c * (double)wall[2 * k + 1]);
+        }
+        gtscore_index_free(&map);
+        gtscore_index_init(&map);
+        assert_int_equal(gtscore_index_add_f(&map, moved, 2, 0), 0);
+        assert_int_equal(gtscore_index_build(&map, 0.1), 0);
+        scan.pose_x_m = 5.0;
+        scan.pose_y_m = -3.0;
+        scan.pose_theta_rad = 1.0;
+        memset(&acc2, 0, sizeof acc2);
+        gtscore_score_scan(&map, &scan, &acc2);
+        assert_int_equal(acc2.hits, 2);
+        assert_near(acc2.ray_rmse_m, acc.ray_rmse_m, 2e-5);
+    }
+
+    /* endpoints within 5 cm: beams 1 (3 cm) and 2 (4 cm) */
+    gtscore_endpoints_within(&map, &scan, 1, 0.05, &within, &total);
+    assert_int_equal(total, 4);
+    assert_int_equal(within, 2);
+    gtscore_endpoints_within(&map, &scan, 1, 0.035, &within, &total);
+    assert_int_equal(within, 1);
+    gtscore_index_free(&map);
+}
+
+/* The grid index against brute force on random segments, points (some far
+ * outside the grid) and rays. */
+static void test_index_vs_brute_force(void **state)
+{
+    enum { SEGS = 300, QUERIES = 3000 };
+    double seg[4 * SEGS];
+    gtscore_index index;
+    scansim_rng rng;
+    int i, k;
+    (void)state;
+    scansim_rng_seed(&rng, 99);
+    gtscore_index_init(&index);
+    for (i = 0; i < SEGS; i++) {
+        double x = 20.0 * scansim_rng_uniform(&rng) - 10.0;
+        double y = 10.0 * scansim_rng_uniform(&rng);
+        double a = 6.283 * scansim_rng_uniform(&rng), len = 3.0 * scansim_rng_uniform(&rng);
+        seg[4 * i] = x;
+        seg[4 * i + 1] = y;
+        seg[4 * i + 2] = x + len * cos(a);
+        seg[4 * i + 3] = y + len * sin(a);
+        assert_int_equal(gtscore_index_add_d(&index, &seg[4 * i], 2, 0), 0);
+    }
+    assert_int_equal(gtscore_index_build(&index, 0.3), 0);
+    for (k = 0; k < QUERIES; k++) {
+        double x = 40.0 * scansim_rng_uniform(&rng) - 20.0;
+        double y = 30.0 * scansim_rng_uniform(&rng) - 10.0;
+        double a = 6.283 * scansim_rng_uniform(&rng);
+        double best_d = INFINITY, best_t = INFINITY, d, t;
+        for (i = 0; i < SEGS; i++) {
+            const double *g = &seg[4 * i];
+            double ex = g[2] - g[0], ey = g[3] - g[1], wx = x - g[0], wy = y - g[1];
+            double u = (wx * ex + wy * ey) / (ex * ex + ey * ey);
+            double dx = cos(a), dy = sin(a), den = dx * ey - dy * ex;
+            u = u < 0.0 ? 0.0 : (u > 1.0 ? 1.0 : u);
+            d = hypot(wx - u * ex, wy - u * ey);
+            if (d < best_d)
+                best_d = d;
+            if (fabs(den) > 1e-15) {
+                double tt = (-wx * ey + wy * ex) / den, uu = (-wx * dy + wy * dx) / den;
+                if (tt > 1e-12 && tt <= 15.0 && uu >= 0.0 && uu <= 1.0 && tt < best_t)
+                    best_t = tt;
+            }
+        }
+        d = gtscore_index_distance(&index, x, y, INFINITY);
+        assert_near(d, best_d, 1e-9);
+        d = gtscore_index_distance(&index, x, y, 0.2);
+        if (best_d <= 0.2)
+            assert_near(d, best_d, 1e-9);
+        else
+            assert_true(d > 0.2);
+        t = gtscore_index_ray(&index, x, y, a, 15.0);
+        if (isinf(best_t))
+            assert_true(isinf(t));
+        else
+            assert_near(t, best_t, 1e-9);
+    }
+    gtscore_index_free(&index);
+}
+
+static void test_reader_errors(void **state)
+{
+    char err[256];
+    gtscore_truth t;
+    (void)state;
+    truth_error("wall closed 0 0 1 1\n", err, sizeof err);
+    assert_string_equal(err, "bad.gt.txt:1: wall: a closed wall needs at least 3 points");
+    truth_error("# c\nwall open 0 0 1 1\nwall open 0 x 1 1\n", err, sizeof err);
+    assert_string_equal(err, "bad.gt.txt:3: wall: bad number 'x'");
+    truth_error("wall open 0 0 1\n", err, sizeof err);
+    assert_string_equal(err, "bad.gt.txt:1: wall: odd number of coordinates");
+    truth_error("wall sideways 0 0 1 1\n", err, sizeof err);
+    assert_string_equal(err, "bad.gt.txt:1: wall: expected 'closed' or 'open'");
+    truth_error("wall open 0 0 1 1\nseen 1\n", err, sizeof err);
+    assert_string_equal(err, "bad.gt.txt:2: seen: expected two numbers x y");
+    truth_error("ideal 3\nideal 4\n", err, sizeof err);
+    assert_string_equal(err, "bad.gt.txt:2: ideal: given twice");
+    truth_error("ideal -1\n", err, sizeof err);
+    assert_string_equal(err, "bad.gt.txt:1: ideal: expected one whole number");
+    truth_error("wall open 0 0 1 1\nfloor 3\n", err, sizeof err);
+    assert_string_equal(err, "bad.gt.txt:2: unknown line type 'floor'");
+    truth_error("seen 1 1\n", err, sizeof err);
+    assert_string_equal(err, "bad.gt.txt:1: no walls");
+    truth_error("wall open 0 0 1 inf\n", err, sizeof err);
+    assert_string_equal(err, "bad.gt.txt:1: wall: bad number 'inf'");
+    assert_int_equal(gtscore_truth_load(&t, "/nonexistent/x.gt.txt", err, sizeof err), -1);
+    assert_non_null(strstr(err, "/nonexistent/x.gt.txt: "));
+    gtscore_truth_free(&t);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_truth_as_map),
+        cmocka_unit_test(test_shifted_map),
+        cmocka_unit_test(test_missing_wall),
+        cmocka_unit_test(test_percentile_and_far),
+        cmocka_unit_test(test_single_scan),
+        cmocka_unit_test(test_index_vs_brute_force),
+        cmocka_unit_test(test_reader_errors),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,310 @@
+/* test_scansim.c - the laser simulator: determinism, geometry, noise,
+ * people, dropout, and its log and ground-truth files read back by
+ * scanlog and gtscore. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "gtscore.h"
+#include "scanlog.h"
+#include "scansim.h"
+
+#define assert_near(a, b, tol) \
+    near_check((double)(a), (double)(b), (double)(tol), #a, __FILE__, __LINE__)
+
+static void near_check(double a, double b, double tol, const char *what, const char *file,
+                       int line)
+{
+    if (!(fabs(a - b) <= tol))
+        fail_msg("%s:%d: %s = %.9g, expected %.9g +- %.3g", file, line, what, a, b, tol);
+}
+
+/* splitmix64 from seed 0: the published first outputs. Pins the integer
+ * stream on every platform. */
+static void test_rng_reference(void **state)
+{
+    scansim_rng rng;
+    (void)state;
+    scansim_rng_seed(&rng, 0);
+    assert_true(scansim_rng_u64(&rng) == UINT64_C(0xE220A8397B1DCDAF));
+    assert_true(scansim_rng_u64(&rng) == UINT64_C(0x6E789E6AA1B965F4));
+    assert_true(scansim_rng_u64(&rng) == UINT64_C(0x06C45D188009454F));
+}
+
+static void test_rng_gauss_moments(void **state)
+{
+    scansim_rng rng;
+    double sum = 0.0, sum_sq = 0.0, mean, var;
+    int i, n = 200000;
+    (void)state;
+    scansim_rng_seed(&rng, 42);
+    for (i = 0; i < n; i++) {
+        double g = scansim_rng_gauss(&rng), u = scansim_rng_uniform(&rng);
+        assert_true(u >= 0.0 && u < 1.0);
+        sum += g;
+        sum_sq += g * g;
+    }
+    mean = sum / n;
+    var = sum_sq / n - mean * mean;
+    assert_true(fabs(mean) < 0.01);
+    assert_true(fabs(var - 1.0) < 0.02);
+}
+
+static void run_builtin(scansim_scene *scene, const char *name, uint64_t seed)
+{
+    assert_int_equal(scansim_scene_builtin(scene, name, seed), 0);
+    assert_int_equal(scansim_run(scene), 0);
+    assert_true(scene->scan_count > 0);
+}
+
+static void test_same_seed_same_ranges(void **state)
+{
+    scansim_scene a, b, c;
+    size_t n;
+    (void)state;
+    run_builtin(&a, "office", 7);
+    run_builtin(&b, "office", 7);
+    run_builtin(&c, "office", 8);
+    assert_int_equal(a.scan_count, b.scan_count);
+    n = (size_t)a.scan_count * a.laser.beam_count;
+    assert_memory_equal(a.range_m, b.range_m, n * sizeof(float));
+    assert_true(a.scans[5].pose_x_m == b.scans[5].pose_x_m);
+    assert_true(memcmp(a.range_m, c.range_m, n * sizeof(float)) != 0);
+    /* a second run of the same scene starts the stream afresh */
+    assert_int_equal(scansim_run(&a), 0);
+    assert_memory_equal(a.range_m, b.range_m, n * sizeof(float));
+    scansim_scene_free(&a);
+    scansim_scene_free(&b);
+    scansim_scene_free(&c);
+}
+
+/* One beam at a wall 2 m away, perpendicular: the range is 2 m within the
+ * noise, exactly 2 m without it. */
+static void test_perpendicular_beam(void **state)
+{
+    static const double wall[] = {2.0, -5.0, 2.0, 5.0};
+    scansim_scene s;
+    double sum = 0.0;
+    uint32_t i, n = 400;
+    (void)state;
+    scansim_scene_init(&s, "wall", 3);
+    s.laser.beam_count = 1;
+    s.laser.start_angle_rad = 0.0f;
+    s.laser.dropout = 0.0f;
+    s.pose_sigma_m = 0.0;
+    s.pose_sigma_rad = 0.0;
+    assert_int_equal(scansim_add_wall(&s, wall, 2, 0), 0);
+    for (i = 0; i < n; i++)
+        assert_int_equal(scansim_add_pose(&s, 0.0, 0.0, 0.0), 0);
+    assert_int_equal(scansim_run(&s), 0);
+    for (i = 0; i < n; i++) {
+        double r = (double)s.range_m[i];
+        assert_true(fabs(r - 2.0) < 5.0 * 0.01);
+        sum += r;
+    }
+    assert_true(fabs(sum / n - 2.0) < 0.003); /* 4 standard errors */
+
+    s.laser.range_sigma_m = 0.0f;
+    assert_int_equal(scansim_run(&s), 0);
+    assert_near(s.range_m[0], 2.0, 1e-6);
+    /* the wall seen face-on: samples around the hit point, and a short
+     * stretch is not worth a vertex */
+    assert_true(scansim_seen_count(&s) >= 1);
+    assert_int_equal(scansim_ideal_vertices(&s), 0);
+    scansim_scene_free(&s);
+}
+
+/* A person stands in the beam in scan 1 only. */
+static void test_person_in_one_scan(void **state)
+{
+    static const double wall[] = {5.0, -5.0, 5.0, 5.0};
+    scansim_person p;
+    scansim_scene s;
+    (void)state;
+    scansim_scene_init(&s, "person", 1);
+    s.laser.beam_count = 1;
+    s.laser.start_angle_rad = 0.0f;
+    s.laser.range_sigma_m = 0.0f;
+    s.laser.dropout = 0.0f;
+    s.pose_sigma_m = 0.0;
+    s.pose_sigma_rad = 0.0;
+    assert_int_equal(scansim_add_wall(&s, wall, 2, 0), 0);
+    memset(&p, 0, sizeof p);
+    p.from_x_m = p.to_x_m = 2.0;
+    p.radius_m = 0.2;
+    p.first_scan = p.last_scan = 1;
+    assert_int_equal(scansim_add_person(&s, &p), 0);
+    assert_int_equal(scansim_add_pose(&s, 0, 0, 0), 0);
+    assert_int_equal(scansim_add_pose(&s, 0, 0, 0), 0);
+    assert_int_equal(scansim_add_pose(&s, 0, 0, 0), 0);
+    assert_int_equal(scansim_run(&s), 0);
+    assert_near(s.range_m[0], 5.0, 1e-6);
+    assert_near(s.range_m[1], 1.8, 1e-6);
+    assert_near(s.range_m[2], 5.0, 1e-6);
+    scansim_scene_free(&s);
+}
+
+/* Dropped beams and walls beyond the range read exactly max_range_m. */
+static void test_dropout_and_max_range(void **state)
+{
+    scansim_scene s;
+    uint32_t i, dropped = 0, total;
+    (void)state;
+    run_builtin(&s, "square", 5);
+    total = s.scan_count * s.laser.beam_count;
+    for (i = 0; i < total; i++)
+        dropped += s.range_m[i] == s.laser.max_range_m;
+    /* the room is 6 x 4 m: only dropout gives no return, 0.3% of beams */
+    assert_true(dropped > total / 1000u && dropped < total / 100u);
+
+    s.laser.dropout = 0.5f;
+    assert_int_equal(scansim_run(&s), 0);
+    for (dropped = 0, i = 0; i < total; i++)
+        dropped += s.range_m[i] == s.laser.max_range_m;
+    assert_true(fabs((double)dropped / total - 0.5) < 0.03);
+    scansim_scene_free(&s);
+}
+
+static void test_builtins_sane(void **state)
+{
+    const char *const *names = scansim_builtin_names();
+    scansim_scene s;
+    (void)state;
+    for (; *names; names++) {
+        gtscore_index walls;
+        uint32_t i, w;
+        run_builtin(&s, *names, 11);
+        assert_true(s.scan_count <= 400u);
+        assert_true(scansim_seen_count(&s) > 0);
+        /* every seen sample lies on a true wall */
+        gtscore_index_init(&walls);
+        for (w = 0; w < s.wall_count; w++)
+            assert_int_equal(gtscore_index_add_d(&walls, &s.wall_xy_m[2u * s.walls[w].first_point],
+                                                 s.walls[w].point_count,
+                                                 (int)s.walls[w].closed),
+                             0);
+        assert_int_equal(gtscore_index_build(&walls, 0.25), 0);
+        for (i = 0; i < s.sample_count; i++)
+            assert_true(gtscore_index_distance(&walls, s.sample_xy_m[2u * i],
+                                               s.sample_xy_m[2u * i + 1u], 1.0) < 1e-9);
+        gtscore_index_free(&walls);
+        if (strcmp(*names, "square") == 0)
+            assert_int_equal(scansim_ideal_vertices(&s), 4);
+        if (strcmp(*names, "circle") == 0) {
+            assert_int_equal(s.scan_count, 3);
+            assert_int_equal(scansim_seen_count(&s), s.sample_count); /* seen all round */
+        }
+        scansim_scene_free(&s);
+    }
+    assert_int_equal(scansim_scene_builtin(&s, "nowhere", 1), -1);
+}
+
+/* The ground truth written, read back by gtscore: same walls, seen
+ * samples and ideal count. */
+static void test_gt_round_trip(void **state)
+{
+    scansim_scene s;
+    gtscore_truth t;
+    char err[256];
+    FILE *f = tmpfile();
+    uint32_t w, i;
+    (void)state;
+    assert_non_null(f);
+    run_builtin(&s, "office", 7);
+    assert_int_equal(scansim_write_gt(&s, f), 0);
+    rewind(f);
+    assert_int_equal(gtscore_truth_read(&t, f, "office.gt.txt", err, sizeof err), 0);
+    fclose(f);
+    assert_int_equal(t.wall_count, s.wall_count);
+    assert_int_equal(t.seen_count, scansim_seen_count(&s));
+    assert_true(t.has_ideal);
+    assert_int_equal(t.ideal, scansim_ideal_vertices(&s));
+    for (w = 0; w < s.wall_count; w++) {
+        assert_int_equal(t.walls[w].point_count, s.walls[w].point_count);
+        assert_int_equal(t.walls[w].closed, s.walls[w].closed);
+        for (i = 0; i < 2u * s.walls[w].point_count; i++)
+            assert_true(fabs(t.wall_xy_m[2u * t.walls[w].first_point + i] -
+                             s.wall_xy_m[2u * s.walls[w].first_point + i]) <= 0.5e-4 + 1e-12);
+    }
+    gtscore_truth_free(&t);
+    scansim_scene_free(&s);
+}
+
+/* The log written, read back by the CLI's reader: same poses and ranges
+ * (to the mm of the text format), same beam geometry. */
+static void test_log_round_trip(void **state)
+{
+    scansim_scene s;
+    scanlog log;
+    FILE *f = tmpfile();
+    uint32_t k, i;
+    (void)state;
+    assert_non_null(f);
+    run_builtin(&s, "angled", 7);
+    assert_int_equal(scansim_write_log(&s, f), 0);
+    rewind(f);
+    memset(&log, 0, sizeof log);
+    if (scanlog_read(&log, f, "angled.log", NULL) != 0)
+        fail_msg("scanlog_read: %s", log.error);
+    fclose(f);
+    assert_int_equal(log.count, s.scan_count);
+    for (k = 0; k < s.scan_count; k++) {
+        const polyc_scan *a = &s.scans[k], *b = &log.scans[k];
+        assert_int_equal(b->beam_count, a->beam_count);
+        assert_true(fabs(b->pose_x_m - a->pose_x_m) < 1e-6);
+        assert_true(fabs(b->pose_theta_rad - a->pose_theta_rad) < 1e-6);
+        assert_near(b->start_angle_rad, a->start_angle_rad, 1e-8);
+        assert_near(b->angle_step_rad, a->angle_step_rad, 1e-8);
+        assert_near(b->max_range_m, a->max_range_m, 1e-6);
+        for (i = 0; i < a->beam_count; i++) {
+            int none_a = !(a->range_m[i] < a->max_range_m);
+            int none_b = !(b->range_m[i] < b->max_range_m);
+            assert_int_equal(none_a, none_b);
+            if (!none_a)
+                assert_near(b->range_m[i], a->range_m[i], 0.0005 + 1e-6);
+        }
+    }
+    scanlog_free(&log);
+    scansim_scene_free(&s);
+}
+
+static void test_path_spacing(void **state)
+{
+    static const double way[] = {0.0, 0.0, 1.0, 0.0, 1.0, 1.0};
+    scansim_scene s;
+    uint32_t i;
+    (void)state;
+    scansim_scene_init(&s, "path", 1);
+    assert_int_equal(scansim_add_path(&s, way, 3, 0.25), 0);
+    assert_int_equal(s.pose_count, 8); /* 0 .. 1.75 m in 0.25 m steps */
+    for (i = 1; i < s.pose_count; i++) {
+        double d = hypot(s.poses[i].x_m - s.poses[i - 1u].x_m,
+                         s.poses[i].y_m - s.poses[i - 1u].y_m);
+        assert_true(d <= 0.25 + 1e-9 && d > 0.17);
+    }
+    assert_near(s.poses[7].theta_rad, 3.14159265358979323846 / 2, 1e-12);
+    scansim_scene_free(&s);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_rng_reference),
+        cmocka_unit_test(test_rng_gauss_moments),
+        cmocka_unit_test(test_same_seed_same_ranges),
+        cmocka_unit_test(test_perpendicular_beam),
+        cmocka_unit_test(test_person_in_one_scan),
+        cmocka_unit_test(test_dropout_and_max_range),
+        cmocka_unit_test(test_builtins_sane),
+        cmocka_unit_test(test_gt_round_trip),
+        cmocka_unit_test(test_log_round_trip),
+        cmocka_unit_test(test_path_spacing),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,581 @@
+/* bench.c - measure libpolyc on the shared data sets (not in the repo).
+ *
+ *   bench [--runs N] [--only NAMES] [--single K] [--iterations N] DATA_DIR
+ *
+ * Takes DATA_DIR/sim/NAME.log (+ NAME.gt.txt ground truth) and
+ * DATA_DIR/carmen/NAME.log. Prints one table: per scene the input size, the
+ * median time of each stage over N runs, memory, and accuracy (scored by
+ * tools/gtscore), then a single-scan section on the real logs. Logs are read
+ * with tools/scanlog, the same reader as the CLI. Exit codes: 0 ok, 1 some
+ * scene failed, 2 usage or no data directory.
+ */
+#include <dirent.h>
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <time.h>
+
+#include "gtscore.h"
+#include "mapout.h"
+#include "polyc.h"
+#include "scanlog.h"
+
+#define EXIT_FAILED 1
+#define EXIT_USAGE 2
+#define MAX_RUNS 99
+#define NEAR_M 0.05 /* "share of endpoints within 5 cm of the map" */
+
+static const char usage_text[] =
+    "usage: bench [options] DATA_DIR\n"
+    "Measures libpolyc on DATA_DIR/sim/*.log (scored against NAME.gt.txt) and\n"
+    "DATA_DIR/carmen/*.log (see shared/data/README.md); `make bench DATA=dir`\n"
+    "builds it with -O3 and runs it.\n"
+    "options:\n"
+    "  --runs N         runs per scene; stage times are medians (default 3)\n"
+    "  --only NAMES     comma-separated scene names (intel,office), or sim / carmen\n"
+    "  --single K       single-scan maps from K scans of each real log (default 10;\n"
+    "                   0: no single-scan section)\n"
+    "  --iterations N   optimiser iteration cap (default: the library's)\n"
+    "  -h, --help       this text\n"
+    "Columns: stage times in ms (parse = reading the log, add = polyc_add_scan,\n"
+    "grid, contour, trace, optimise, output = JSON to /dev/null); block and used\n"
+    "= the context's memory block and its high-water mark; rss = peak resident\n"
+    "size of the process so far. Accuracy (shared/data/README.md): sim scenes\n"
+    "precision RMS / p95 in mm, completeness, vertices / ideal; real logs the\n"
+    "share of scan endpoints within 5 cm of the map (end5).\n"
+    "Exit: 0 ok; 1 a scene failed (its row says why); 2 usage error, or\n"
+    "DATA_DIR missing: 'bench: data directory DIR not found (pass DATA=path)'.\n";
+
+enum stage { ST_PARSE, ST_ADD, ST_GRID, ST_CONTOUR, ST_TRACE, ST_OPT, ST_OUT, ST_TOTAL,
+             ST_COUNT };
+
+typedef struct options {
+    unsigned runs;
+    const char *only;          /* NULL: every scene */
+    unsigned single;
+    long iterations;           /* < 0: library default */
+    const char *data;
+} options;
+
+typedef struct scene {
+    char name[128];            /* "office" */
+    char kind[8];              /* "sim" or "carmen" */
+    char log_path[1536];
+    char gt_path[1536];        /* sim only */
+} scene;
+
+/* ---- small helpers -------------------------------------------------------- */
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
+}
+
+static int compare_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double median(const double *v, unsigned n)
+{
+    double tmp[MAX_RUNS];
+    memcpy(tmp, v, n * sizeof *v);
+    qsort(tmp, n, sizeof *tmp, compare_double);
+    return n % 2u ? tmp[n / 2u] : 0.5 * (tmp[n / 2u - 1u] + tmp[n / 2u]);
+}
+
+static double peak_rss_mb(void)
+{
+    struct rusage ru;
+    if (getrusage(RUSAGE_SELF, &ru) != 0)
+        return 0.0;
+    return (double)ru.ru_maxrss / 1024.0; /* Linux: kilobytes */
+}
+
+static double mb(uint64_t bytes)
+{
+    return (double)bytes / (1024.0 * 1024.0);
+}
+
+/* Is `name` (or its kind) listed in the comma-separated `only`? */
+static int selected(const options *o, const scene *s)
+{
+    const char *p = o->only;
+    if (!p)
+        return 1;
+    while (*p) {
+        size_t len = strcspn(p, ",");
+        if ((len == strlen(s->name) && strncmp(p, s->name, len) == 0) ||
+            (len == strlen(s->kind) && strncmp(p, s->kind, len) == 0))
+            return 1;
+        p += len;
+        if (*p == ',')
+            p++;
+    }
+    return 0;
+}
+
+static int compare_scene(const void *a, const void *b)
+{
+    return strcmp(((const scene *)a)->name, ((const scene *)b)->name);
+}
+
+/* Appends DATA/kind/NAME.log files to *list. Returns the new count. */
+static size_t find_scenes(const options *o, const char *kind, scene **list, size_t count,
+                          size_t *cap)
+{
+    char dir_path[1024];
+    DIR *dir;
+    struct dirent *e;
+    size_t first = count;
+    snprintf(dir_path, sizeof dir_path, "%s/%s", o->data, kind);
+    dir = opendir(dir_path);
+    if (!dir)
+        return count;
+    while ((e = readdir(dir)) != NULL) {
+        size_t len = strlen(e->d_name);
+        scene *s;
+        if (len <= 4 || len - 4 >= sizeof s->name || strcmp(e->d_name + len - 4, ".log") != 0)
+            continue;
+        if (count == *cap) {
+            scene *p = realloc(*list, (*cap ? 2u * *cap : 32u) * sizeof *p);
+            if (!p)
+                break;
+            *list = p;
+            *cap = *cap ? 2u * *cap : 32u;
+        }
+        s = &(*list)[count];
+        memset(s, 0, sizeof *s);
+        memcpy(s->name, e->d_name, len - 4);
+        snprintf(s->kind, sizeof s->kind, "%s", kind);
+        snprintf(s->log_path, sizeof s->log_path, "%s/%s", dir_path, e->d_name);
+        if (strcmp(kind, "sim") == 0)
+            snprintf(s->gt_path, sizeof s->gt_path, "%s/%s.gt.txt", dir_path, s->name);
+        if (selected(o, s))
+            count++;
+    }
+    closedir(dir);
+    qsort(*list + first, count - first, sizeof **list, compare_scene);
+    return count;
+}
+
+/* ---- reading a log (tools/scanlog) --------------------------------------- */
+
+static int read_log(const char *path, scanlog *log, double *ms)
+{
+    FILE *f = fopen(path, "r");
+    double t0 = now_ms();
+    int rc;
+    memset(log, 0, sizeof *log);
+    if (!f) {
+        snprintf(log->error, sizeof log->error, "%s: %s", path, strerror(errno));
+        return -1;
+    }
+    rc = scanlog_read(log, f, path, NULL);
+    fclose(f);
+    *ms = now_ms() - t0;
+    return rc;
+}
+
+/* ---- one pipeline run ---------------------------------------------------- */
+
+typedef struct pipeline {
+    polyc_config config;
+    polyc_limits limits;
+    void *block;
+    size_t block_size;
+    polyc_ctx *ctx;
+    const char *failed_at;     /* the call that failed, NULL if none */
+    polyc_status status;
+} pipeline;
+
+static int step(pipeline *p, polyc_status st, const char *what)
+{
+    if (st == POLYC_OK)
+        return 0;
+    p->status = st;
+    p->failed_at = what;
+    return -1;
+}
+
+static int pipeline_open(pipeline *p, const options *o, const polyc_scan *scans, uint32_t n)
+{
+    memset(p, 0, sizeof *p);
+    polyc_config_default(&p->config);
+    if (o->iterations >= 0)
+        p->config.max_iterations = (uint32_t)o->iterations;
+    if (step(p, polyc_limits_for_scans(&p->config, scans, n, &p->limits),
+             "polyc_limits_for_scans"))
+        return -1;
+    p->block_size = polyc_memory_size(&p->config, &p->limits);
+    if (p->block_size == 0)
+        return step(p, POLYC_ERR_CONFIG, "polyc_memory_size");
+    p->block = malloc(p->block_size);
+    if (!p->block)
+        return step(p, POLYC_ERR_NOMEM, "malloc of the block");
+    return 0;
+}
+
+static void pipeline_close(pipeline *p)
+{
+    free(p->block);
+    p->block = NULL;
+}
+
+/* init, add, grid, contour, trace, optimise; times[] gets each stage. */
+static int pipeline_run(pipeline *p, const polyc_scan *scans, uint32_t n, double *times)
+{
+    double t = now_ms(), t1;
+    uint32_t i;
+    if (step(p, polyc_init(p->block, p->block_size, &p->config, &p->limits, &p->ctx),
+             "polyc_init"))
+        return -1;
+    for (i = 0; i < n; i++)
+        if (step(p, polyc_add_scan(p->ctx, &scans[i]), "polyc_add_scan"))
+            return -1;
+    t1 = now_ms(); times[ST_ADD] = t1 - t; t = t1;
+    if (step(p, polyc_build_grid(p->ctx), "polyc_build_grid"))
+        return -1;
+    t1 = now_ms(); times[ST_GRID] = t1 - t; t = t1;
+    if (step(p, polyc_extract_contour(p->ctx), "polyc_extract_contour"))
+        return -1;
+    t1 = now_ms(); times[ST_CONTOUR] = t1 - t; t = t1;
+    if (step(p, polyc_trace(p->ctx), "polyc_trace"))
+        return -1;
+    t1 = now_ms(); times[ST_TRACE] = t1 - t; t = t1;
+    if (p->config.max_iterations > 0 &&
+        step(p, polyc_optimize(p->ctx, NULL, NULL), "polyc_optimize"))
+        return -1;
+    times[ST_OPT] = now_ms() - t;
+    return 0;
+}
+
+/* The current map as an array of polylines (malloc'ed, NULL if empty). */
+static polyc_polyline *get_lines(pipeline *p, uint32_t *count)
+{
+    uint32_t i, n = polyc_polyline_count(p->ctx);
+    polyc_polyline *lines = calloc(n ? n : 1u, sizeof *lines);
+    *count = 0;
+    if (!lines)
+        return NULL;
+    for (i = 0; i < n; i++)
+        if (step(p, polyc_get_polyline(p->ctx, i, &lines[i]), "polyc_get_polyline")) {
+            free(lines);
+            return NULL;
+        }
+    *count = n;
+    return lines;
+}
+
+static double write_output(const pipeline *p, const polyc_polyline *lines, uint32_t count)
+{
+    double t = now_ms();
+    polyc_stats stats;
+    mapout_map map;
+    FILE *f = fopen("/dev/null", "w");
+    if (!f)
+        return (double)NAN;
+    memset(&map, 0, sizeof map);
+    polyc_get_stats(p->ctx, &stats);
+    map.lines = lines;
+    map.line_count = count;
+    map.stats = &stats;
+    mapout_json(f, &map);
+    fclose(f);
+    return now_ms() - t;
+}
+
+/* ---- the table ----------------------------------------------------------- */
+
+static void print_header(const options *o)
+{
+    printf("libpolyc %u.%u.%u bench: median of %u run%s, data %s\n", polyc_version() / 10000u,
+           polyc_version() / 100u % 100u, polyc_version() % 100u, o->runs,
+           o->runs == 1 ? "" : "s", o->data);
+    printf("%-24s %6s %8s | %7s %6s %7s %7s %7s %8s %6s %8s | %7s %7s %7s | %6s %7s %6s "
+           "%5s | %6s %6s %6s %6s\n",
+           "scene", "scans", "beams", "parse", "add", "grid", "contour", "trace", "optimise",
+           "output", "total", "blockMB", "usedMB", "rssMB", "lines", "verts", "ideal", "x",
+           "rms", "p95", "compl", "end5");
+    printf("%-24s %6s %8s | %7s %6s %7s %7s %7s %8s %6s %8s | %7s %7s %7s | %6s %7s %6s "
+           "%5s | %6s %6s %6s %6s\n",
+           "", "", "", "ms", "ms", "ms", "ms", "ms", "ms", "ms", "ms", "", "", "", "", "", "",
+           "", "mm", "mm", "", "");
+}
+
+typedef struct row_accuracy {
+    int has_truth;
+    gtscore_map_score score;
+    double end5;               /* < 0: not computed */
+    uint32_t lines, vertices;
+} row_accuracy;
+
+static void accuracy(const scene *s, const scanlog *log, const polyc_polyline *lines,
+                     uint32_t count, row_accuracy *acc)
+{
+    uint32_t i;
+    memset(acc, 0, sizeof *acc);
+    acc->end5 = -1.0;
+    acc->lines = count;
+    for (i = 0; i < count; i++)
+        acc->vertices += lines[i].point_count;
+    if (s->gt_path[0]) {
+        gtscore_truth truth;
+        char err[512];
+        if (gtscore_truth_load(&truth, s->gt_path, err, sizeof err) == 0 &&
+            gtscore_score_map(&truth, lines, count, &acc->score) == 0)
+            acc->has_truth = 1;
+        else
+            fprintf(stderr, "bench: %s: no score: %s\n", s->name, err);
+        gtscore_truth_free(&truth);
+    } else {
+        gtscore_index map;
+        uint64_t within, total;
+        gtscore_index_init(&map);
+        if (gtscore_index_add_polylines(&map, lines, count) == 0 &&
+            gtscore_index_build(&map, 0.1) == 0) {
+            gtscore_endpoints_within(&map, log->scans, log->count, NEAR_M, &within, &total);
+            acc->end5 = total ? (double)within / (double)total : 0.0;
+        }
+        gtscore_index_free(&map);
+    }
+}
+
+static int bench_scene(const options *o, const scene *s)
+{
+    double times[MAX_RUNS][ST_COUNT], column[MAX_RUNS], med[ST_COUNT];
+    scanlog log;
+    pipeline p;
+    polyc_polyline *lines = NULL;
+    polyc_stats stats;
+    row_accuracy acc;
+    uint32_t count = 0;
+    unsigned r, k;
+    char label[160];
+    int ok = 0;
+
+    snprintf(label, sizeof label, "%s/%s", s->kind, s->name);
+    memset(times, 0, sizeof times);
+    memset(&log, 0, sizeof log);
+    for (r = 0; r < o->runs; r++) {
+        scanlog_free(&log);
+        if (read_log(s->log_path, &log, &times[r][ST_PARSE]) != 0) {
+            printf("%-24s error: %s\n", label, log.error);
+            scanlog_free(&log);
+            return -1;
+        }
+    }
+    if (pipeline_open(&p, o, log.scans, log.count) == 0) {
+        for (r = 0; r < o->runs && p.failed_at == NULL; r++) {
+            free(lines);
+            lines = NULL;
+            if (pipeline_run(&p, log.scans, log.count, times[r]) != 0)
+                break;
+            lines = get_lines(&p, &count);
+            if (!lines)
+                break;
+            times[r][ST_OUT] = write_output(&p, lines, count);
+            for (k = 0; k < ST_TOTAL; k++)
+                times[r][ST_TOTAL] += times[r][k];
+        }
+        ok = p.failed_at == NULL && lines != NULL;
+    }
+    if (!ok) {
+        printf("%-24s %6u %8llu | error in %s: %s (%s)\n", label, log.count,
+               (unsigned long long)log.beams, p.failed_at ? p.failed_at : "get_lines",
+               polyc_status_str(p.status), p.ctx ? polyc_last_error(p.ctx) : "");
+        free(lines);
+        pipeline_close(&p);
+        scanlog_free(&log);
+        return -1;
+    }
+    for (k = 0; k < ST_COUNT; k++) {
+        for (r = 0; r < o->runs; r++)
+            column[r] = times[r][k];
+        med[k] = median(column, o->runs);
+    }
+    polyc_get_stats(p.ctx, &stats);
+    accuracy(s, &log, lines, count, &acc);
+
+    printf("%-24s %6u %8llu | %7.1f %6.1f %7.1f %7.1f %7.1f %8.1f %6.1f %8.1f | %7.1f %7.1f "
+           "%7.1f | %6u %7u ",
+           label, log.count, (unsigned long long)log.beams, med[ST_PARSE], med[ST_ADD],
+           med[ST_GRID], med[ST_CONTOUR], med[ST_TRACE], med[ST_OPT], med[ST_OUT],
+           med[ST_TOTAL], mb(stats.memory_size_bytes), mb(stats.memory_used_bytes),
+           peak_rss_mb(), acc.lines, acc.vertices);
+    if (acc.has_truth)
+        printf("%6u %5.2f | %6.1f %6.1f %6.4f %6s\n", acc.score.ideal, acc.score.vertex_ratio,
+               1e3 * acc.score.precision_rms_m, 1e3 * acc.score.precision_p95_m,
+               acc.score.completeness, "-");
+    else if (acc.end5 >= 0.0)
+        printf("%6s %5s | %6s %6s %6s %6.4f\n", "-", "-", "-", "-", "-", acc.end5);
+    else
+        printf("%6s %5s | %6s %6s %6s %6s\n", "-", "-", "-", "-", "-", "-");
+    fflush(stdout);
+    free(lines);
+    pipeline_close(&p);
+    scanlog_free(&log);
+    return 0;
+}
+
+/* ---- single scans of the real logs ---------------------------------------- */
+
+static int single_scans(const options *o, const scene *s)
+{
+    scanlog log;
+    double parse_ms, f_sum = 0.0, ms_sum = 0.0, sum_sq = 0.0, vertices = 0.0;
+    uint64_t hits = 0;
+    unsigned k, done = 0;
+    char label[160];
+
+    snprintf(label, sizeof label, "%s/%s", s->kind, s->name);
+    if (read_log(s->log_path, &log, &parse_ms) != 0) {
+        printf("%-24s error: %s\n", label, log.error);
+        scanlog_free(&log);
+        return -1;
+    }
+    for (k = 0; k < o->single && k < log.count; k++) {
+        /* evenly spread over the log, away from its ends */
+        uint32_t idx = (uint32_t)(((uint64_t)2u * k + 1u) * log.count / (2u * o->single));
+        const polyc_scan *scan = &log.scans[idx];
+        double times[ST_COUNT], t0 = now_ms();
+        pipeline p;
+        polyc_polyline *lines;
+        uint32_t count = 0, i;
+        gtscore_index map;
+        gtscore_scan_score acc;
+        if (pipeline_open(&p, o, scan, 1) != 0 || pipeline_run(&p, scan, 1, times) != 0 ||
+            (lines = get_lines(&p, &count)) == NULL) {
+            printf("%-24s scan %u: error in %s: %s (%s)\n", label, idx,
+                   p.failed_at ? p.failed_at : "get_lines", polyc_status_str(p.status),
+                   p.ctx ? polyc_last_error(p.ctx) : "");
+            pipeline_close(&p);
+            continue;
+        }
+        ms_sum += now_ms() - t0;
+        for (i = 0; i < count; i++)
+            vertices += lines[i].point_count;
+        gtscore_index_init(&map);
+        memset(&acc, 0, sizeof acc);
+        if (gtscore_index_add_polylines(&map, lines, count) == 0 &&
+            gtscore_index_build(&map, 0.1) == 0)
+            gtscore_score_scan(&map, scan, &acc);
+        gtscore_index_free(&map);
+        f_sum += acc.f;
+        sum_sq += acc.sum_sq_m2;
+        hits += acc.hits;
+        done++;
+        free(lines);
+        pipeline_close(&p);
+    }
+    if (done)
+        printf("%-24s %6u %8.4f %9.1f %9.1f %9.1f\n", label, done, f_sum / done,
+               hits ? 1e3 * sqrt(sum_sq / (double)hits) : 0.0, vertices / done, ms_sum / done);
+    fflush(stdout);
+    scanlog_free(&log);
+    return done ? 0 : -1;
+}
+
+/* ---- main ---------------------------------------------------------------- */
+
+static int parse_count(const char *text, long min, long max, long *out)
+{
+    char *end;
+    long v;
+    errno = 0;
+    v = strtol(text, &end, 10);
+    if (errno || end == text || *end || v < min || v > max)
+        return -1;
+    *out = v;
+    return 0;
+}
+
+static int parse_options(int argc, char **argv, options *o)
+{
+    int i;
+    long v;
+    memset(o, 0, sizeof *o);
+    o->runs = 3;
+    o->single = 10;
+    o->iterations = -1;
+    for (i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
+            fputs(usage_text, stdout);
+            exit(0);
+        } else if (strcmp(a, "--runs") == 0 && i + 1 < argc) {
+            if (parse_count(argv[++i], 1, MAX_RUNS, &v))
+                return -1;
+            o->runs = (unsigned)v;
+        } else if (strcmp(a, "--single") == 0 && i + 1 < argc) {
+            if (parse_count(argv[++i], 0, 100000, &v))
+                return -1;
+            o->single = (unsigned)v;
+        } else if (strcmp(a, "--iterations") == 0 && i + 1 < argc) {
+            if (parse_count(argv[++i], 0, 100000000, &v))
+                return -1;
+            o->iterations = v;
+        } else if (strcmp(a, "--only") == 0 && i + 1 < argc) {
+            o->only = argv[++i];
+        } else if (a[0] == '-' || o->data) {
+            return -1;
+        } else {
+            o->data = a;
+        }
+    }
+    return o->data ? 0 : -1;
+}
+
+int main(int argc, char **argv)
+{
+    options o;
+    scene *list = NULL;
+    size_t count = 0, cap = 0, i, reals = 0;
+    DIR *dir;
+    int failed = 0;
+
+    if (parse_options(argc, argv, &o) != 0) {
+        fputs(usage_text, stderr);
+        return EXIT_USAGE;
+    }
+    dir = opendir(o.data);
+    if (!dir) {
+        fprintf(stderr, "bench: data directory %s not found (pass DATA=path)\n", o.data);
+        return EXIT_USAGE;
+    }
+    closedir(dir);
+    count = find_scenes(&o, "sim", &list, count, &cap);
+    count = find_scenes(&o, "carmen", &list, count, &cap);
+    if (count == 0) {
+        fprintf(stderr, "bench: no %s*.log under %s/sim or %s/carmen\n",
+                o.only ? "selected " : "", o.data, o.data);
+        free(list);
+        return EXIT_USAGE;
+    }
+    print_header(&o);
+    for (i = 0; i < count; i++) {
+        if (bench_scene(&o, &list[i]) != 0)
+            failed = 1;
+        reals += strcmp(list[i].kind, "carmen") == 0;
+    }
+    if (o.single > 0 && reals > 0) {
+        printf("\nsingle scans: a map from one scan; f = share of reflected beams whose ray "
+               "meets the map,\nray RMSE = measured minus map range over those beams "
+               "(tools/gtscore.h)\n");
+        printf("%-24s %6s %8s %9s %9s %9s\n", "log", "scans", "mean f", "rayRMSE", "verts",
+               "ms/scan");
+        printf("%-24s %6s %8s %9s %9s %9s\n", "", "", "", "mm", "/scan", "");
+        for (i = 0; i < count; i++)
+            if (strcmp(list[i].kind, "carmen") == 0 && single_scans(&o, &list[i]) != 0)
+                failed = 1;
+    }
+    printf("\npeak RSS of the process: %.1f MB\n", peak_rss_mb());
+    free(list);
+    return failed ? EXIT_FAILED : 0;
+}

@@ -1,0 +1,329 @@
+/* mapout.c - the map out of the library, into a file.
+ * Takes: polylines (and optionally stats, scans, the grid).
+ * Gives: JSON, SVG (y up, scale bar, optional layers) or TXT on a FILE. */
+#include "mapout.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ---- TXT ---- */
+
+int mapout_txt(FILE *f, const mapout_map *map)
+{
+    for (uint32_t i = 0; i < map->line_count; i++) {
+        const polyc_polyline *pl = &map->lines[i];
+        fprintf(f, "%s %u", pl->closed ? "closed" : "open", (unsigned)pl->point_count);
+        for (uint32_t j = 0; j < pl->point_count; j++)
+            fprintf(f, " %.4f %.4f", (double)pl->xy_m[2 * j], (double)pl->xy_m[2 * j + 1]);
+        fputc('\n', f);
+    }
+    return ferror(f) ? -1 : 0;
+}
+
+/* ---- JSON ---- */
+
+static void json_u64(FILE *f, const char *key, uint64_t v, int *first)
+{
+    fprintf(f, "%s\"%s\": %llu", *first ? "" : ", ", key, (unsigned long long)v);
+    *first = 0;
+}
+
+static void json_double(FILE *f, const char *key, double v, int *first)
+{
+    if (isfinite(v))
+        fprintf(f, "%s\"%s\": %.6f", *first ? "" : ", ", key, v);
+    else   /* JSON has no NaN or infinity */
+        fprintf(f, "%s\"%s\": null", *first ? "" : ", ", key);
+    *first = 0;
+}
+
+static void json_stats(FILE *f, const polyc_stats *s, const mapout_times *t)
+{
+    int first = 1;
+    fputs("{", f);
+    if (s) {
+        json_u64(f, "scans", s->scans, &first);
+        json_u64(f, "beams", s->beams, &first);
+        json_u64(f, "beams_skipped", s->beams_skipped, &first);
+        json_u64(f, "hits", s->hits, &first);
+        json_u64(f, "data_points", s->data_points, &first);
+        json_u64(f, "weighted_points", s->weighted_points, &first);
+        json_u64(f, "grid_width", s->grid_width, &first);
+        json_u64(f, "grid_height", s->grid_height, &first);
+        json_u64(f, "grid_tiles", s->grid_tiles, &first);
+        json_u64(f, "grid_bytes", s->grid_bytes, &first);
+        json_u64(f, "contour_cells", s->contour_cells, &first);
+        json_u64(f, "initial_polylines", s->initial_polylines, &first);
+        json_u64(f, "initial_vertices", s->initial_vertices, &first);
+        json_u64(f, "polylines", s->polylines, &first);
+        json_u64(f, "vertices", s->vertices, &first);
+        json_u64(f, "iterations", s->iterations, &first);
+        json_double(f, "bic", s->bic, &first);
+        json_double(f, "error_sq_m2", s->error_sq_m2, &first);
+        json_u64(f, "memory_size_bytes", s->memory_size_bytes, &first);
+        json_u64(f, "memory_used_bytes", s->memory_used_bytes, &first);
+    }
+    if (t) {
+        json_double(f, "time_parse_ms", t->parse_ms, &first);
+        json_double(f, "time_add_ms", t->add_ms, &first);
+        json_double(f, "time_grid_ms", t->grid_ms, &first);
+        json_double(f, "time_contour_ms", t->contour_ms, &first);
+        json_double(f, "time_trace_ms", t->trace_ms, &first);
+        json_double(f, "time_optimize_ms", t->optimize_ms, &first);
+    }
+    fputs("}", f);
+}
+
+int mapout_json(FILE *f, const mapout_map *map)
+{
+    fputs("{\"polylines\": [", f);
+    for (uint32_t i = 0; i < map->line_count; i++) {
+        const polyc_polyline *pl = &map->lines[i];
+        fprintf(f, "%s\n{\"closed\": %s, \"points\": [", i ? "," : "",
+                pl->closed ? "true" : "false");
+        for (uint32_t j = 0; j < pl->point_count; j++)
+            fprintf(f, "%s[%.4f, %.4f]", j ? ", " : "", (double)pl->xy_m[2 * j],
+                    (double)pl->xy_m[2 * j + 1]);
+        fputs("]}", f);
+    }
+    fputs(map->line_count ? "\n], \"stats\": " : "], \"stats\": ", f);
+    json_stats(f, map->stats, map->times);
+    fputs("}\n", f);
+    return ferror(f) ? -1 : 0;
+}
+
+/* ---- SVG ---- */
+
+#define SVG_MARGIN_PX 24.0
+#define SVG_FOOTER_PX 60.0             /* room for the scale bar */
+#define SVG_PX_PER_M 40.0              /* preferred scale, clamped by: */
+#define SVG_MIN_SIDE_PX 600.0
+#define SVG_MAX_SIDE_PX 4000.0
+
+/* Distinct colours, cycled over the polylines. */
+static const char *const palette[] = {"#c0392b", "#2471a3", "#229954", "#d68910", "#7d3c98",
+                                      "#17a589", "#a04000", "#e74c8c", "#2e4053", "#b7950b"};
+
+typedef struct view {
+    double x0, y0, x1, y1;             /* metres shown */
+    double scale;                      /* px per metre */
+    double width, height;              /* px */
+    double stroke;                     /* line width, px */
+    double font;                       /* label size, px */
+} view;
+
+static double px_x(const view *v, double x) { return SVG_MARGIN_PX + (x - v->x0) * v->scale; }
+/* SVG's y grows downwards; maps have y up. */
+static double px_y(const view *v, double y) { return SVG_MARGIN_PX + (v->y1 - y) * v->scale; }
+
+static void box_add(view *v, double x, double y)
+{
+    if (!isfinite(x) || !isfinite(y))
+        return;
+    v->x0 = fmin(v->x0, x);
+    v->y0 = fmin(v->y0, y);
+    v->x1 = fmax(v->x1, x);
+    v->y1 = fmax(v->y1, y);
+}
+
+/* Endpoint of beam j of scan s, if it is a hit (the library's rule). */
+static int endpoint(const polyc_scan *s, uint32_t j, double *x, double *y)
+{
+    float r = s->range_m[j];
+    if (!isfinite(r) || r < s->min_range_m || r >= s->max_range_m)
+        return 0;
+    double a = s->pose_theta_rad + (double)s->start_angle_rad + j * (double)s->angle_step_rad;
+    *x = s->pose_x_m + (double)r * cos(a);
+    *y = s->pose_y_m + (double)r * sin(a);
+    return 1;
+}
+
+static void make_view(const mapout_map *map, view *v)
+{
+    v->x0 = v->y0 = INFINITY;
+    v->x1 = v->y1 = -INFINITY;
+    for (uint32_t i = 0; i < map->line_count; i++)
+        for (uint32_t j = 0; j < map->lines[i].point_count; j++)
+            box_add(v, (double)map->lines[i].xy_m[2 * j], (double)map->lines[i].xy_m[2 * j + 1]);
+    for (uint32_t i = 0; map->scans && i < map->scan_count; i++) {
+        double x, y;
+        for (uint32_t j = 0; j < map->scans[i].beam_count; j++)
+            if (endpoint(&map->scans[i], j, &x, &y))
+                box_add(v, x, y);
+    }
+    double gx, gy;
+    float cell_m;
+    uint32_t gw, gh;
+    if (map->grid && polyc_grid_info(map->grid, &gx, &gy, &cell_m, &gw, &gh) == POLYC_OK &&
+        gw && gh) {
+        box_add(v, gx, gy);
+        box_add(v, gx + gw * (double)cell_m, gy + gh * (double)cell_m);
+    }
+    if (!(v->x0 <= v->x1)) {           /* nothing to show */
+        v->x0 = v->y0 = -0.5;
+        v->x1 = v->y1 = 0.5;
+    }
+    /* No side thinner than a tenth of the other (a single straight wall). */
+    double side = fmax(fmax(v->x1 - v->x0, v->y1 - v->y0), 1e-3);
+    double padx = fmax(0, side / 10 - (v->x1 - v->x0)) / 2;
+    double pady = fmax(0, side / 10 - (v->y1 - v->y0)) / 2;
+    v->x0 -= padx;
+    v->x1 += padx;
+    v->y0 -= pady;
+    v->y1 += pady;
+    double long_px = fmin(fmax(side * SVG_PX_PER_M, SVG_MIN_SIDE_PX), SVG_MAX_SIDE_PX);
+    v->scale = long_px / side;
+    /* Big pictures are mostly viewed shrunk to a screen: thicker lines. */
+    v->stroke = fmin(fmax(long_px / 800, 1.5), 3.0);
+    v->font = fmin(fmax(long_px / 60, 14), 48);
+    v->width = ceil(2 * SVG_MARGIN_PX + (v->x1 - v->x0) * v->scale);
+    v->height = ceil(2 * SVG_MARGIN_PX + (v->y1 - v->y0) * v->scale + SVG_FOOTER_PX);
+}
+
+/* Endpoints as 1 px grey squares, at most one per pixel (file size stays
+ * bounded by the picture, not by the number of beams). */
+static void svg_points(FILE *f, const mapout_map *map, const view *v)
+{
+    size_t w = (size_t)v->width, h = (size_t)v->height;
+    unsigned char *seen = calloc((w * h + 7) / 8, 1);
+    if (!seen)
+        return;
+    fputs("<path id=\"points\" fill=\"#8c8c8c\" d=\"", f);
+    for (uint32_t i = 0; i < map->scan_count; i++) {
+        double x, y;
+        for (uint32_t j = 0; j < map->scans[i].beam_count; j++) {
+            if (!endpoint(&map->scans[i], j, &x, &y))
+                continue;
+            double fx = floor(px_x(v, x)), fy = floor(px_y(v, y));
+            if (fx < 0 || fy < 0 || fx >= v->width || fy >= v->height)
+                continue;
+            size_t k = (size_t)fy * w + (size_t)fx;
+            if (seen[k / 8] & (1u << (k % 8)))
+                continue;
+            seen[k / 8] = (unsigned char)(seen[k / 8] | (1u << (k % 8)));
+            fprintf(f, "M%.0f %.0fh1v1h-1z", fx, fy);
+        }
+    }
+    fputs("\"/>\n", f);
+    free(seen);
+}
+
+/* Grid cells with m > threshold (light blue) and contour cells (orange),
+ * merged into blocks of at least one pixel and into runs along each row. */
+static void svg_grid(FILE *f, const mapout_map *map, const view *v)
+{
+    double gx, gy;
+    float cell_m;
+    uint32_t gw, gh;
+    if (polyc_grid_info(map->grid, &gx, &gy, &cell_m, &gw, &gh) != POLYC_OK || !gw || !gh)
+        return;
+    uint32_t k = (uint32_t)ceil(1.0 / ((double)cell_m * v->scale));
+    if (k < 1)
+        k = 1;
+    uint32_t bw = (gw + k - 1) / k, bh = (gh + k - 1) / k;
+    unsigned char *block = calloc((size_t)bw * bh, 1);   /* bit 0: occupied, 1: contour */
+    if (!block)
+        return;
+    for (uint32_t iy = 0; iy < gh; iy++)
+        for (uint32_t ix = 0; ix < gw; ix++) {
+            uint32_t hits, misses, contour;
+            if (polyc_grid_cell(map->grid, ix, iy, &hits, &misses, &contour) != POLYC_OK)
+                continue;
+            unsigned char *b = &block[(size_t)(iy / k) * bw + ix / k];
+            if (hits && (double)hits > (double)map->contour_threshold * ((double)hits + misses))
+                *b |= 1;
+            if (contour)
+                *b |= 2;
+        }
+    const char *fill[2] = {"#bcd0ea", "#f0a04b"};
+    const char *id[2] = {"grid", "contour"};
+    double bm = k * (double)cell_m;    /* block size in metres */
+    for (int layer = 0; layer < 2; layer++) {
+        fprintf(f, "<path id=\"%s\" fill=\"%s\" d=\"", id[layer], fill[layer]);
+        for (uint32_t by = 0; by < bh; by++)
+            for (uint32_t bx = 0; bx < bw;) {
+                if (!(block[(size_t)by * bw + bx] & (1u << layer))) {
+                    bx++;
+                    continue;
+                }
+                uint32_t run = bx;
+                while (run < bw && (block[(size_t)by * bw + run] & (1u << layer)))
+                    run++;
+                double x = px_x(v, gx + bx * bm), y = px_y(v, gy + (by + 1) * bm);
+                double w = (double)(run - bx) * bm * v->scale;
+                fprintf(f, "M%.2f %.2fh%.2fv%.2fh%.2fz", x, y, w, bm * v->scale, -w);
+                bx = run;
+            }
+        fputs("\"/>\n", f);
+    }
+    free(block);
+}
+
+/* A round length of at most `target` metres: 1, 2 or 5 times a power of 10. */
+static double nice_length(double target)
+{
+    double p = pow(10, floor(log10(target)));
+    if (5 * p <= target)
+        return 5 * p;
+    if (2 * p <= target)
+        return 2 * p;
+    return p;
+}
+
+static void svg_scalebar(FILE *f, const view *v)
+{
+    double len_m = nice_length((v->x1 - v->x0) / 4);
+    double x0 = SVG_MARGIN_PX, x1 = x0 + len_m * v->scale;
+    double y = v->height - SVG_MARGIN_PX;
+    fprintf(f,
+            "<g id=\"scalebar\"><path d=\"M%.2f %.2fv-6M%.2f %.2fH%.2fv-6\" stroke=\"black\""
+            " stroke-width=\"%.2f\" fill=\"none\"/>\n"
+            "<text x=\"%.2f\" y=\"%.2f\" font-family=\"sans-serif\" font-size=\"%.0f\">%g m</text>"
+            "</g>\n",
+            x0, y, x0, y, x1, v->stroke + 0.5, x1 + 8, y, v->font, len_m);
+}
+
+int mapout_svg(FILE *f, const mapout_map *map)
+{
+    view v;
+    make_view(map, &v);
+    fprintf(f,
+            "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+            "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\""
+            " viewBox=\"0 0 %.0f %.0f\">\n"
+            "<!-- polyc map: x %.4f..%.4f m, y %.4f..%.4f m (y up), %.4f px/m -->\n"
+            "<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n",
+            v.width, v.height, v.width, v.height, v.x0, v.x1, v.y0, v.y1, v.scale);
+    if (map->grid)
+        svg_grid(f, map, &v);
+    if (map->scans)
+        svg_points(f, map, &v);
+    fprintf(f, "<g id=\"polylines\" fill=\"none\" stroke-width=\"%.2f\" stroke-linejoin=\"round\""
+               " stroke-linecap=\"round\">\n",
+            v.stroke);
+    for (uint32_t i = 0; i < map->line_count; i++) {
+        const polyc_polyline *pl = &map->lines[i];
+        const char *colour = palette[i % (sizeof palette / sizeof palette[0])];
+        if (pl->point_count == 0)
+            continue;
+        fprintf(f, "<path stroke=\"%s\" d=\"", colour);
+        for (uint32_t j = 0; j < pl->point_count; j++)
+            fprintf(f, "%s%.2f %.2f", j ? " L" : "M", px_x(&v, (double)pl->xy_m[2 * j]),
+                    px_y(&v, (double)pl->xy_m[2 * j + 1]));
+        fputs(pl->closed ? " Z\"/>\n" : "\"/>\n", f);
+        if (map->vertices) {
+            fprintf(f, "<path stroke=\"none\" fill=\"%s\" d=\"", colour);
+            double r = 1.4 * v.stroke;                       /* dot radius, px */
+            for (uint32_t j = 0; j < pl->point_count; j++)
+                fprintf(f, "M%.2f %.2fm%.2f 0a%.2f %.2f 0 1 0 %.2f 0a%.2f %.2f 0 1 0 %.2f 0",
+                        px_x(&v, (double)pl->xy_m[2 * j]), px_y(&v, (double)pl->xy_m[2 * j + 1]),
+                        -r, r, r, 2 * r, r, r, -2 * r);
+            fputs("\"/>\n", f);
+        }
+    }
+    fputs("</g>\n", f);
+    svg_scalebar(f, &v);
+    fputs("</svg>\n", f);
+    return ferror(f) ? -1 : 0;
+}

@@ -1,0 +1,717 @@
+/* scanlog.c - laser log lines in, polyc_scan records out.
+ * Takes: a FILE of CARMEN FLASER / ROBOTLASER1 or polyc plain SCAN lines.
+ * Gives: owned scans, line counters, the FLASER no-return threshold, or
+ * one "NAME:LINE: message" error. Rules are in docs/formats.md. */
+#include "scanlog.h"
+
+#include <errno.h>
+#include <float.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define PI_D 3.14159265358979323846
+#define MAX_NUMBER_CHARS 64          /* longer tokens are not numbers we accept */
+#define FLASER_TAIL 9                /* x y theta ox oy otheta ipc_ts host log_ts */
+#define ROBOTLASER1_TAIL 14          /* laser pose, robot pose, 5 motion, 3 stamps */
+
+/* ---- the FLASER no-return rule: a histogram in 1 cm bins ---- */
+
+#define NR_BIN_M 0.01
+#define NR_BINS 100000u              /* 0 .. 1000 m; beyond counts as no return */
+#define NR_WINDOW 50u                /* the cluster lies within 0.5 m */
+#define NR_SHOULDER 200u             /* compared with the 2 m just below it */
+
+typedef struct nr_hist {
+    uint32_t *bin;
+    uint64_t total;                  /* valid ranges seen, beyond included */
+    uint64_t beyond;                 /* >= NR_BINS * NR_BIN_M */
+} nr_hist;
+
+static void nr_add(nr_hist *h, float range_m)
+{
+    if (!(range_m >= SCANLOG_MIN_RANGE_M) || !isfinite(range_m))
+        return;
+    h->total++;
+    /* + 0.002: 51.05f is 51.0499992, which belongs to the 51.05 bin */
+    double k = floor((double)range_m / NR_BIN_M + 0.002);
+    if (k >= (double)NR_BINS)
+        h->beyond++;
+    else
+        h->bin[(uint32_t)k]++;
+}
+
+static int cmp_u32(const void *a, const void *b)
+{
+    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* Median beams per bin over bins [lo, hi): the background density of real
+ * returns, blind to a second code's spike (acapulco's 50.0 below 51.15). */
+static double nr_median(const nr_hist *h, uint32_t lo, uint32_t hi)
+{
+    uint32_t tmp[NR_SHOULDER];
+    uint32_t n = hi - lo;
+    if (n == 0)
+        return 0;
+    memcpy(tmp, h->bin + lo, n * sizeof tmp[0]);
+    qsort(tmp, n, sizeof tmp[0], cmp_u32);
+    return n % 2 ? tmp[n / 2] : 0.5 * ((double)tmp[n / 2 - 1] + tmp[n / 2]);
+}
+
+/* Is [b-0.5 m, b] a code cluster: at least 3 beams and 0.05% of all, half
+ * of them in one 1 cm bin (a code repeats one value; real returns spread),
+ * and at least 16x the background density of the 2 m below it (median beams
+ * per bin)? If so, *bottom is its lowest bin holding more than 1 + 4x that
+ * median, so that stray real returns in the window stay hits. */
+static int nr_cluster(const nr_hist *h, const uint64_t *prefix, uint32_t b, uint32_t *bottom)
+{
+    uint32_t lo = b >= NR_WINDOW ? b - NR_WINDOW : 0;
+    uint32_t slo = lo >= NR_SHOULDER ? lo - NR_SHOULDER : 0;
+    uint64_t t = prefix[b + 1] - prefix[lo];
+    if (!h->bin[b] || t < 3 || t * 2000u < h->total)
+        return 0;
+    uint32_t peak = 0;
+    for (uint32_t k = lo; k <= b; k++)
+        peak = h->bin[k] > peak ? h->bin[k] : peak;
+    if (2u * (uint64_t)peak < t)
+        return 0;
+    double median = nr_median(h, slo, lo);
+    if ((double)t < 16.0 * median * (b - lo + 1))
+        return 0;
+    double dense = 1.0 + 4.0 * median;
+    uint32_t k = lo;
+    while (k < b && (double)h->bin[k] <= dense)
+        k++;
+    *bottom = k;
+    return 1;
+}
+
+/* Walks down from the largest range to the first cluster that also holds at
+ * least as many beams as everything above it: the main no-return code. Then
+ * looks for more codes (acapulco has 50.0 besides 51.15) in the 10% of range
+ * below, again and again. The threshold goes half a bin below the lowest
+ * code. Without a cluster every range is a hit. prefix: NR_BINS + 1. */
+static void nr_pick(const nr_hist *h, uint64_t *prefix, scanlog_noreturn *out)
+{
+    uint32_t top = 0, b, bottom = 0, next;
+    int any = 0;
+    prefix[0] = 0;
+    for (b = 0; b < NR_BINS; b++) {
+        prefix[b + 1] = prefix[b] + h->bin[b];
+        if (h->bin[b]) {
+            top = b;
+            any = 1;
+        }
+    }
+    memset(out, 0, sizeof *out);
+    out->beams = h->total;
+    out->max_range_m = any ? (float)((top + 1) * NR_BIN_M) : (float)(NR_BINS * NR_BIN_M);
+    for (b = top + 1; any && b-- > 0;) {
+        uint64_t above = prefix[top + 1] - prefix[b + 1] + h->beyond;
+        if (nr_cluster(h, prefix, b, &bottom) && above <= prefix[b + 1] - prefix[bottom]) {
+            out->found = 1;
+            break;
+        }
+    }
+    if (!out->found)
+        return;
+    out->code_hi_m = b * NR_BIN_M;
+    for (int more = 1; more;) {
+        more = 0;
+        uint32_t limit = bottom - bottom / 10;
+        for (b = bottom; b-- > limit;)
+            if (nr_cluster(h, prefix, b, &next)) {
+                bottom = next;
+                more = 1;
+                break;
+            }
+    }
+    uint32_t mode = top;
+    for (b = bottom; b <= top; b++)
+        if (h->bin[b] > h->bin[mode])
+            mode = b;
+    out->max_range_m = (float)((bottom - 0.5) * NR_BIN_M);
+    out->code_lo_m = bottom * NR_BIN_M;
+    out->code_mode_m = mode * NR_BIN_M;
+    out->code_beams = prefix[top + 1] - prefix[bottom] + h->beyond;
+}
+
+void scanlog_detect_noreturn(const float *range_m, size_t count, scanlog_noreturn *out)
+{
+    nr_hist h = {calloc(NR_BINS, sizeof(uint32_t)), 0, 0};
+    uint64_t *prefix = malloc((NR_BINS + 1) * sizeof *prefix);
+    memset(out, 0, sizeof *out);
+    if (h.bin && prefix) {
+        for (size_t i = 0; i < count; i++)
+            nr_add(&h, range_m[i]);
+        nr_pick(&h, prefix, out);
+    }
+    free(h.bin);
+    free(prefix);
+}
+
+/* ---- the reader ---- */
+
+typedef struct reader {
+    scanlog *log;
+    const char *name;
+    uint64_t line;
+    double max_range_m;              /* opts->max_range_m or 0 */
+    char *buf;
+    size_t cap;
+} reader;
+
+/* A cursor over the whitespace-separated fields of one line. */
+typedef struct fields {
+    char *p;
+    uint32_t index;                  /* 1-based number of the last field taken */
+} fields;
+
+static int fail(reader *r, const char *fmt, ...)
+{
+    char msg[400];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    if (r->line > 0)
+        snprintf(r->log->error, sizeof r->log->error, "%s:%llu: %s", r->name,
+                 (unsigned long long)r->line, msg);
+    else
+        snprintf(r->log->error, sizeof r->log->error, "%s: %s", r->name, msg);
+    return -1;
+}
+
+static int is_space(int c)
+{
+    return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
+}
+
+/* Reads one line into r->buf without its '\n' (a final line may lack it).
+ * 1: a line, 0: end of file, -1: error (NUL, control byte, too long, I/O). */
+static int read_line(reader *r, FILE *f, size_t *len_out)
+{
+    size_t len = 0;
+    int c;
+    r->line++;
+    while ((c = getc_unlocked(f)) != EOF && c != '\n') {
+        if (c == 0 || (c < 0x20 && !is_space(c)) || c == 0x7f)
+            return fail(r, "binary data (byte 0x%02x at column %llu)", (unsigned)c,
+                        (unsigned long long)len + 1);
+        if (len + 1 >= r->cap) {
+            if (r->cap >= SCANLOG_MAX_LINE_BYTES)
+                return fail(r, "line longer than %u bytes", SCANLOG_MAX_LINE_BYTES);
+            size_t ncap = r->cap ? r->cap * 2 : 4096;
+            char *nbuf = realloc(r->buf, ncap);
+            if (!nbuf)
+                return fail(r, "out of memory reading a line");
+            r->buf = nbuf;
+            r->cap = ncap;
+        }
+        r->buf[len++] = (char)c;
+    }
+    if (ferror(f))
+        return fail(r, "read error: %s", strerror(errno));
+    if (c == EOF && len == 0) {
+        r->line--;
+        return 0;
+    }
+    if (!r->buf) {                   /* an empty first line */
+        r->buf = malloc(4096);
+        if (!r->buf)
+            return fail(r, "out of memory reading a line");
+        r->cap = 4096;
+    }
+    r->buf[len] = '\0';
+    *len_out = len;
+    return 1;
+}
+
+/* Next field, NUL-terminated in place; NULL at the end of the line. */
+static char *next_field(fields *fs)
+{
+    char *p = fs->p;
+    while (*p && is_space((unsigned char)*p))
+        p++;
+    if (!*p) {
+        fs->p = p;
+        return NULL;
+    }
+    char *start = p;
+    while (*p && !is_space((unsigned char)*p))
+        p++;
+    if (*p)
+        *p++ = '\0';
+    fs->p = p;
+    fs->index++;
+    return start;
+}
+
+static uint64_t count_fields(const char *p)
+{
+    uint64_t n = 0;
+    while (*p) {
+        while (*p && is_space((unsigned char)*p))
+            p++;
+        if (!*p)
+            break;
+        n++;
+        while (*p && !is_space((unsigned char)*p))
+            p++;
+    }
+    return n;
+}
+
+/* A number with nothing after it; NaN and inf are numbers here (callers
+ * decide). Fails on missing, non-numeric or over-long fields. */
+static int take_double(reader *r, fields *fs, const char *what, double *out)
+{
+    char *s = next_field(fs);
+    if (!s)
+        return fail(r, "missing %s (field %u)", what, fs->index + 1);
+    size_t len = strlen(s);
+    char *end = NULL;
+    if (len <= MAX_NUMBER_CHARS)
+        *out = strtod(s, &end);
+    if (len > MAX_NUMBER_CHARS || end != s + len)
+        return fail(r, "%s is not a number: '%.24s%s' (field %u)", what, s,
+                    len > 24 ? "..." : "", fs->index);
+    /* Overflow gives +-HUGE_VAL, underflow a tiny number (errno ERANGE):
+     * the callers' range checks judge both. */
+    return 0;
+}
+
+static int take_count(reader *r, fields *fs, const char *what, uint32_t max, uint32_t *out)
+{
+    char *s = next_field(fs);
+    if (!s)
+        return fail(r, "missing %s (field %u)", what, fs->index + 1);
+    size_t len = strlen(s);
+    unsigned long long v = 0;
+    for (size_t i = 0; i < len; i++) {
+        if (s[i] < '0' || s[i] > '9' || len > 18)
+            return fail(r, "%s is not a count: '%.24s%s' (field %u)", what, s,
+                        len > 24 ? "..." : "", fs->index);
+        v = v * 10 + (unsigned)(s[i] - '0');
+    }
+    if (v > max)
+        return fail(r, "%s %llu out of range (at most %u)", what, v, max);
+    *out = (uint32_t)v;
+    return 0;
+}
+
+static int take_pose(reader *r, fields *fs, const char *what, double *x, double *y,
+                     double *theta)
+{
+    char name[64];
+    double *v[3] = {x, y, theta};
+    const char *axis[3] = {"x", "y", "theta"};
+    for (int i = 0; i < 3; i++) {
+        snprintf(name, sizeof name, "%s %s", what, axis[i]);
+        if (take_double(r, fs, name, v[i]))
+            return -1;
+        double lim = i < 2 ? SCANLOG_MAX_POSE_M : SCANLOG_MAX_ANGLE_RAD;
+        if (!isfinite(*v[i]))
+            return fail(r, "%s is not finite", name);
+        if (fabs(*v[i]) > lim)
+            return fail(r, "%s %g beyond +-%g %s", name, *v[i], lim, i < 2 ? "m" : "rad");
+    }
+    return 0;
+}
+
+static int take_angle(reader *r, fields *fs, const char *what, double *out)
+{
+    if (take_double(r, fs, what, out))
+        return -1;
+    if (!isfinite(*out) || fabs(*out) > SCANLOG_MAX_ANGLE_RAD)
+        return fail(r, "%s %g is not a finite angle within +-%g rad", what, *out,
+                    SCANLOG_MAX_ANGLE_RAD);
+    return 0;
+}
+
+static int grow(reader *r, void **p, size_t *cap, size_t need, size_t elem)
+{
+    if (need <= *cap)
+        return 0;
+    size_t ncap = *cap ? *cap : 1024;
+    while (ncap < need)
+        ncap *= 2;
+    if (ncap > SIZE_MAX / elem)
+        return fail(r, "out of memory");
+    void *np = realloc(*p, ncap * elem);
+    if (!np)
+        return fail(r, "out of memory");
+    *p = np;
+    *cap = ncap;
+    return 0;
+}
+
+/* Appends n ranges to the pool; bad values (NaN, inf, negative) become NaN,
+ * which the library counts as skipped. */
+static int take_ranges(reader *r, fields *fs, uint32_t n)
+{
+    scanlog *log = r->log;
+    if (grow(r, (void **)&log->pool, &log->pool_cap, log->pool_len + n, sizeof(float)))
+        return -1;
+    for (uint32_t i = 0; i < n; i++) {
+        double v;
+        if (take_double(r, fs, "range", &v))
+            return -1;
+        float f = (float)v;
+        if (!isfinite(v) || v < 0 || !isfinite(f)) {
+            f = NAN;
+            log->bad_ranges++;
+        }
+        log->pool[log->pool_len + i] = f;
+    }
+    return 0;
+}
+
+/* Records the scan whose ranges were just appended to the pool. */
+static int push_scan(reader *r, const polyc_scan *s, enum scanlog_kind kind)
+{
+    scanlog *log = r->log;
+    if (log->count == UINT32_MAX - 1)
+        return fail(r, "too many scans");
+    if (log->beams + s->beam_count > UINT32_MAX)
+        return fail(r, "more than %u beams in total", (unsigned)UINT32_MAX);
+    if (log->count == log->cap) {
+        size_t cap = log->cap ? (size_t)log->cap * 2 : 256;
+        if (cap > UINT32_MAX)
+            cap = UINT32_MAX;
+        void *a = realloc(log->scans, cap * sizeof *log->scans);
+        if (a)
+            log->scans = a;
+        void *b = realloc(log->line_of_scan, cap * sizeof *log->line_of_scan);
+        if (b)
+            log->line_of_scan = b;
+        void *c = realloc(log->kind_of_scan, cap * sizeof *log->kind_of_scan);
+        if (c)
+            log->kind_of_scan = c;
+        void *d = realloc(log->offset_of_scan, cap * sizeof *log->offset_of_scan);
+        if (d)
+            log->offset_of_scan = d;
+        if (!a || !b || !c || !d)
+            return fail(r, "out of memory");
+        log->cap = (uint32_t)cap;
+    }
+    log->scans[log->count] = *s;
+    log->scans[log->count].range_m = NULL;   /* set in finish(): the pool moves */
+    log->line_of_scan[log->count] = r->line;
+    log->kind_of_scan[log->count] = (uint8_t)kind;
+    log->offset_of_scan[log->count] = log->pool_len;
+    log->pool_len += s->beam_count;
+    log->beams += s->beam_count;
+    log->kind_counts[kind]++;
+    log->count++;
+    return 0;
+}
+
+/* Exactly n + tail fields must remain after a count of `items`. */
+static int check_tail(reader *r, fields *fs, const char *type, const char *items, uint32_t n,
+                      uint64_t tail)
+{
+    uint64_t rest = count_fields(fs->p);
+    if (rest != (uint64_t)n + tail)
+        return fail(r, "%s with %u %s needs %llu fields after the count, found %llu", type, n,
+                    items, (unsigned long long)n + tail, (unsigned long long)rest);
+    return 0;
+}
+
+/* FLASER n r1..rn x y theta odom_x odom_y odom_theta ipc_ts host logger_ts */
+static int parse_flaser(reader *r, fields *fs)
+{
+    polyc_scan s;
+    uint32_t n;
+    memset(&s, 0, sizeof s);
+    if (take_count(r, fs, "beam count", SCANLOG_MAX_BEAMS_SCAN, &n) ||
+        check_tail(r, fs, "FLASER", "beams", n, FLASER_TAIL) || take_ranges(r, fs, n) ||
+        take_pose(r, fs, "pose", &s.pose_x_m, &s.pose_y_m, &s.pose_theta_rad))
+        return -1;
+    double inc = PI_D / 180.0;                   /* CARMEN: 180/181 beams, 1 deg */
+    if (n == 360 || n == 361)
+        inc = PI_D / 360.0;
+    else if (n != 180 && n != 181 && n > 1)     /* any other count spans 180 deg */
+        inc = n % 2 ? PI_D / (n - 1) : PI_D / n;
+    s.start_angle_rad = (float)(-PI_D / 2);
+    s.angle_step_rad = (float)inc;
+    s.min_range_m = SCANLOG_MIN_RANGE_M;
+    s.max_range_m = 0;                           /* set by the no-return rule */
+    s.beam_count = n;
+    return push_scan(r, &s, SCANLOG_FLASER);
+}
+
+/* Beam order reversed so that the step is positive (the library's rule). */
+static void reverse_last(scanlog *log, size_t n)
+{
+    float *a = log->pool + log->pool_len;
+    for (size_t i = 0; i < n / 2; i++) {
+        float t = a[i];
+        a[i] = a[n - 1 - i];
+        a[n - 1 - i] = t;
+    }
+}
+
+static int check_max_range(reader *r, double max_range_m, polyc_scan *s)
+{
+    if (!isfinite(max_range_m) || max_range_m <= (double)SCANLOG_MIN_RANGE_M ||
+        max_range_m > SCANLOG_MAX_POSE_M)
+        return fail(r, "max range %g m out of (%g, %g]", max_range_m,
+                    (double)SCANLOG_MIN_RANGE_M, SCANLOG_MAX_POSE_M);
+    if (r->max_range_m > 0 && r->max_range_m < max_range_m)
+        max_range_m = r->max_range_m;
+    s->max_range_m = (float)max_range_m;
+    return 0;
+}
+
+/* ROBOTLASER1 type start fov res max_range accuracy remission_mode n r1..rn
+ *   m rem1..remm laser_x laser_y laser_theta robot_x .. (14 fields) */
+static int parse_robotlaser1(reader *r, fields *fs)
+{
+    polyc_scan s;
+    double type, start, fov, res, max_range, accuracy, mode;
+    uint32_t n, m;
+    memset(&s, 0, sizeof s);
+    if (take_double(r, fs, "laser_type", &type) || take_angle(r, fs, "start_angle", &start) ||
+        take_double(r, fs, "fov", &fov) || take_angle(r, fs, "angular_res", &res) ||
+        take_double(r, fs, "max_range", &max_range) ||
+        take_double(r, fs, "accuracy", &accuracy) ||
+        take_double(r, fs, "remission_mode", &mode) ||
+        take_count(r, fs, "beam count", SCANLOG_MAX_BEAMS_SCAN, &n))
+        return -1;
+    uint64_t rest = count_fields(fs->p);
+    if (rest < (uint64_t)n + 1)
+        return fail(r, "ROBOTLASER1 with %u beams has only %llu fields after the count",
+                    n, (unsigned long long)rest);
+    if (take_ranges(r, fs, n) ||
+        take_count(r, fs, "remission count", SCANLOG_MAX_BEAMS_SCAN, &m) ||
+        check_tail(r, fs, "ROBOTLASER1", "remissions", m, ROBOTLASER1_TAIL))
+        return -1;
+    for (uint32_t i = 0; i < m; i++)
+        next_field(fs);
+    if (take_pose(r, fs, "laser pose", &s.pose_x_m, &s.pose_y_m, &s.pose_theta_rad) ||
+        check_max_range(r, max_range, &s))
+        return -1;
+    if (res == 0 && n > 1)
+        return fail(r, "angular_res is 0 with %u beams", n);
+    if (res < 0) {
+        reverse_last(r->log, n);
+        start += (n - 1) * res;
+        res = -res;
+    }
+    s.start_angle_rad = (float)start;
+    s.angle_step_rad = res > 0 ? (float)res : 1.0f;   /* one beam: any step */
+    s.min_range_m = SCANLOG_MIN_RANGE_M;
+    s.beam_count = n;
+    return push_scan(r, &s, SCANLOG_ROBOTLASER1);
+}
+
+/* SCAN x y theta start step min max n r1..rn (docs/formats.md) */
+static int parse_plain(reader *r, fields *fs)
+{
+    polyc_scan s;
+    double start, step, min_r, max_r;
+    uint32_t n;
+    memset(&s, 0, sizeof s);
+    if (take_pose(r, fs, "pose", &s.pose_x_m, &s.pose_y_m, &s.pose_theta_rad) ||
+        take_angle(r, fs, "start angle", &start) || take_angle(r, fs, "angle step", &step) ||
+        take_double(r, fs, "min range", &min_r) || take_double(r, fs, "max range", &max_r) ||
+        take_count(r, fs, "beam count", SCANLOG_MAX_BEAMS_SCAN, &n) ||
+        check_tail(r, fs, "SCAN", "beams", n, 0) || take_ranges(r, fs, n))
+        return -1;
+    if (!(step > 0))
+        return fail(r, "angle step %g must be > 0", step);
+    if (!isfinite(min_r) || min_r < 0 || min_r >= max_r)
+        return fail(r, "min range %g m must be finite, >= 0 and below max range", min_r);
+    if (check_max_range(r, max_r, &s))
+        return -1;
+    s.start_angle_rad = (float)start;
+    s.angle_step_rad = (float)step;
+    s.min_range_m = (float)min_r;
+    s.beam_count = n;
+    return push_scan(r, &s, SCANLOG_PLAIN);
+}
+
+static void count_keyword(scanlog *log, const char *word)
+{
+    log->skipped_lines++;
+    for (uint32_t i = 0; i < log->keyword_count; i++)
+        if (strcmp(log->keywords[i].name, word) == 0) {
+            log->keywords[i].count++;
+            return;
+        }
+    if (log->keyword_count < SCANLOG_MAX_KEYWORDS) {
+        scanlog_keyword *k = &log->keywords[log->keyword_count++];
+        snprintf(k->name, sizeof k->name, "%s", word);
+        k->count = 1;
+    }
+}
+
+/* A line type we skip: letters, digits and '_' (CARMEN's message names). */
+static int is_keyword(const char *s)
+{
+    size_t n = strlen(s);
+    if (n == 0 || n >= sizeof(((scanlog_keyword *)0)->name))
+        return 0;
+    for (size_t i = 0; i < n; i++) {
+        char c = s[i];
+        if (!((c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') ||
+              c == '_'))
+            return 0;
+    }
+    return 1;
+}
+
+static int parse_comment(reader *r, char *line)
+{
+    fields fs = {line + 1, 0};
+    char *w = next_field(&fs);
+    if (w && strcmp(w, "polyc-scans") == 0) {
+        char *v = next_field(&fs);
+        if (!v || strcmp(v, "1") != 0)
+            return fail(r, "unsupported polyc-scans version '%.16s' (this reader: 1)",
+                        v ? v : "");
+    }
+    count_keyword(r->log, "#");
+    return 0;
+}
+
+static int parse_line(reader *r, char *line)
+{
+    fields fs = {line, 0};
+    char *p = line;
+    while (*p && is_space((unsigned char)*p))
+        p++;
+    if (*p == '#')
+        return parse_comment(r, p);
+    char *word = next_field(&fs);
+    if (!word) {
+        r->log->blank_lines++;
+        return 0;
+    }
+    if (strcmp(word, "FLASER") == 0)
+        return parse_flaser(r, &fs);
+    if (strcmp(word, "ROBOTLASER1") == 0)
+        return parse_robotlaser1(r, &fs);
+    if (strcmp(word, "SCAN") == 0)
+        return parse_plain(r, &fs);
+    if (!is_keyword(word))
+        return fail(r, "not a log line: starts with '%.24s%s'", word,
+                    strlen(word) > 24 ? "..." : "");
+    count_keyword(r->log, word);
+    return 0;
+}
+
+/* Applies the no-return rule to FLASER scans and points scans at the pool. */
+static int finish(reader *r)
+{
+    scanlog *log = r->log;
+    if (log->count == 0)
+        return fail(r, "no scans found (%llu lines read)", (unsigned long long)log->lines);
+    if (log->kind_counts[SCANLOG_FLASER]) {
+        scanlog_noreturn *nr = &log->noreturn;
+        if (r->max_range_m > 0) {
+            memset(nr, 0, sizeof *nr);
+            nr->overridden = 1;
+            nr->max_range_m = (float)r->max_range_m;
+        } else {
+            nr_hist h = {calloc(NR_BINS, sizeof(uint32_t)), 0, 0};
+            uint64_t *prefix = malloc((NR_BINS + 1) * sizeof *prefix);
+            if (h.bin && prefix) {
+                for (uint32_t i = 0; i < log->count; i++) {
+                    if (log->kind_of_scan[i] != SCANLOG_FLASER)
+                        continue;
+                    const float *a = log->pool + log->offset_of_scan[i];
+                    for (uint32_t j = 0; j < log->scans[i].beam_count; j++)
+                        nr_add(&h, a[j]);
+                }
+                nr_pick(&h, prefix, nr);
+            }
+            free(h.bin);
+            free(prefix);
+            if (!h.bin || !prefix)
+                return fail(r, "out of memory");
+        }
+        for (uint32_t i = 0; i < log->count; i++)
+            if (log->kind_of_scan[i] == SCANLOG_FLASER)
+                log->scans[i].max_range_m = nr->max_range_m;
+    }
+    for (uint32_t i = 0; i < log->count; i++)
+        log->scans[i].range_m = log->scans[i].beam_count ? log->pool + log->offset_of_scan[i]
+                                                         : NULL;
+    return 0;
+}
+
+int scanlog_read(scanlog *log, FILE *f, const char *name, const scanlog_opts *opts)
+{
+    reader r;
+    size_t len;
+    int got;
+    memset(log, 0, sizeof *log);
+    memset(&r, 0, sizeof r);
+    r.log = log;
+    r.name = name;
+    r.max_range_m = opts && opts->max_range_m > 0 ? opts->max_range_m : 0;
+    while ((got = read_line(&r, f, &len)) == 1) {
+        log->lines++;
+        size_t pool_len = log->pool_len;
+        if (parse_line(&r, r.buf)) {
+            log->pool_len = pool_len;
+            break;
+        }
+    }
+    free(r.buf);
+    if (got != 0)
+        return -1;
+    r.line = 0;
+    return finish(&r);
+}
+
+void scanlog_free(scanlog *log)
+{
+    free(log->scans);
+    free(log->line_of_scan);
+    free(log->kind_of_scan);
+    free(log->offset_of_scan);
+    free(log->pool);
+    memset(log, 0, sizeof *log);
+}
+
+/* ---- the plain format writer ---- */
+
+static void put_float(FILE *f, double v, int digits)
+{
+    if (isnan(v))
+        fputs(" nan", f);
+    else if (isinf(v))
+        fputs(v > 0 ? " inf" : " -inf", f);
+    else
+        fprintf(f, " %.*g", digits, v);
+}
+
+int scanlog_write_plain(FILE *f, const polyc_scan *scans, uint32_t count)
+{
+    fputs("# polyc-scans 1\n"
+          "# SCAN x_m y_m theta_rad start_angle_rad angle_step_rad min_range_m max_range_m"
+          " n range_1_m .. range_n_m\n",
+          f);
+    for (uint32_t i = 0; i < count; i++) {
+        const polyc_scan *s = &scans[i];
+        fputs("SCAN", f);
+        put_float(f, s->pose_x_m, 17);
+        put_float(f, s->pose_y_m, 17);
+        put_float(f, s->pose_theta_rad, 17);
+        put_float(f, (double)s->start_angle_rad, 9);
+        put_float(f, (double)s->angle_step_rad, 9);
+        put_float(f, (double)s->min_range_m, 9);
+        put_float(f, (double)s->max_range_m, 9);
+        fprintf(f, " %u", (unsigned)s->beam_count);
+        for (uint32_t j = 0; j < s->beam_count; j++)
+            put_float(f, (double)s->range_m[j], 9);
+        fputc('\n', f);
+    }
+    return ferror(f) ? -1 : 0;
+}

@@ -1,0 +1,168 @@
+/* scansim.h - a small deterministic 2D laser simulator for tests, examples
+ * and benchmarks.
+ *
+ * Takes: a scene (walls as polylines, a trajectory of true poses, a laser,
+ * noise settings, people walking through). Gives: polyc_scan records as a
+ * laser would report them, a CARMEN ROBOTLASER1 log and a ground-truth file
+ * in the format of shared/data/sim/NAME.gt.txt (ideal, wall, seen).
+ *
+ * Deterministic: one seed gives the same scans. The random stream is
+ * splitmix64 (exact integer arithmetic on every platform); Gaussian noise is
+ * Box-Muller on top of it (log, sqrt, cos from libm, so bitwise identity of
+ * the float ranges needs a libm that rounds the same; the mm-rounded log text
+ * is the same on every glibc/musl/macOS we know of).
+ *
+ * Memory: a scene owns malloc'ed arrays; scansim_scene_free() releases them.
+ * Functions returning int give 0 on success, -1 on bad arguments or when
+ * malloc fails (the scene stays valid, nothing half-added).
+ *
+ * SPDX-License-Identifier: MIT
+ */
+#ifndef SCANSIM_H
+#define SCANSIM_H
+
+#include <stdint.h>
+#include <stdio.h>
+
+#include "polyc.h"
+
+/* ---- random numbers ---------------------------------------------------- */
+
+typedef struct scansim_rng {
+    uint64_t state;
+    double spare;     /* second Box-Muller value, valid if has_spare */
+    int has_spare;
+} scansim_rng;
+
+void scansim_rng_seed(scansim_rng *rng, uint64_t seed);
+uint64_t scansim_rng_u64(scansim_rng *rng);
+/* Uniform in [0, 1), 53 bits. */
+double scansim_rng_uniform(scansim_rng *rng);
+/* Standard normal (mean 0, std-dev 1). */
+double scansim_rng_gauss(scansim_rng *rng);
+
+/* ---- scene ------------------------------------------------------------- */
+
+/* Beam i points at pose_theta + start_angle_rad + i * angle_step_rad. */
+typedef struct scansim_laser {
+    uint32_t beam_count;
+    float start_angle_rad;
+    float angle_step_rad;
+    float min_range_m;        /* reported in polyc_scan; hits closer are kept */
+    float max_range_m;        /* a wall farther away gives no return */
+    float range_sigma_m;      /* Gaussian range noise */
+    float dropout;            /* share of beams that return nothing, [0, 1] */
+} scansim_laser;
+
+typedef struct scansim_pose {
+    double x_m;
+    double y_m;
+    double theta_rad;
+} scansim_pose;
+
+/* A disc that walks in a straight line from `from` to `to` during scans
+ * first_scan..last_scan (inclusive) and is absent from every other scan. */
+typedef struct scansim_person {
+    double from_x_m, from_y_m;
+    double to_x_m, to_y_m;
+    double radius_m;
+    uint32_t first_scan;
+    uint32_t last_scan;
+} scansim_person;
+
+/* A wall: points wall_xy_m[2*first_point ..] of the scene, point_count of
+ * them; closed: the last point connects to the first. */
+typedef struct scansim_wall {
+    uint32_t first_point;
+    uint32_t point_count;
+    uint32_t closed;
+} scansim_wall;
+
+typedef struct scansim_scene {
+    char name[32];
+    uint64_t seed;
+    scansim_laser laser;
+    double pose_sigma_m;       /* alignment noise of the logged pose */
+    double pose_sigma_rad;
+
+    double *wall_xy_m;         /* interleaved x, y */
+    uint32_t wall_point_count, wall_point_cap;
+    scansim_wall *walls;
+    uint32_t wall_count, wall_cap;
+    scansim_pose *poses;       /* true laser poses, one scan each */
+    uint32_t pose_count, pose_cap;
+    scansim_person *people;
+    uint32_t person_count, person_cap;
+
+    /* Filled by scansim_run (freed and refilled by each run). */
+    polyc_scan *scans;         /* scan_count scans; pose = logged (noisy) pose */
+    float *range_m;            /* scan_count * beam_count ranges; a beam with
+                                  no return reads exactly max_range_m */
+    uint32_t scan_count;
+    uint64_t hit_count;        /* beams that returned a wall or a person */
+    double *sample_xy_m;       /* wall samples every <= 2 cm, along each wall */
+    uint8_t *sample_seen;      /* 1: some beam observed this sample */
+    uint8_t *sample_corner;    /* 1: this sample is a corner of its wall */
+    uint32_t *wall_first_sample; /* per wall, index of its first sample */
+    uint32_t *wall_sample_count;
+    uint32_t sample_count;
+} scansim_scene;
+
+/* An empty scene with the defaults: 181 beams over 180 degrees, 8 m range,
+ * 1 cm range noise, 0.3% dropout, 1 cm / 0.2 degree pose noise. */
+void scansim_scene_init(scansim_scene *scene, const char *name, uint64_t seed);
+void scansim_scene_free(scansim_scene *scene);
+
+int scansim_add_wall(scansim_scene *scene, const double *xy_m, uint32_t point_count,
+                     int closed);
+/* A closed regular polygon of `sides` points approximating a circle. */
+int scansim_add_circle(scansim_scene *scene, double cx_m, double cy_m, double radius_m,
+                       uint32_t sides);
+/* A closed rectangle, axis-aligned in the scene's frame (for thick walls). */
+int scansim_add_box(scansim_scene *scene, double x0_m, double y0_m, double x1_m,
+                    double y1_m);
+int scansim_add_pose(scansim_scene *scene, double x_m, double y_m, double theta_rad);
+/* Poses every spacing_m along the waypoint polyline (first waypoint
+ * included), each facing the direction of travel. */
+int scansim_add_path(scansim_scene *scene, const double *xy_m, uint32_t waypoint_count,
+                     double spacing_m);
+int scansim_add_person(scansim_scene *scene, const scansim_person *person);
+/* Rotates the whole scene (walls, poses, people) by angle_rad about the
+ * origin, then shifts it: used to put walls off the grid axes. */
+void scansim_transform(scansim_scene *scene, double angle_rad, double dx_m, double dy_m);
+
+/* Built-in scenes: "square", "office", "angled", "circle". -1 if unknown. */
+int scansim_scene_builtin(scansim_scene *scene, const char *name, uint64_t seed);
+/* NULL-terminated list of the built-in names. */
+const char *const *scansim_builtin_names(void);
+
+/* ---- simulation -------------------------------------------------------- */
+
+/* First intersection of the ray from (x, y) at angle_rad with the walls and
+ * with the people present in scan `scan_index` (UINT32_MAX: no people).
+ * Returns the range, or INFINITY if nothing is hit; *object (may be NULL)
+ * gets the wall segment index (see scansim_segment_count order), -2 for a
+ * person, -1 for nothing. */
+double scansim_cast(const scansim_scene *scene, double x_m, double y_m, double angle_rad,
+                    uint32_t scan_index, int32_t *object);
+/* Number of wall segments (a closed wall of n points has n, an open one n-1). */
+uint32_t scansim_segment_count(const scansim_scene *scene);
+
+/* Simulates one scan per pose: fills scans, range_m, sample_seen. */
+int scansim_run(scansim_scene *scene);
+
+/* Vertices of a perfect map of the seen walls (after scansim_run): every
+ * stretch seen over >= 20 cm counts its two ends and its corners; a closed
+ * wall seen all round counts its corners. */
+uint32_t scansim_ideal_vertices(const scansim_scene *scene);
+/* Number of seen samples (after scansim_run). */
+uint32_t scansim_seen_count(const scansim_scene *scene);
+
+/* ROBOTLASER1 lines, one per scan, ranges in mm precision. 0 or -1 (I/O). */
+int scansim_write_log(const scansim_scene *scene, FILE *out);
+/* The ground truth (ideal, wall, seen). 0 or -1 (I/O). */
+int scansim_write_gt(const scansim_scene *scene, FILE *out);
+/* Both, to files; 0 or -1 with errno set. */
+int scansim_save(const scansim_scene *scene, const char *log_path, const char *gt_path);
+
+#endif /* SCANSIM_H */
