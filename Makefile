@@ -16,8 +16,8 @@ TOOL_MOD = $(filter-out tools/polyc.c tools/bench.c,$(wildcard tools/*.c))
 TOOL_OBJ = $(TOOL_MOD:tools/%.c=$(BUILD)/tobj/%.o)
 TOOL_CFLAGS = $(WARN) $(OPT) $(CFLAGS) -Iinclude -Itools -D_POSIX_C_SOURCE=200809L
 
-.PHONY: all lib test unit bench clean
-all: $(BUILD)/libpolyc.a $(BUILD)/polyc
+.PHONY: all lib test unit bench clean install cross test-cxx test-install test-python test-embedded
+all: $(BUILD)/libpolyc.a $(BUILD)/libpolyc.so $(BUILD)/polyc
 
 $(BUILD)/obj/%.o: src/%.c include/polyc.h $(wildcard src/*.h)
 	@mkdir -p $(dir $@)
@@ -30,6 +30,27 @@ $(BUILD)/libpolyc.a: $(LIB_OBJ)
 $(BUILD)/polyc: tools/polyc.c $(TOOL_OBJ) $(BUILD)/libpolyc.a
 	$(CC) $(TOOL_CFLAGS) $^ -o $@ $(LDLIBS)
 
+# Shared library: exports only the POLYC_API functions (-fvisibility=hidden)
+VERSION := $(shell awk '/define POLYC_VERSION_(MAJOR|MINOR|PATCH) /{v = v s $$3; s = "."} END {print v}' include/polyc.h)
+SONAME   = libpolyc.so.$(firstword $(subst ., ,$(VERSION)))
+$(BUILD)/libpolyc.so: $(LIB_OBJ)
+	$(CC) -shared -Wl,-soname,$(SONAME) $(LDFLAGS) $^ -o $@ $(LDLIBS)
+
+# `make install PREFIX=/usr/local DESTDIR=`: header, libpolyc.a, libpolyc.so.X.Y.Z
+# with its soname and dev links, the tool, and polyc.pc for pkg-config
+PREFIX ?= /usr/local
+LIBDIR ?= $(PREFIX)/lib
+install: all
+	install -d $(DESTDIR)$(PREFIX)/include $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(LIBDIR)/pkgconfig
+	install -m 644 include/polyc.h $(DESTDIR)$(PREFIX)/include/
+	install -m 644 $(BUILD)/libpolyc.a $(DESTDIR)$(LIBDIR)/
+	install -m 755 $(BUILD)/libpolyc.so $(DESTDIR)$(LIBDIR)/libpolyc.so.$(VERSION)
+	ln -sf libpolyc.so.$(VERSION) $(DESTDIR)$(LIBDIR)/$(SONAME)
+	ln -sf $(SONAME) $(DESTDIR)$(LIBDIR)/libpolyc.so
+	install -m 755 $(BUILD)/polyc $(DESTDIR)$(PREFIX)/bin/
+	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@LIBDIR@|$(LIBDIR)|' -e 's|@VERSION@|$(VERSION)|' \
+	    polyc.pc.in > $(DESTDIR)$(LIBDIR)/pkgconfig/polyc.pc
+
 # Unit and end-to-end tests: one cmocka binary per tests/test_*.c
 TEST_SRC = $(wildcard tests/test_*.c)
 TEST_BIN = $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
@@ -40,7 +61,73 @@ $(BUILD)/tests/%: tests/%.c $(TOOL_OBJ) $(BUILD)/libpolyc.a $(wildcard tests/*.h
 unit: $(TEST_BIN) $(BUILD)/polyc
 	@set -e; for t in $(TEST_BIN); do echo "== $$t"; $$t; done
 
-test: unit
+# Also: the header as C++, an installed copy used through pkg-config, the
+# Python binding against build/libpolyc.so, the 128 KiB example on the host
+test: unit test-cxx test-install test-python test-embedded
+test-cxx: $(BUILD)/tests/cxx_header
+	$(BUILD)/tests/cxx_header
+$(BUILD)/tests/cxx_header: tests/cxx_header.cpp include/polyc.h $(BUILD)/libpolyc.a
+	@mkdir -p $(dir $@)
+	$(CXX) -std=c++11 -Wall -Wextra -Werror -pedantic -Iinclude $< $(BUILD)/libpolyc.a -o $@ $(LDLIBS)
+test-install: all
+	tests/install_test.sh "$(MAKE)" "$(BUILD)"
+test-python: all
+	POLYC_LIB=$(abspath $(BUILD)/libpolyc.so) POLYC_TOOL=$(abspath $(BUILD)/polyc) \
+	    python3 -m unittest discover -v -s bindings/python -p 'test_*.py'
+# the library as for the target (8-bit grid counters), tests/embedded_test.sh checks the map
+EMB_OBJ = $(LIB_SRC:src/%.c=$(BUILD)/emb/%.o)
+$(BUILD)/emb/%.o: src/%.c include/polyc.h $(wildcard src/*.h)
+	@mkdir -p $(dir $@)
+	$(CC) $(WARN) $(OPT) $(CFLAGS) -DPOLYC_COUNTER_BITS=8 -Iinclude -c $< -o $@
+$(BUILD)/embedded_scan: examples/embedded_scan.c $(EMB_OBJ)
+	$(CC) $(WARN) $(OPT) $(CFLAGS) -Iinclude $^ -o $@ $(LDLIBS)
+test-embedded: $(BUILD)/embedded_scan footprint
+	tests/embedded_test.sh $(BUILD)/embedded_scan
+# bytes per scan, beam, vertex and grid tile (README "Footprint"): 16-, then 8-bit counters
+.PHONY: footprint
+footprint: $(BUILD)/footprint $(BUILD)/footprint8
+	$(BUILD)/footprint 0.025 && $(BUILD)/footprint8 0.025
+$(BUILD)/footprint: examples/footprint.c $(BUILD)/libpolyc.a
+	$(CC) $(WARN) $(OPT) $(CFLAGS) -Iinclude $^ -o $@ $(LDLIBS)
+$(BUILD)/footprint8: examples/footprint.c $(EMB_OBJ)
+	$(CC) $(WARN) $(OPT) $(CFLAGS) -Iinclude $^ -o $@ $(LDLIBS)
+
+# Cortex-M4 (`make cross`; needs gcc-arm-none-eabi, libnewlib-arm-none-eabi): the
+# library at -Os -Werror and its sizes; FAILS if it references an allocator or
+# stdio (nm -u), or if the linked example (nosys.specs) contains one; then the
+# example's stack from -fstack-usage. A failed POLYC_ASSERT traps (udf): newlib's
+# assert() calls __assert_func, which pulls in fiprintf and all of stdio.
+CROSS  ?= arm-none-eabi-
+XBUILD ?= build-cross
+XFLAGS  = $(WARN) -mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard -Os -Werror \
+          -ffunction-sections -fdata-sections -fstack-usage -fcallgraph-info=su \
+          -DPOLYC_COUNTER_BITS=8 '-DPOLYC_ASSERT(x)=((x) ? (void)0 : __builtin_trap())' -Iinclude
+XOBJ    = $(LIB_SRC:src/%.c=$(XBUILD)/%.o)
+sp     := $(subst ,, )
+X_ALLOC = _*(malloc|calloc|realloc|reallocf|free|memalign|aligned_alloc|posix_memalign|sbrk)(_r)?
+X_STDIO = $(subst $(sp),|,.*printf.* .*scanf.* f?open fdopen freopen fclose fread fwrite fputs \
+          fputc putc puts putchar fgets gets fgetc getc getchar ungetc fflush fseek ftell rewind \
+          perror setvbuf setbuf tmpfile stdin stdout stderr __assert_func setlocale localeconv \
+          strto(d|f|ld) atof)
+cross: $(XBUILD)/libpolyc.a $(XBUILD)/embedded_scan.elf
+	$(CROSS)size -t $(XOBJ)
+	$(CROSS)size $(XBUILD)/embedded_scan.elf
+	@bad=$$($(CROSS)nm -u $(XOBJ) | awk '{print $$2}' | grep -Ex '$(X_ALLOC)|$(X_STDIO)|_impure_ptr' | sort -u); \
+	if [ -n "$$bad" ]; then echo "cross: FAIL: the library references" $$bad; exit 1; fi
+	@bad=$$($(CROSS)nm $(XBUILD)/embedded_scan.elf | awk '{print $$3}' | grep -Ex '$(X_ALLOC)|$(X_STDIO)' | sort -u); \
+	if [ -n "$$bad" ]; then echo "cross: FAIL: the linked example contains" $$bad; exit 1; fi
+	@echo "cross: no allocator and no stdio in the library or the linked example"
+	python3 tools/stack_usage.py --cross $(CROSS) --elf $(XBUILD)/embedded_scan.elf $(XBUILD)/*.ci
+$(XBUILD)/%.o: src/%.c include/polyc.h $(wildcard src/*.h)
+	@mkdir -p $(dir $@)
+	$(CROSS)gcc $(XFLAGS) -c $< -o $@
+$(XBUILD)/libpolyc.a: $(XOBJ)
+	rm -f $@ && $(CROSS)ar rcs $@ $^
+$(XBUILD)/embedded_scan.o: examples/embedded_scan.c include/polyc.h
+	@mkdir -p $(dir $@)
+	$(CROSS)gcc $(XFLAGS) -DEMBEDDED_SCAN_TARGET -c $< -o $@
+$(XBUILD)/embedded_scan.elf: $(XBUILD)/embedded_scan.o $(XBUILD)/libpolyc.a
+	$(CROSS)gcc $(XFLAGS) -specs=nosys.specs -Wl,--gc-sections $^ -lm -o $@
 
 # Benchmark on the shared data (not in the repo): an optimised build in
 # build-bench/, then one table. `make bench DATA=dir BENCH_ARGS='--only intel'`

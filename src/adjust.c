@@ -101,14 +101,17 @@ int polyc__hill_climb(polyc__opt *o, int32_t v)
 }
 
 /* Rounds of hill climbing; after the first, only vertices next to one that
- * moved in the previous round are climbed again. */
-int polyc__op_adjust(polyc__opt *o, int max_rounds)
+ * moved in the previous round are climbed again. With touched_only, the
+ * first round takes only the vertices edited since the last adjustment. */
+int polyc__op_adjust(polyc__opt *o, int max_rounds, int touched_only)
 {
     const polyc__store *s = o->s;
     int total = 0;
     uint32_t stamp = ++o->work_stamp;
     for (int32_t v = 0; v < s->v_high; v++)
-        o->v_work[v] = stamp;
+        if (!touched_only || o->v_touch[v] == o->touch_stamp)
+            o->v_work[v] = stamp;
+    o->touch_stamp++;
     for (int r = 0; r < max_rounds; r++) {
         uint32_t next = ++o->work_stamp;
         int moved = 0;

@@ -201,6 +201,7 @@ size_t polyc_memory_size(const polyc_config *config, const polyc_limits *limits)
     n = polyc__add(n, polyc__contour_bytes(limits)); /* tracing scratch */
     n = polyc__add(n, polyc__flat_bytes(limits));
     n = polyc__add(n, polyc__prior_bytes(limits));
+    n = polyc__add(n, 2 * polyc__spacing_bytes(limits)); /* trace and optimiser */
     n = polyc__add(n, polyc__optimizer_bytes(config, limits));
     return n == SIZE_MAX ? 0 : n;
 }

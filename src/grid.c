@@ -2,7 +2,7 @@
  * Takes: the stored scans. Gives: per cell hits and misses, counted by exact
  * traversal of every beam (Amanatides-Woo), in 32 x 32 tiles allocated only
  * where beams pass, over the extent of the data. */
-#include "internal.h"
+#include "walk.h"
 
 #include <math.h>
 #include <string.h>
@@ -129,82 +129,68 @@ int polyc__beam_get(const polyc_ctx *ctx, const polyc__scan *s, uint32_t i, poly
 
 /* Exact traversal of the cells from (sx, sy) to (ex, ey); `visit` gets each
  * cell with the beam parameter t at which the beam enters it. Returns early
- * when visit returns non-zero. The step count is fixed in advance, so the walk
- * always ends in the end cell whatever the rounding. */
+ * when visit returns non-zero. */
 void polyc__traverse(const polyc__beam *b, polyc__cell_fn visit, void *u)
 {
-    int32_t ix = (int32_t)floorf(b->sx), iy = (int32_t)floorf(b->sy);
-    int32_t ex = (int32_t)floorf(b->ex), ey = (int32_t)floorf(b->ey);
-    float dx = b->ex - b->sx, dy = b->ey - b->sy;
-    int32_t stx = dx > 0.0f ? 1 : -1, sty = dy > 0.0f ? 1 : -1;
-    float tdx = dx != 0.0f ? fabsf(1.0f / dx) : 1e30f;
-    float tdy = dy != 0.0f ? fabsf(1.0f / dy) : 1e30f;
-    float tmx = dx > 0.0f ? ((float)ix + 1.0f - b->sx) * tdx : (b->sx - (float)ix) * tdx;
-    float tmy = dy > 0.0f ? ((float)iy + 1.0f - b->sy) * tdy : (b->sy - (float)iy) * tdy;
-    if (dx == 0.0f) tmx = 1e30f;
-    if (dy == 0.0f) tmy = 1e30f;
-    int32_t n = (ex > ix ? ex - ix : ix - ex) + (ey > iy ? ey - iy : iy - ey);
-    float t = 0.0f;
-    for (int32_t k = 0; k < n; k++) {
-        if (visit(u, ix, iy, t, 0))
+    polyc__walk w;
+    polyc__walk_start(&w, b);
+    while (w.n > 0) {
+        if (visit(u, w.ix, w.iy, w.t, 0))
             return;
-        if (tmx < tmy) {
-            t = tmx;
-            tmx += tdx;
-            ix += stx;
-        } else {
-            t = tmy;
-            tmy += tdy;
-            iy += sty;
-        }
+        polyc__walk_step(&w);
     }
-    visit(u, ex, ey, t, 1);
+    visit(u, w.ex, w.ey, w.t, 1);
 }
 
-typedef struct count_pass {
-    polyc_ctx *ctx;
-    const polyc__beam *beam;
-    int32_t last_dir;
-    polyc__tile *last_tile;
-} count_pass;
-
-static polyc__tile *tile_for(count_pass *p, int32_t ix, int32_t iy)
+/* The tile of cell (ix, iy) inside the grid, allocated on first use; NULL
+ * when the tile budget is spent (out_of_tiles). Tiles stay contiguous
+ * because nothing else allocates during the grid pass. */
+static polyc__tile *tile_get(polyc__grid *g, polyc__arena *a, int32_t ix, int32_t iy)
 {
-    polyc__grid *g = &p->ctx->grid;
-    if (ix < 0 || iy < 0 || ix >= g->width || iy >= g->height)
-        return NULL;
-    int32_t d = (iy >> POLYC__TILE_SHIFT) * g->tiles_x + (ix >> POLYC__TILE_SHIFT);
-    if (d == p->last_dir)
-        return p->last_tile;
-    if (g->dir[d] == 0) {
+    uint32_t *d = &g->dir[(iy >> POLYC__TILE_SHIFT) * g->tiles_x + (ix >> POLYC__TILE_SHIFT)];
+    if (*d == 0) {
         if (g->tile_count >= g->tile_cap) {
             g->out_of_tiles = 1;
             return NULL;
         }
-        polyc__tile *t = polyc__alloc_zero(&p->ctx->arena, 1, sizeof(polyc__tile));
+        polyc__tile *t = polyc__alloc_zero(a, 1, sizeof(polyc__tile));
         if (!t || t != g->tiles + g->tile_count) {
             g->out_of_tiles = 1;
             return NULL;
         }
-        g->dir[d] = ++g->tile_count;
+        *d = ++g->tile_count;
     }
-    p->last_dir = d;
-    p->last_tile = &g->tiles[g->dir[d] - 1];
-    return p->last_tile;
+    return &g->tiles[*d - 1];
 }
 
-static int count_cell(void *u, int32_t ix, int32_t iy, float t_enter, int last)
+/* One beam into the counters: a miss in every cell the beam enters before
+ * miss_end, a hit in the end cell of a reflection. Every cell walked gets
+ * its tile, even past miss_end; the walk stops at the grid's edge. The tile
+ * directory is read only when the walk crosses into another tile. */
+static void count_beam(polyc__grid *g, polyc__arena *a, const polyc__beam *b)
 {
-    count_pass *p = u;
-    polyc__tile *t = tile_for(p, ix, iy);
-    if (!t)
-        return 1;
-    int idx = polyc__cell_index(ix, iy);
-    if (last && p->beam->hit)
+    polyc__walk w;
+    polyc__walk_start(&w, b);
+    const float miss_end = b->miss_end;
+    polyc__tile *t = NULL;
+    if (w.n > 0 && (!polyc__walk_enter(&w, g->width, g->height) || !(t = tile_get(g, a, w.ix, w.iy))))
+        return;
+    while (w.n > 0) {
+        if (w.t < miss_end)
+            count_inc(&t->misses[w.idx], &t->hits[w.idx]);
+        if (polyc__walk_step(&w) && w.n > 0 &&
+            (!polyc__walk_enter(&w, g->width, g->height) || !(t = tile_get(g, a, w.ix, w.iy))))
+            return;
+    }
+    /* the end cell, where the walk is unless rounding took it elsewhere */
+    if (w.ex < 0 || w.ey < 0 || w.ex >= g->width || w.ey >= g->height ||
+        !(t = tile_get(g, a, w.ex, w.ey)))
+        return;
+    int idx = polyc__cell_index(w.ex, w.ey);
+    if (b->hit)
         count_inc(&t->hits[idx], &t->misses[idx]);
-    else if (t_enter < p->beam->miss_end)
+    else if (w.t < miss_end)
         count_inc(&t->misses[idx], &t->hits[idx]);
-    return 0;
 }
 
 polyc_status polyc__grid_build(polyc_ctx *ctx)
@@ -246,18 +232,13 @@ polyc_status polyc__grid_build(polyc_ctx *ctx)
      * contiguous because nothing else allocates during this pass */
     g->tiles = (polyc__tile *)(ctx->arena.base + ctx->arena.used);
 
-    count_pass p;
-    memset(&p, 0, sizeof p);
-    p.ctx = ctx;
-    p.last_dir = -1;
     for (uint32_t si = 0; si < ctx->scan_count; si++) {
         const polyc__scan *s = &ctx->scans[si];
         for (uint32_t i = 0; i < s->count; i++) {
             polyc__beam b;
             if (!polyc__beam_get(ctx, s, i, &b))
                 continue;
-            p.beam = &b;
-            polyc__traverse(&b, count_cell, &p);
+            count_beam(g, &ctx->arena, &b);
             if (g->out_of_tiles)
                 return polyc__fail(ctx, POLYC_ERR_NOMEM,
                                    "grid needs more cells than limits.max_grid_cells");

@@ -158,6 +158,19 @@ polyc_status polyc__prior_build(polyc_ctx *ctx, polyc__prior *p);
 /* p(turn | x, y) in [0, 1]; x, y frame-relative metres; turn in [0, pi]. */
 float polyc__prior_p(const polyc__prior *p, float x, float y, float turn_rad);
 
+/* ---- expected beam spacing (spacing.c) ---- */
+typedef struct polyc__spacing {
+    float origin_x, origin_y, tile_m, min_step_rad;
+    int32_t w, h;
+    float *dist;                   /* per tile: distance to the nearest pose */
+} polyc__spacing;
+
+size_t polyc__spacing_bytes(const polyc_limits *lim);
+polyc_status polyc__spacing_build(polyc_ctx *ctx, polyc__spacing *sp);
+/* metres between neighbouring endpoints near (x, y), frame-relative; a lower
+ * bound, since the nearest pose is taken (0 without poses) */
+float polyc__spacing_at(const polyc__spacing *sp, float x, float y);
+
 typedef enum polyc__stage {
     POLYC__STAGE_SCANS = 0,
     POLYC__STAGE_GRID,

@@ -331,8 +331,9 @@ static int cmp_float(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* A segment with a stretch longer than split_gap_m onto which no data point
- * projects is cut there: the polyline ends on either side of the gap. */
+/* A segment with a stretch longer than split_gap_m (or 2.5 beam spacings
+ * where the data are sparser than that) onto which no data point projects
+ * is cut there: the polyline ends on either side of the gap. */
 int polyc__op_split(polyc__opt *o)
 {
     polyc__store *s = o->s;
@@ -382,7 +383,12 @@ int polyc__op_split(polyc__opt *o)
             }
             prev = cur;
         }
-        if (best > gap_min && n_cut < o->cut_cap) {
+        /* sparse data (far from every pose) has gaps of a few beam
+         * spacings between neighbouring points: those are no gaps */
+        float gx = a->x + (b->x - a->x) * (g0 + 0.5f * best) / len;
+        float gy = a->y + (b->y - a->y) * (g0 + 0.5f * best) / len;
+        float need = fmaxf(gap_min, 2.5f * polyc__spacing_at(&o->spacing, gx, gy));
+        if (best > need && n_cut < o->cut_cap) {
             o->cut_seg[n_cut] = v;
             o->cut_next[n_cut] = a->next;
             o->cut_t0[n_cut] = g0 / len;

@@ -29,7 +29,7 @@ size_t polyc__optimizer_bytes(const polyc_config *cfg, const polyc_limits *lim)
     n = polyc__add(n, polyc__bytes(V + 1, sizeof(int32_t)));      /* split_off */
     n = polyc__add(n, polyc__bytes(V, 4 * sizeof(float) + 2 * sizeof(int32_t))); /* cuts */
     n = polyc__add(n, polyc__bytes(V, 4 * sizeof(double)));       /* acost, seg stats */
-    n = polyc__add(n, polyc__bytes(V, 5 * sizeof(int32_t) + 1));  /* marks, lists, seg_in */
+    n = polyc__add(n, polyc__bytes(V, 6 * sizeof(int32_t) + 1));  /* marks, lists, seg_in */
     n = polyc__add(n, polyc__bytes(V * 3 + 16, sizeof(polyc__heap_entry)));
     n = polyc__add(n, polyc__bytes(ADDED_CAP, sizeof(int32_t)));
     n = polyc__add(n, polyc__bytes(NB, 4 * sizeof(int32_t)));     /* heads, starts, marks, list */
@@ -54,6 +54,8 @@ static polyc_status setup(polyc_ctx *ctx, polyc__opt *o)
     int32_t V = o->s->v_cap;
     polyc_status st = polyc__prior_build(ctx, &o->prior);
     if (st != POLYC_OK)
+        return st;
+    if ((st = polyc__spacing_build(ctx, &o->spacing)) != POLYC_OK)
         return st;
     if ((st = polyc__hash_init(o)) != POLYC_OK)
         return st;
@@ -83,6 +85,8 @@ static polyc_status setup(polyc_ctx *ctx, polyc__opt *o)
     ALLOC(o->seg_in, V);
     ALLOC(o->v_work, V);
     memset(o->v_work, 0, (size_t)V * sizeof(uint32_t));
+    ALLOC(o->v_touch, V);
+    memset(o->v_touch, 0, (size_t)V * sizeof(uint32_t));
     ALLOC(o->heap, V * 3 + 16);
     o->heap_cap = V * 3 + 16;
     ALLOC(o->added, ADDED_CAP);
@@ -133,11 +137,16 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
         polyc__op_overlaps(&o);          /* A */
         polyc__op_merge(&o);             /* B */
         polyc__op_split(&o);             /* C */
-        polyc__op_adjust(&o, ADJUST_ROUNDS); /* D */
+        polyc__op_remove_vertices(&o);   /* G: fewer vertices first, so that */
+        polyc__op_adjust(&o, ADJUST_ROUNDS, 0); /* D moves what is left */
         polyc__op_zigzag(&o);            /* E */
-        polyc__op_remove_vertices(&o);   /* G, fewer vertices */
+        polyc__op_remove_vertices(&o);   /* G */
         polyc__op_add_vertices(&o, ADD_ROUNDS); /* G, more vertices */
-        polyc__op_adjust(&o, ADJUST_ROUNDS);
+        polyc__op_adjust(&o, ADJUST_ROUNDS, 1);
+        /* moves and additions can leave segments without data or hairpins:
+         * clean them before the model is judged, so the best one is clean */
+        if (polyc__op_split(&o) + polyc__op_zigzag(&o) > 0)
+            polyc__op_adjust(&o, ADJUST_ROUNDS, 1);
         if (o.h.out_of_entries)
             return polyc__fail(ctx, POLYC_ERR_NOMEM, "spatial hash full");
         double bic = polyc__bic(&o);

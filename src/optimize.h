@@ -29,6 +29,7 @@ typedef struct polyc__opt {
     double angle;                  /* sum over vertices of (1 - p(turn | x, y)) */
     double *acost;                 /* per vertex: 1 - p */
     polyc__prior prior;
+    polyc__spacing spacing;        /* expected point spacing: the split scale */
 
     polyc__hash h;
     uint8_t *seg_in;               /* per vertex: its segment is in the hash */
@@ -64,6 +65,8 @@ typedef struct polyc__opt {
 
     uint32_t *v_work;              /* per vertex: == round stamp when to be climbed */
     uint32_t work_stamp;
+    uint32_t *v_touch;             /* per vertex: == touch_stamp when an edit touched it */
+    uint32_t touch_stamp;
     polyc__rng rng;
     polyc__flat best;
     double noise_m;
@@ -118,7 +121,7 @@ int polyc__op_link(polyc__opt *o, int32_t tail, int32_t head); /* join or close 
 int polyc__op_overlaps(polyc__opt *o);
 int polyc__op_merge(polyc__opt *o);
 int polyc__op_split(polyc__opt *o);
-int polyc__op_adjust(polyc__opt *o, int max_rounds);
+int polyc__op_adjust(polyc__opt *o, int max_rounds, int touched_only);
 int polyc__op_zigzag(polyc__opt *o);
 void polyc__op_noise(polyc__opt *o, double sigma_m);
 int polyc__op_remove_vertices(polyc__opt *o);

@@ -165,7 +165,10 @@ int polyc__chg_seg_in(polyc__opt *o, int32_t seg)
 
 void polyc__chg_dirty(polyc__opt *o, int32_t v)
 {
-    if (v == POLYC__NONE || o->v_dirty[v] == o->epoch || o->dirty_n >= o->dirty_cap)
+    if (v == POLYC__NONE)
+        return;
+    o->v_touch[v] = o->touch_stamp;
+    if (o->v_dirty[v] == o->epoch || o->dirty_n >= o->dirty_cap)
         return;
     o->v_dirty[v] = o->epoch;
     o->angle -= o->acost[v];

@@ -4,6 +4,7 @@
  * leaves the polyline's length unchanged (collinear, in cell units) dropped. */
 #include "internal.h"
 
+#include <math.h>
 #include <string.h>
 
 static const int32_t NB_X[8] = {1, 0, -1, 0, 1, -1, -1, 1}; /* 4-neighbours first */
@@ -43,13 +44,33 @@ static int unvisited_degree(const polyc__grid *g, int32_t ix, int32_t iy)
 /* The next cell of a walk: an unvisited neighbour, 4-neighbours before
  * diagonal ones, and among those the one with the fewest unvisited
  * neighbours of its own (it keeps the walk on the rim of thick contours).
- * From an isolated contour cell (no contour neighbour at all) the walk
- * continues to the nearest isolated unvisited cell within `link` cells: sparse data
- * (far walls, single scans) leave such gaps, which the merge operator would
- * close anyway; dense chains are never bridged here. */
-static int next_cell(const polyc__grid *g, int32_t link, int32_t ix, int32_t iy, int32_t *nx,
-                     int32_t *ny)
+ * From the end of a chain (a contour cell with at most one contour
+ * neighbour) the walk continues to the nearest unvisited chain end within
+ * link_radius: sparse data (far walls, single scans) leave gaps as wide as
+ * the beam spacing there. Cells inside dense chains are never jumped to. */
+typedef struct tracer {
+    const polyc__grid *g;
+    polyc__spacing spacing;
+    double ox, oy;                 /* frame-relative grid origin */
+    int32_t link;                  /* cells: the merge distance */
+    int32_t link_max;              /* cells: the widest gap bridged in sparse data */
+} tracer;
+
+/* Gap to bridge from a chain end: 2.5 beam spacings there, at least the
+ * merge distance, at most link_max. */
+static int32_t link_radius(const tracer *tr, int32_t ix, int32_t iy)
 {
+    const polyc__grid *g = tr->g;
+    float x = (float)(tr->ox + ((double)ix + 0.5) * (double)g->cell_m);
+    float y = (float)(tr->oy + ((double)iy + 0.5) * (double)g->cell_m);
+    float cells = 2.5f * polyc__spacing_at(&tr->spacing, x, y) * g->inv_cell;
+    int32_t r = cells > (float)tr->link_max ? tr->link_max : (int32_t)cells;
+    return r > tr->link ? r : tr->link;
+}
+
+static int next_cell(const tracer *tr, int32_t ix, int32_t iy, int32_t *nx, int32_t *ny)
+{
+    const polyc__grid *g = tr->g;
     for (int pass = 0; pass < 2; pass++) {
         int best = 99;
         for (int k = pass * 4; k < pass * 4 + 4; k++) {
@@ -66,14 +87,15 @@ static int next_cell(const polyc__grid *g, int32_t link, int32_t ix, int32_t iy,
         if (best < 99)
             return 1;
     }
-    if (contour_degree(g, ix, iy) > 0)
-        return 0; /* dense contour: chains end where they end */
+    if (contour_degree(g, ix, iy) > 1)
+        return 0; /* inside a dense contour: no jumps */
+    int32_t link = link_radius(tr, ix, iy);
     int32_t best2 = link * link + 1;
     for (int32_t dy = -link; dy <= link; dy++)
         for (int32_t dx = -link; dx <= link; dx++) {
             int32_t d2 = dx * dx + dy * dy;
             if (d2 >= best2 || d2 <= 2 || !unvisited(g, ix + dx, iy + dy) ||
-                contour_degree(g, ix + dx, iy + dy) > 0)
+                contour_degree(g, ix + dx, iy + dy) > 1)
                 continue;
             best2 = d2;
             *nx = ix + dx;
@@ -137,14 +159,14 @@ typedef struct walk {
     uint32_t n, cap;
 } walk;
 
-static void walk_from(const polyc__grid *g, int32_t link, walk *w, int32_t ix, int32_t iy)
+static void walk_from(const tracer *tr, walk *w, int32_t ix, int32_t iy)
 {
     while (w->n < w->cap) {
         w->xy[2 * w->n] = ix;
         w->xy[2 * w->n + 1] = iy;
         w->n++;
-        set_visited(g, ix, iy);
-        if (!next_cell(g, link, ix, iy, &ix, &iy))
+        set_visited(tr->g, ix, iy);
+        if (!next_cell(tr, ix, iy, &ix, &iy))
             break;
     }
 }
@@ -234,8 +256,15 @@ polyc_status polyc__trace_build(polyc_ctx *ctx)
         memcpy(g->tiles[k].mark, g->tiles[k].contour, sizeof g->tiles[k].mark);
     thin(ctx, w.xy, w.cap); /* the walk buffer is free until the walks start */
 
+    tracer tr;
     float link_f = ctx->cfg.merge_dist_m / g->cell_m;
-    int32_t link = link_f < 1.0f ? 1 : (link_f > 8.0f ? 8 : (int32_t)link_f);
+    tr.g = g;
+    tr.ox = g->origin_x_m - ctx->frame_x;
+    tr.oy = g->origin_y_m - ctx->frame_y;
+    tr.link = link_f < 1.0f ? 1 : (link_f > 8.0f ? 8 : (int32_t)link_f);
+    tr.link_max = (int32_t)fminf(fmaxf(0.5f / g->cell_m, (float)tr.link), 32.0f);
+    if ((st = polyc__spacing_build(ctx, &tr.spacing)) != POLYC_OK)
+        return st;
     /* endpoints first (walking can create new ones: repeat until none), then
      * the rest, which are cycles or knots of them; each walk also goes
      * backwards from its start when cells are left on that side */
@@ -248,12 +277,12 @@ polyc_status polyc__trace_build(polyc_ctx *ctx)
                 if (!unvisited(g, ix, iy) || (phase == 0 && unvisited_degree(g, ix, iy) > 1))
                     continue;
                 w.n = 0;
-                walk_from(g, link, &w, ix, iy);
-                int closed = phase == 1 && w.n >= 4 && adjacent(&w.xy[0], &w.xy[2 * (w.n - 1)], link);
+                walk_from(&tr, &w, ix, iy);
+                int closed = phase == 1 && w.n >= 4 && adjacent(&w.xy[0], &w.xy[2 * (w.n - 1)], tr.link);
                 int32_t nx, ny;
-                if (!closed && next_cell(g, link, ix, iy, &nx, &ny)) {
+                if (!closed && next_cell(&tr, ix, iy, &nx, &ny)) {
                     reverse_cells(w.xy, w.n);
-                    walk_from(g, link, &w, nx, ny);
+                    walk_from(&tr, &w, nx, ny);
                 }
                 if ((st = emit(ctx, &w, closed)) != POLYC_OK)
                     return st;

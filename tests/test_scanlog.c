@@ -285,7 +285,7 @@ static void round_trip(const char *text, size_t len)
     assert_int_equal(parse_len(&b, buf, blen, 0), 0);
     assert_int_equal(b.kind_counts[SCANLOG_PLAIN], a.count);
     assert_same_scans(&a, &b);
-    assert_int_equal(a.bad_ranges, b.bad_ranges);
+    assert_int_equal(a.bad_ranges + a.short_ranges, b.bad_ranges);   /* all NaN now */
     scanlog_free(&a);
     scanlog_free(&b);
     free(buf);
@@ -360,11 +360,18 @@ static void test_bad_ranges_counted(void **state)
 {
     (void)state;
     scanlog log;
-    assert_int_equal(parse(&log, "FLASER 5 nan -0.5 inf 1e999 2 0 0 0 0 0 0 0 h 0\n"), 0);
+    assert_int_equal(parse(&log, "FLASER 7 nan -0.5 inf 1e999 0 0.019 2 0 0 0 0 0 0 0 h 0\n"), 0);
     assert_int_equal(log.bad_ranges, 4);
-    for (int i = 0; i < 4; i++)
+    assert_int_equal(log.short_ranges, 2);      /* error codes below 2 cm */
+    for (int i = 0; i < 6; i++)
         assert_true(isnan(log.scans[0].range_m[i]));
-    near((double)log.scans[0].range_m[4], 2, 0);
+    near((double)log.scans[0].range_m[6], 2, 0);
+    scanlog_free(&log);
+    /* the plain format passes short ranges on: its min range says what they are */
+    assert_int_equal(parse(&log, "SCAN 0 0 0 0 0.1 0.05 4 2 0.01 -1\n"), 0);
+    near((double)log.scans[0].range_m[0], 0.01, 1e-9);
+    assert_true(isnan(log.scans[0].range_m[1]));
+    assert_int_equal(log.short_ranges, 0);
     scanlog_free(&log);
 }
 

@@ -189,7 +189,7 @@ static void svg_points(FILE *f, const mapout_map *map, const view *v)
     unsigned char *seen = calloc((w * h + 7) / 8, 1);
     if (!seen)
         return;
-    fputs("<path id=\"points\" fill=\"#8c8c8c\" d=\"", f);
+    fputs("<path id=\"points\" fill=\"#707070\" fill-opacity=\"0.6\" d=\"", f);
     for (uint32_t i = 0; i < map->scan_count; i++) {
         double x, y;
         for (uint32_t j = 0; j < map->scans[i].beam_count; j++) {

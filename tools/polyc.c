@@ -335,8 +335,9 @@ static void print_input_stats(const scanlog *log)
             (unsigned long long)log->kind_counts[SCANLOG_FLASER],
             (unsigned long long)log->kind_counts[SCANLOG_ROBOTLASER1],
             (unsigned long long)log->kind_counts[SCANLOG_PLAIN]);
-    fprintf(e, "input beams    %llu (bad ranges %llu)\n", (unsigned long long)log->beams,
-            (unsigned long long)log->bad_ranges);
+    fprintf(e, "input beams    %llu (bad ranges %llu, below min range %llu)\n",
+            (unsigned long long)log->beams, (unsigned long long)log->bad_ranges,
+            (unsigned long long)log->short_ranges);
     fprintf(e, "lines skipped  %llu (", (unsigned long long)log->skipped_lines);
     for (uint32_t i = 0; i < log->keyword_count; i++)
         fprintf(e, "%s%s %llu", i ? ", " : "", log->keywords[i].name,
@@ -488,10 +489,15 @@ static int make_map(const options *o, run *r, double t_start, mapout_times *t)
     t->optimize_ms = t5 - t4;
 
     polyc_stats stats;
+    double bic = 0, error_sq_m2 = 0;
+    int scored = (o->no_optimize || cfg.max_iterations == 0) &&   /* the initial polylines */
+                 polyc_score(ctx, &bic, &error_sq_m2) == POLYC_OK;
     if ((st = polyc_get_stats(ctx, &stats)) != POLYC_OK)
         return library_fail("stats", st, ctx, size);
-    if (o->no_optimize || cfg.max_iterations == 0)   /* BIC of the initial polylines */
-        polyc_score(ctx, &stats.bic, &stats.error_sq_m2);
+    if (scored) {
+        stats.bic = bic;
+        stats.error_sq_m2 = error_sq_m2;
+    }
     uint32_t n = polyc_polyline_count(ctx);
     r->lines = calloc(n ? n : 1, sizeof *r->lines);
     if (!r->lines)

@@ -349,9 +349,11 @@ static int grow(reader *r, void **p, size_t *cap, size_t need, size_t elem)
     return 0;
 }
 
-/* Appends n ranges to the pool; bad values (NaN, inf, negative) become NaN,
- * which the library counts as skipped. */
-static int take_ranges(reader *r, fields *fs, uint32_t n)
+/* Appends n ranges to the pool. Bad values (NaN, inf, negative) and values
+ * in [0, short_m) become NaN, which the library counts as skipped: neither
+ * hit nor free space. CARMEN lasers write error codes below their minimum
+ * range (Hokuyo: 0..19 mm); they mean "no reading", not "nothing there". */
+static int take_ranges(reader *r, fields *fs, uint32_t n, float short_m)
 {
     scanlog *log = r->log;
     if (grow(r, (void **)&log->pool, &log->pool_cap, log->pool_len + n, sizeof(float)))
@@ -364,6 +366,9 @@ static int take_ranges(reader *r, fields *fs, uint32_t n)
         if (!isfinite(v) || v < 0 || !isfinite(f)) {
             f = NAN;
             log->bad_ranges++;
+        } else if (f < short_m) {
+            f = NAN;
+            log->short_ranges++;
         }
         log->pool[log->pool_len + i] = f;
     }
@@ -382,6 +387,8 @@ static int push_scan(reader *r, const polyc_scan *s, enum scanlog_kind kind)
         size_t cap = log->cap ? (size_t)log->cap * 2 : 256;
         if (cap > UINT32_MAX)
             cap = UINT32_MAX;
+        if (cap > SIZE_MAX / sizeof *log->scans)   /* 32-bit size_t */
+            return fail(r, "out of memory");
         void *a = realloc(log->scans, cap * sizeof *log->scans);
         if (a)
             log->scans = a;
@@ -428,7 +435,8 @@ static int parse_flaser(reader *r, fields *fs)
     uint32_t n;
     memset(&s, 0, sizeof s);
     if (take_count(r, fs, "beam count", SCANLOG_MAX_BEAMS_SCAN, &n) ||
-        check_tail(r, fs, "FLASER", "beams", n, FLASER_TAIL) || take_ranges(r, fs, n) ||
+        check_tail(r, fs, "FLASER", "beams", n, FLASER_TAIL) ||
+        take_ranges(r, fs, n, SCANLOG_MIN_RANGE_M) ||
         take_pose(r, fs, "pose", &s.pose_x_m, &s.pose_y_m, &s.pose_theta_rad))
         return -1;
     double inc = PI_D / 180.0;                   /* CARMEN: 180/181 beams, 1 deg */
@@ -486,7 +494,7 @@ static int parse_robotlaser1(reader *r, fields *fs)
     if (rest < (uint64_t)n + 1)
         return fail(r, "ROBOTLASER1 with %u beams has only %llu fields after the count",
                     n, (unsigned long long)rest);
-    if (take_ranges(r, fs, n) ||
+    if (take_ranges(r, fs, n, SCANLOG_MIN_RANGE_M) ||
         take_count(r, fs, "remission count", SCANLOG_MAX_BEAMS_SCAN, &m) ||
         check_tail(r, fs, "ROBOTLASER1", "remissions", m, ROBOTLASER1_TAIL))
         return -1;
@@ -520,7 +528,7 @@ static int parse_plain(reader *r, fields *fs)
         take_angle(r, fs, "start angle", &start) || take_angle(r, fs, "angle step", &step) ||
         take_double(r, fs, "min range", &min_r) || take_double(r, fs, "max range", &max_r) ||
         take_count(r, fs, "beam count", SCANLOG_MAX_BEAMS_SCAN, &n) ||
-        check_tail(r, fs, "SCAN", "beams", n, 0) || take_ranges(r, fs, n))
+        check_tail(r, fs, "SCAN", "beams", n, 0) || take_ranges(r, fs, n, 0.0f))
         return -1;
     if (!(step > 0))
         return fail(r, "angle step %g must be > 0", step);

@@ -52,6 +52,7 @@ typedef struct scanlog {
     uint64_t skipped_lines;    /* comments and other line types */
     uint64_t beams;
     uint64_t bad_ranges;       /* NaN, inf, negative: passed on as NaN (skipped) */
+    uint64_t short_ranges;     /* CARMEN ranges below SCANLOG_MIN_RANGE_M: NaN too */
     uint64_t kind_counts[4];   /* scans per enum scanlog_kind */
     scanlog_keyword keywords[SCANLOG_MAX_KEYWORDS];
     uint32_t keyword_count;

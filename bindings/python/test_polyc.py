@@ -1,0 +1,182 @@
+"""test_polyc.py - the Python binding (run by `make test`).
+
+A synthetic room mapped through Python must give the polylines the `polyc`
+tool gives for the same scans written in its plain format (to the tool's 4
+decimals); too small a block, bad configuration and bad scans raise
+PolycError with the library's message; the ctypes structs match the library.
+Environment: POLYC_LIB (libpolyc.so) and POLYC_TOOL (the polyc binary),
+defaulting to the repository's build/.
+"""
+import ctypes
+import json
+import math
+import os
+import random
+import struct
+import subprocess
+import tempfile
+import unittest
+
+import polyc
+
+REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+TOOL = os.environ.get("POLYC_TOOL", os.path.join(REPO, "build", "polyc"))
+
+# A 6 m x 4 m room with a cabinet and a pillar: wall segments (x0, y0, x1, y1).
+WALLS = [(0, 0, 6, 0), (6, 0, 6, 4), (6, 4, 0, 4), (0, 4, 0, 0),
+         (4.0, 2.8, 5.0, 2.8), (5.0, 2.8, 5.0, 3.4), (5.0, 3.4, 4.0, 3.4), (4.0, 3.4, 4.0, 2.8),
+         (2.0, 1.0, 2.3, 1.0), (2.3, 1.0, 2.3, 1.3), (2.3, 1.3, 2.0, 1.3), (2.0, 1.3, 2.0, 1.0)]
+POSES = [(1.0, 2.0, 0.0), (3.0, 2.2, 0.4), (4.8, 1.5, 2.5), (2.5, 3.0, -2.0)]
+
+
+def f32(v):
+    """v rounded to float32, as the library stores it."""
+    return struct.unpack("f", struct.pack("f", v))[0]
+
+
+def cast(x, y, a, max_range):
+    dx, dy = math.cos(a), math.sin(a)
+    best = max_range
+    for ax, ay, bx, by in WALLS:
+        ex, ey = bx - ax, by - ay
+        den = dx * ey - dy * ex
+        if abs(den) < 1e-12:
+            continue
+        t = ((ax - x) * ey - (ay - y) * ex) / den
+        u = ((ax - x) * dy - (ay - y) * dx) / den
+        if 0 < t < best and 0 <= u <= 1:
+            best = t
+    return best
+
+
+def scene(beams=181, seed=5):
+    """Scans of the room: 181 beams over 180 degrees, 1 cm noise, float32 values."""
+    rng = random.Random(seed)
+    start, step = f32(-math.pi / 2), f32(math.pi / (beams - 1))
+    scans = []
+    for x, y, th in POSES:
+        ranges = [f32(cast(x, y, th + start + i * step, 30.0) + rng.gauss(0, 0.01))
+                  for i in range(beams)]
+        scans.append(polyc.Scan((x, y, th), start, step, f32(0.02), f32(30.0), ranges))
+    return scans
+
+
+def write_plain(path, scans):
+    """polyc's plain format (docs/formats.md); repr() round-trips every value."""
+    with open(path, "w") as f:
+        f.write("# polyc-scans 1\n")
+        for s in scans:
+            fields = list(s.pose) + [s.start_angle_rad, s.angle_step_rad, s.min_range_m,
+                                     s.max_range_m]
+            f.write("SCAN %s %d %s\n" % (" ".join(repr(float(v)) for v in fields),
+                                         len(s.ranges_m),
+                                         " ".join(repr(float(r)) for r in s.ranges_m)))
+
+
+class Binding(unittest.TestCase):
+    def test_struct_sizes(self):
+        for name, cls in polyc._STRUCTS.items():
+            self.assertEqual(polyc._lib.polyc_struct_size(name.encode()), ctypes.sizeof(cls), name)
+        self.assertEqual(polyc._lib.polyc_struct_size(b"no_such_struct"), 0)
+
+    def test_defaults_in_field_order(self):
+        c = polyc.default_config()   # a field out of order would show a wrong value here
+        self.assertAlmostEqual(c["cell_m"], 0.025, places=6)
+        self.assertEqual(c["contour_threshold"], 0.5)
+        self.assertEqual(c["alpha"], 500.0)
+        self.assertAlmostEqual(c["merge_dist_m"], 0.15, places=6)
+        self.assertAlmostEqual(c["split_gap_m"], 0.20, places=6)
+        self.assertAlmostEqual(c["step_m"], 0.01, places=6)
+        self.assertEqual((c["patience"], c["max_iterations"], c["flags"], c["seed"]), (5, 100, 0, 1))
+        self.assertEqual(polyc.version()[0] * 10000 + polyc.version()[1] * 100 + polyc.version()[2],
+                         polyc._lib.polyc_version())
+
+    def test_same_map_as_the_tool(self):
+        scans = scene()
+        result = polyc.build_map(scans, cell_m=0.05)
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "room.scans")
+            write_plain(path, scans)
+            out = subprocess.run([TOOL, "--format", "json", "--cell", "0.05", path],
+                                 capture_output=True, text=True, check=True).stdout
+        tool = json.loads(out)
+        self.assertGreater(len(result.polylines), 0)
+        self.assertEqual(len(result.polylines), len(tool["polylines"]))
+        for mine, theirs in zip(result.polylines, tool["polylines"]):
+            self.assertEqual(mine.closed, theirs["closed"])
+            self.assertEqual([(float("%.4f" % x), float("%.4f" % y)) for x, y in mine.points],
+                             [tuple(p) for p in theirs["points"]])
+        for key in ("scans", "beams", "hits", "data_points", "polylines", "vertices",
+                    "iterations", "memory_size_bytes"):
+            self.assertEqual(result.stats[key], tool["stats"][key], key)
+        self.assertEqual(float("%.6f" % result.stats["bic"]), tool["stats"]["bic"])
+
+    def test_too_small_block(self):
+        scans = scene()
+        with self.assertRaises(polyc.PolycError) as e:
+            polyc.build_map(scans, memory_bytes=100000, cell_m=0.05)
+        self.assertEqual(e.exception.status, polyc.ERR_NOMEM)
+        self.assertEqual(e.exception.name, "POLYC_ERR_NOMEM")
+        self.assertIn("memory block too small", str(e.exception))
+        self.assertIn("100000 bytes given", str(e.exception))
+
+    def test_config_errors(self):
+        scans = scene()
+        with self.assertRaises(polyc.PolycError) as e:
+            polyc.build_map(scans, cell_m=-1.0)
+        self.assertEqual(e.exception.status, polyc.ERR_CONFIG)
+        self.assertIn("cell_m must be", str(e.exception))
+        with self.assertRaises(polyc.PolycError) as e:
+            polyc.build_map(scans, noise_decay=0.0)
+        self.assertIn("noise_decay", e.exception.detail)
+        with self.assertRaises(TypeError):
+            polyc.build_map(scans, no_such_field=1)
+        with self.assertRaises(TypeError):
+            polyc.build_map(scans, reserved=1)
+
+    def test_bad_scan(self):
+        ctx = polyc.Context((2, 10, 4096, 0))
+        with self.assertRaises(polyc.PolycError) as e:
+            ctx.add_scan((float("nan"), 0.0, 0.0), -1.5, 0.1, 0.02, 10.0, [1.0] * 10)
+        self.assertEqual(e.exception.status, polyc.ERR_SCAN)
+        self.assertIn("scan pose is not finite", str(e.exception))
+        ctx.add_scan((0.0, 0.0, 0.0), -1.5, 0.1, 0.02, 10.0, [1.0] * 10)
+        with self.assertRaises(polyc.PolycError) as e:   # more beams than the limits allow
+            ctx.add_scan((0.0, 0.0, 0.0), -1.5, 0.1, 0.02, 10.0, [1.0] * 10)
+        self.assertEqual(e.exception.status, polyc.ERR_LIMIT)
+
+    def test_stages_and_progress(self):
+        scans = scene()
+        whole = polyc.build_map(scans, cell_m=0.05)
+        ctx = polyc.Context((whole.stats["scans"], whole.stats["beams"],
+                             polyc_grid_cells(scans, 0.05), 0), cell_m=0.05)
+        with self.assertRaises(polyc.PolycError) as e:
+            ctx.score()
+        self.assertEqual(e.exception.status, polyc.ERR_STATE)
+        for s in scans:
+            ctx.add_scan(*s)
+        ctx.trace()
+        initial = ctx.polylines()
+        self.assertEqual(len(initial), whole.stats["initial_polylines"])
+        seen = []
+        ctx.optimize(progress=lambda it: seen.append(it["iteration"]) and False)
+        self.assertEqual(ctx.polylines(), whole.polylines)
+        self.assertEqual(len(seen), whole.stats["iterations"])    # one call per iteration
+        self.assertEqual(seen, list(range(seen[0], seen[0] + len(seen))))
+        with self.assertRaises(polyc.PolycError) as e:   # stop at the first iteration
+            ctx.optimize(progress=lambda it: True)
+        self.assertEqual(e.exception.status, polyc.ERR_STOPPED)
+
+
+def polyc_grid_cells(scans, cell_m):
+    """max_grid_cells as polyc_limits_for_scans computes it."""
+    cfg = polyc._config({"cell_m": cell_m})
+    held = [polyc._scan(s) for s in scans]
+    arr = (polyc._Scan * len(held))(*[s for s, _ in held])
+    lim = polyc._Limits()
+    polyc._lib.polyc_limits_for_scans(ctypes.byref(cfg), arr, len(held), ctypes.byref(lim))
+    return lim.max_grid_cells
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)

@@ -1,0 +1,81 @@
+/* spacing.c - the expected distance between neighbouring scan endpoints.
+ * Takes: the scan poses and the grid's tile layout. Gives: per tile, the
+ * distance to the nearest pose (a chamfer distance transform) and from it
+ * the beam spacing there (distance x smallest angle step): the scale below
+ * which a gap between points is just sampling, not a gap in the wall. */
+#include "internal.h"
+
+#include <math.h>
+
+size_t polyc__spacing_bytes(const polyc_limits *lim)
+{
+    size_t tiles = ((size_t)lim->max_grid_cells + POLYC__TILE_CELLS - 1) / POLYC__TILE_CELLS;
+    return polyc__bytes(tiles * 4 + 64, sizeof(float));
+}
+
+polyc_status polyc__spacing_build(polyc_ctx *ctx, polyc__spacing *sp)
+{
+    const polyc__grid *g = &ctx->grid;
+    sp->w = g->tiles_x;
+    sp->h = g->tiles_y;
+    sp->tile_m = g->cell_m * (float)POLYC__TILE_SIDE;
+    sp->origin_x = (float)(g->origin_x_m - ctx->frame_x);
+    sp->origin_y = (float)(g->origin_y_m - ctx->frame_y);
+    sp->min_step_rad = 0.0f;
+    sp->dist = NULL;
+    size_t n = (size_t)sp->w * (size_t)sp->h;
+    if (n == 0)
+        return POLYC_OK;
+    sp->dist = polyc__alloc(&ctx->arena, n, sizeof(float));
+    if (!sp->dist)
+        return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the spacing field");
+    float step = 1e30f;
+    for (size_t i = 0; i < n; i++)
+        sp->dist[i] = 1e30f;
+    for (uint32_t k = 0; k < ctx->scan_count; k++) {
+        const polyc__scan *s = &ctx->scans[k];
+        if (s->count > 1 && fabsf(s->step_rad) < step)
+            step = fabsf(s->step_rad);
+        int32_t tx = (int32_t)floorf((s->x_m - sp->origin_x) / sp->tile_m);
+        int32_t ty = (int32_t)floorf((s->y_m - sp->origin_y) / sp->tile_m);
+        if (tx >= 0 && ty >= 0 && tx < sp->w && ty < sp->h)
+            sp->dist[(size_t)ty * (size_t)sp->w + (size_t)tx] = 0.0f;
+    }
+    sp->min_step_rad = step < 1e29f ? step : 0.0f;
+    /* two chamfer passes, weights 1 and sqrt 2 tiles */
+    const float a = sp->tile_m, b = sp->tile_m * 1.41421356f;
+    for (int32_t y = 0; y < sp->h; y++)
+        for (int32_t x = 0; x < sp->w; x++) {
+            float *d = &sp->dist[(size_t)y * (size_t)sp->w + (size_t)x];
+            if (x > 0) *d = fminf(*d, d[-1] + a);
+            if (y > 0) {
+                const float *up = d - sp->w;
+                *d = fminf(*d, up[0] + a);
+                if (x > 0) *d = fminf(*d, up[-1] + b);
+                if (x + 1 < sp->w) *d = fminf(*d, up[1] + b);
+            }
+        }
+    for (int32_t y = sp->h - 1; y >= 0; y--)
+        for (int32_t x = sp->w - 1; x >= 0; x--) {
+            float *d = &sp->dist[(size_t)y * (size_t)sp->w + (size_t)x];
+            if (x + 1 < sp->w) *d = fminf(*d, d[1] + a);
+            if (y + 1 < sp->h) {
+                const float *dn = d + sp->w;
+                *d = fminf(*d, dn[0] + a);
+                if (x + 1 < sp->w) *d = fminf(*d, dn[1] + b);
+                if (x > 0) *d = fminf(*d, dn[-1] + b);
+            }
+        }
+    return POLYC_OK;
+}
+
+float polyc__spacing_at(const polyc__spacing *sp, float x, float y)
+{
+    if (!sp->dist)
+        return 0.0f;
+    int32_t tx = (int32_t)floorf((x - sp->origin_x) / sp->tile_m);
+    int32_t ty = (int32_t)floorf((y - sp->origin_y) / sp->tile_m);
+    tx = tx < 0 ? 0 : (tx >= sp->w ? sp->w - 1 : tx);
+    ty = ty < 0 ? 0 : (ty >= sp->h ? sp->h - 1 : ty);
+    return sp->dist[(size_t)ty * (size_t)sp->w + (size_t)tx] * sp->min_step_rad;
+}
