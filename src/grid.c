@@ -58,10 +58,17 @@ static int range_is_hit(const polyc__scan *s, float r)
     return r >= s->min_m && r < s->max_m;
 }
 
+/* cos and sin of a scan's angular step, for incidence_sin */
+typedef struct step_rot {
+    float cs, sn;
+} step_rot;
+
 /* sin of the incidence angle of beam i on the surface it hit, from the two
  * neighbouring endpoints when the three are nearly collinear (a surface);
- * 1 when unknown. No trigonometry: done in the beam's own frame. */
-static float incidence_sin(const polyc_ctx *ctx, const polyc__scan *s, uint32_t i, float r)
+ * 1 when unknown. Done in the beam's own frame: the only trigonometry is
+ * the scan's step, given by `rot` or computed when rot is NULL. */
+static float incidence_sin(const polyc_ctx *ctx, const polyc__scan *s, uint32_t i, float r,
+                           const step_rot *rot)
 {
     if (i == 0 || i + 1 >= s->count)
         return 1.0f;
@@ -69,7 +76,13 @@ static float incidence_sin(const polyc_ctx *ctx, const polyc__scan *s, uint32_t 
     float rm = rr[i - 1], rp = rr[i + 1];
     if (!range_is_hit(s, rm) || !range_is_hit(s, rp))
         return 1.0f;
-    float cs = cosf(s->step_rad), sn = sinf(s->step_rad);
+    step_rot own;
+    if (!rot) {
+        own.cs = cosf(s->step_rad);
+        own.sn = sinf(s->step_rad);
+        rot = &own;
+    }
+    float cs = rot->cs, sn = rot->sn;
     float ax = rm * cs, ay = -rm * sn; /* neighbour before */
     float cx = rp * cs, cy = rp * sn;  /* neighbour after */
     float tx = cx - ax, ty = cy - ay;
@@ -83,7 +96,10 @@ static float incidence_sin(const polyc_ctx *ctx, const polyc__scan *s, uint32_t 
     return fabsf(ty) / len;
 }
 
-int polyc__beam_get(const polyc_ctx *ctx, const polyc__scan *s, uint32_t i, polyc__beam *b)
+/* Beam i of scan s in grid coordinates; miss_end only when want_miss_end
+ * (else 1). Returns 0 for a beam that is skipped. */
+static int beam_fill(const polyc_ctx *ctx, const polyc__scan *s, uint32_t i, polyc__beam *b,
+                     int want_miss_end, const step_rot *rot)
 {
     const polyc__grid *g = &ctx->grid;
     float r = ctx->ranges[s->first + i];
@@ -116,15 +132,26 @@ int polyc__beam_get(const polyc_ctx *ctx, const polyc__scan *s, uint32_t i, poly
     b->ex = b->sx + dx * len;
     b->ey = b->sy + dy * len;
     b->miss_end = 1.0f;
-    if (b->hit && ctx->cfg.grazing_cells > 0.0f && !(ctx->cfg.flags & POLYC_FLAG_NO_GRAZING)) {
+    if (want_miss_end && b->hit && ctx->cfg.grazing_cells > 0.0f &&
+        !(ctx->cfg.flags & POLYC_FLAG_NO_GRAZING)) {
         /* The last cell / sin(incidence) of a beam runs within a cell of the
          * surface it hits: a grazing beam would count misses in the wall's
          * own cells there. Misses stop before that stretch. */
-        float sn = fmaxf(incidence_sin(ctx, s, i, r), 0.05f);
+        float sn = fmaxf(incidence_sin(ctx, s, i, r, rot), 0.05f);
         float skip = fminf(ctx->cfg.grazing_cells / sn, 0.5f * len);
         b->miss_end = len > 0.0f ? 1.0f - skip / len : 0.0f;
     }
     return 1;
+}
+
+int polyc__beam_get(const polyc_ctx *ctx, const polyc__scan *s, uint32_t i, polyc__beam *b)
+{
+    return beam_fill(ctx, s, i, b, 1, NULL);
+}
+
+int polyc__beam_path(const polyc_ctx *ctx, const polyc__scan *s, uint32_t i, polyc__beam *b)
+{
+    return beam_fill(ctx, s, i, b, 0, NULL);
 }
 
 /* Exact traversal of the cells from (sx, sy) to (ex, ey); `visit` gets each
@@ -234,9 +261,10 @@ polyc_status polyc__grid_build(polyc_ctx *ctx)
 
     for (uint32_t si = 0; si < ctx->scan_count; si++) {
         const polyc__scan *s = &ctx->scans[si];
+        step_rot rot = {cosf(s->step_rad), sinf(s->step_rad)};
         for (uint32_t i = 0; i < s->count; i++) {
             polyc__beam b;
-            if (!polyc__beam_get(ctx, s, i, &b))
+            if (!beam_fill(ctx, s, i, &b, 1, &rot))
                 continue;
             count_beam(g, &ctx->arena, &b);
             if (g->out_of_tiles)

@@ -56,7 +56,7 @@ typedef struct polyc__tile {
     polyc__count hits[POLYC__TILE_CELLS];
     polyc__count misses[POLYC__TILE_CELLS];
     uint32_t contour[POLYC__TILE_SIDE]; /* bit per cell: labelled contour */
-    uint32_t mark[POLYC__TILE_SIDE];    /* bit per cell: scratch (tracing, data cells) */
+    uint32_t mark[POLYC__TILE_SIDE];    /* bit per cell: scratch (contour, tracing, data cells) */
     uint32_t mark_base;                 /* index of this tile's first marked cell */
     uint16_t mark_row[POLYC__TILE_SIDE];/* marked cells in earlier rows of the tile */
     uint32_t pad[3];                    /* size a multiple of 16 (contiguous tiles) */
@@ -237,6 +237,8 @@ typedef struct polyc__beam {
     float miss_end;                /* misses stop at this fraction of the beam */
 } polyc__beam;
 int polyc__beam_get(const polyc_ctx *ctx, const polyc__scan *s, uint32_t i, polyc__beam *b);
+/* the same without miss_end (left at 1): for passes that only follow the path */
+int polyc__beam_path(const polyc_ctx *ctx, const polyc__scan *s, uint32_t i, polyc__beam *b);
 /* Exact traversal (Amanatides-Woo) of the cells from the sensor to the end;
  * visit gets each cell with the beam parameter at which the beam enters it
  * and `last` set for the end cell; a non-zero return stops the walk. */

@@ -47,7 +47,7 @@ static polyc__heap_entry heap_pop(polyc__opt *o)
 }
 
 /* Change of the BIC if v is removed (see polyc__op_remove for the cases). */
-static double removal_delta(polyc__opt *o, int32_t v)
+double polyc__removal_delta(polyc__opt *o, int32_t v)
 {
     const polyc__store *s = o->s;
     const polyc__vertex *V = s->v;
@@ -101,7 +101,7 @@ int polyc__op_remove_vertices(polyc__opt *o)
     for (int32_t v = 0; v < s->v_high; v++) {
         if (s->v[v].line == POLYC__NONE)
             continue;
-        double d = removal_delta(o, v);
+        double d = polyc__removal_delta(o, v);
         if (d < 0.0)
             heap_push(o, d, v);
     }
@@ -110,7 +110,7 @@ int polyc__op_remove_vertices(polyc__opt *o)
         polyc__heap_entry e = heap_pop(o);
         if (s->v[e.v].line == POLYC__NONE)
             continue;
-        double d = removal_delta(o, e.v);
+        double d = polyc__removal_delta(o, e.v);
         if (d >= 0.0)
             continue;
         if (o->heap_n > 0 && d > o->heap[0].delta + 1e-9) {
@@ -127,7 +127,7 @@ int polyc__op_remove_vertices(polyc__opt *o)
         for (int k = 0; k < 2; k++) {
             if (nb[k] == POLYC__NONE || s->v[nb[k]].line == POLYC__NONE)
                 continue;
-            double dn = removal_delta(o, nb[k]);
+            double dn = polyc__removal_delta(o, nb[k]);
             if (dn < 0.0)
                 heap_push(o, dn, nb[k]);
         }

@@ -417,10 +417,69 @@ int polyc__op_split(polyc__opt *o)
     return n_cut;
 }
 
+/* ---- end trimming (part of C) ---- */
+
+/* Nothing in the BIC holds an open end where the data stop: points beyond
+ * it cost the same wherever it is. Each open end is pulled back to the
+ * farthest projection of the points of its segment, plus half a beam
+ * spacing (at least 1 cm). */
+int polyc__op_trim_ends(polyc__opt *o)
+{
+    polyc__store *s = o->s;
+    int32_t nv = s->v_high;
+    /* per end segment: farthest projection (metres from the inner vertex) */
+    for (int32_t v = 0; v < nv; v++)
+        o->split_t[v] = o->trim_head[v] = -1.0f;
+    for (int32_t i = 0; i < o->np; i++) {
+        int32_t sg = o->pt_seg[i];
+        if (sg == POLYC__NONE)
+            continue;
+        const polyc__vertex *a = &s->v[sg], *b = &s->v[a->next];
+        int head_end = a->prev == POLYC__NONE, tail_end = b->next == POLYC__NONE;
+        if (!head_end && !tail_end)
+            continue;
+        float dx = b->x - a->x, dy = b->y - a->y, len = sqrtf(dx * dx + dy * dy);
+        if (len <= 0.0f)
+            continue;
+        float u = ((o->pts[i].x - a->x) * dx + (o->pts[i].y - a->y) * dy) / len;
+        /* store as fraction from the tail side and from the head side */
+        if (tail_end && u / len > o->split_t[sg])
+            o->split_t[sg] = u / len;
+        if (head_end && (1.0f - u / len) > o->trim_head[sg])
+            o->trim_head[sg] = 1.0f - u / len;
+    }
+    int changed = 0;
+    for (int32_t v = 0; v < nv; v++) {
+        const polyc__vertex *a = &s->v[v];
+        if (a->line == POLYC__NONE || a->next == POLYC__NONE)
+            continue;
+        int32_t w = a->next;
+        float ax = a->x, ay = a->y, bx = s->v[w].x, by = s->v[w].y;
+        float len = sqrtf((bx - ax) * (bx - ax) + (by - ay) * (by - ay));
+        /* a margin of half a beam spacing keeps the last point's own beam on the map */
+        float margin = fmaxf(0.01f, 0.5f * polyc__spacing_at(&o->spacing, bx, by)) / len;
+        float keep_tail = o->split_t[v] + margin, keep_head = o->trim_head[v] + margin;
+        if (s->v[w].next == POLYC__NONE && o->split_t[v] >= 0.0f && keep_tail < 1.0f) {
+            polyc__chg_begin(o);
+            polyc__op_move(o, w, ax + keep_tail * (bx - ax), ay + keep_tail * (by - ay));
+            polyc__chg_commit(o);
+            changed++;
+        }
+        if (a->prev == POLYC__NONE && o->trim_head[v] >= 0.0f && keep_head < 1.0f) {
+            polyc__chg_begin(o);
+            polyc__op_move(o, v, bx + keep_head * (ax - bx), by + keep_head * (ay - by));
+            polyc__chg_commit(o);
+            changed++;
+        }
+    }
+    return changed;
+}
+
 /* ---- E: zigzags ---- */
 
 /* A vertex where the polyline folds back on itself (turn above 150 degrees)
- * is a zigzag left by vertex moves: it goes. */
+ * is a zigzag left by vertex moves: it goes, unless that raises the BIC (a
+ * fold can be real: removing every fold unconditionally lost whole walls). */
 int polyc__op_zigzag(polyc__opt *o)
 {
     polyc__store *s = o->s;
@@ -434,6 +493,8 @@ int polyc__op_zigzag(polyc__opt *o)
         float lu = sqrtf(ux * ux + uy * uy), lw = sqrtf(wx * wx + wy * wy);
         /* (a zero-length segment counts: its vertex is a duplicate) */
         if (lu * lw > 0.0f && (ux * wx + uy * wy) > -0.866f * lu * lw)
+            continue;
+        if (polyc__removal_delta(o, v) > 0.0)
             continue;
         polyc__chg_begin(o);
         polyc__op_remove(o, v);

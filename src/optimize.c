@@ -25,7 +25,8 @@ size_t polyc__optimizer_bytes(const polyc_config *cfg, const polyc_limits *lim)
     n = polyc__add(n, polyc__bytes(P, sizeof(double)));           /* pt_cost */
     n = polyc__add(n, polyc__bytes(P, sizeof(int32_t)));          /* loc_pt */
     n = polyc__add(n, polyc__bytes(P, sizeof(double)));           /* loc_base */
-    n = polyc__add(n, polyc__bytes(P, sizeof(float)));            /* split_t */
+    n = polyc__add(n, polyc__bytes(P + V, sizeof(float)));        /* split_t */
+    n = polyc__add(n, polyc__bytes(V, sizeof(float)));            /* trim_head */
     n = polyc__add(n, polyc__bytes(V + 1, sizeof(int32_t)));      /* split_off */
     n = polyc__add(n, polyc__bytes(V, 4 * sizeof(float) + 2 * sizeof(int32_t))); /* cuts */
     n = polyc__add(n, polyc__bytes(V, 4 * sizeof(double)));       /* acost, seg stats */
@@ -67,7 +68,8 @@ static polyc_status setup(polyc_ctx *ctx, polyc__opt *o)
     ALLOC(o->pt_cost, P);
     ALLOC(o->loc_pt, P);
     ALLOC(o->loc_base, P);
-    ALLOC(o->split_t, P);
+    ALLOC(o->split_t, P > V ? P : V);
+    ALLOC(o->trim_head, V);
     ALLOC(o->split_off, V + 1);
     ALLOC(o->cut_seg, V);
     ALLOC(o->cut_next, V);
@@ -140,13 +142,15 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
         polyc__op_remove_vertices(&o);   /* G: fewer vertices first, so that */
         polyc__op_adjust(&o, ADJUST_ROUNDS, 0); /* D moves what is left */
         polyc__op_zigzag(&o);            /* E */
+        polyc__op_corners(&o);           /* corners (not in the paper) */
         polyc__op_remove_vertices(&o);   /* G */
         polyc__op_add_vertices(&o, ADD_ROUNDS); /* G, more vertices */
         polyc__op_adjust(&o, ADJUST_ROUNDS, 1);
         /* moves and additions can leave segments without data or hairpins:
          * clean them before the model is judged, so the best one is clean */
-        if (polyc__op_split(&o) + polyc__op_zigzag(&o) > 0)
+        if (polyc__op_split(&o) + polyc__op_zigzag(&o) + polyc__op_corners(&o) > 0)
             polyc__op_adjust(&o, ADJUST_ROUNDS, 1);
+        polyc__op_trim_ends(&o); /* last: moves could push ends past the data */
         if (o.h.out_of_entries)
             return polyc__fail(ctx, POLYC_ERR_NOMEM, "spatial hash full");
         double bic = polyc__bic(&o);

@@ -56,6 +56,7 @@ typedef struct polyc__opt {
     float *split_t;
     int32_t *cut_seg, *cut_next, cut_cap;
     float *cut_t0, *cut_t1;
+    float *trim_head;              /* end trimming: farthest point from the head side */
 
     /* model size scratch: per segment sums, farthest point; removal heap */
     double *seg_sum, *seg_w, *seg_far_d;
@@ -123,8 +124,11 @@ int polyc__op_merge(polyc__opt *o);
 int polyc__op_split(polyc__opt *o);
 int polyc__op_adjust(polyc__opt *o, int max_rounds, int touched_only);
 int polyc__op_zigzag(polyc__opt *o);
+int polyc__op_corners(polyc__opt *o);
+int polyc__op_trim_ends(polyc__opt *o);
 void polyc__op_noise(polyc__opt *o, double sigma_m);
 int polyc__op_remove_vertices(polyc__opt *o);
+double polyc__removal_delta(polyc__opt *o, int32_t v);
 int polyc__op_add_vertices(polyc__opt *o, int max_tries);
 int polyc__hill_climb(polyc__opt *o, int32_t v);
 double polyc__turn_cost(const polyc__opt *o, float ax, float ay, float bx, float by, float cx,

@@ -1,7 +1,7 @@
 /* points.c - the data points d_i of the BIC (paper eq. 2).
  * Takes: the grid and the scans. Gives: the reflected endpoints that fall in
  * a cell the grid does not judge free (m >= data_min_m), as one weighted point
- * per grid cell (count, mean, second moments: squared distances to a line
+ * per block of 2 x 2 grid cells (count, mean, second moments: squared distances to a line
  * stay exact) or, with POLYC_FLAG_EXACT_POINTS, one point per endpoint;
  * sorted by spatial-hash bucket. */
 #include "optimize.h"
@@ -40,6 +40,29 @@ static float cell_centre(double origin, int32_t i, float cell)
     return (float)(origin + ((double)i + 0.5) * (double)cell);
 }
 
+/* Weighted points gather the endpoints of a block of 2 x 2 grid cells (5 cm
+ * at the default grid): a quarter of the points to score, while the moments
+ * keep each block's squared distances exact (measured in docs/performance.md). */
+#define BLOCK_SHIFT 1
+#define BLOCK_SIDE (1 << BLOCK_SHIFT)
+
+/* The block of an endpoint (its lower-left cell) and the offset from the
+ * block's centre. */
+static void to_block(const endpoint *e, float cell, int32_t *bx, int32_t *by, float *fx, float *fy)
+{
+    const int32_t mask = ~(int32_t)(BLOCK_SIDE - 1);
+    const float half = 0.5f * (float)(BLOCK_SIDE - 1);
+    *bx = e->ix & mask;
+    *by = e->iy & mask;
+    *fx = e->fx + ((float)(e->ix - *bx) - half) * cell;
+    *fy = e->fy + ((float)(e->iy - *by) - half) * cell;
+}
+
+static float block_centre(double origin, int32_t i, float cell)
+{
+    return (float)(origin + ((double)i + 0.5 * BLOCK_SIDE) * (double)cell);
+}
+
 /* One weighted point per marked cell: mark cells, number them, accumulate. */
 static polyc_status collect_cells(polyc__opt *o, polyc__point *tmp, int32_t cap, int32_t *n_out)
 {
@@ -50,8 +73,12 @@ static polyc_status collect_cells(polyc__opt *o, polyc__point *tmp, int32_t cap,
     endpoint e;
     for (uint32_t si = 0; si < ctx->scan_count; si++)
         for (uint32_t i = 0; i < ctx->scans[si].count; i++)
-            if (endpoint_of(ctx, &ctx->scans[si], i, &e))
-                polyc__grid_tile(g, e.ix, e.iy)->mark[e.iy & 31] |= 1u << (e.ix & 31);
+            if (endpoint_of(ctx, &ctx->scans[si], i, &e)) {
+                int32_t bx, by;
+                float fx, fy;
+                to_block(&e, g->cell_m, &bx, &by, &fx, &fy);
+                polyc__grid_tile(g, e.ix, e.iy)->mark[by & 31] |= 1u << (bx & 31);
+            }
     uint32_t n = 0;
     for (uint32_t k = 0; k < g->tile_count; k++) {
         polyc__tile *t = &g->tiles[k];
@@ -74,22 +101,25 @@ static polyc_status collect_cells(polyc__opt *o, polyc__point *tmp, int32_t cap,
         for (uint32_t i = 0; i < ctx->scans[si].count; i++) {
             if (!endpoint_of(ctx, &ctx->scans[si], i, &e))
                 continue;
-            const polyc__tile *t = polyc__grid_tile(g, e.ix, e.iy);
-            uint32_t row = t->mark[e.iy & 31], col = (uint32_t)(e.ix & 31);
+            int32_t bx, by;
+            float fx, fy;
+            to_block(&e, g->cell_m, &bx, &by, &fx, &fy);
+            const polyc__tile *t = polyc__grid_tile(g, e.ix, e.iy); /* the block's tile too */
+            uint32_t row = t->mark[by & 31], col = (uint32_t)(bx & 31);
             uint32_t below = row & ((1u << col) - 1u);
             uint32_t c = 0;
             while (below) {
                 below &= below - 1;
                 c++;
             }
-            polyc__point *p = &tmp[t->mark_base + t->mark_row[e.iy & 31] + c];
-            /* sums of offsets from the cell centre: small numbers, float is exact enough */
+            polyc__point *p = &tmp[t->mark_base + t->mark_row[by & 31] + c];
+            /* sums of offsets from the block centre: small numbers, float is exact enough */
             p->w += 1.0f;
-            p->x += e.fx;
-            p->y += e.fy;
-            p->cxx += e.fx * e.fx;
-            p->cxy += e.fx * e.fy;
-            p->cyy += e.fy * e.fy;
+            p->x += fx;
+            p->y += fy;
+            p->cxx += fx * fx;
+            p->cxy += fx * fy;
+            p->cyy += fy * fy;
         }
     /* means and central moments; the cell of each point is found again by
      * walking the directory in the numbering order of the marks */
@@ -112,8 +142,8 @@ static polyc_status collect_cells(polyc__opt *o, polyc__point *tmp, int32_t cap,
                 p->cyy -= p->w * my * my;
                 if (p->cxx < 0.0f) p->cxx = 0.0f;
                 if (p->cyy < 0.0f) p->cyy = 0.0f;
-                p->x = cell_centre(ox, tx + c, g->cell_m) + mx;
-                p->y = cell_centre(oy, ty + r, g->cell_m) + my;
+                p->x = block_centre(ox, tx + c, g->cell_m) + mx;
+                p->y = block_centre(oy, ty + r, g->cell_m) + my;
             }
     }
     *n_out = (int32_t)n;

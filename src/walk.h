@@ -38,6 +38,10 @@ static inline void polyc__walk_start(polyc__walk *w, const polyc__beam *b)
     /* the step count is fixed in advance, so the walk always ends */
     w->n = (w->ex > w->ix ? w->ex - w->ix : w->ix - w->ex) + (w->ey > w->iy ? w->ey - w->iy : w->iy - w->ey);
     w->t = 0.0f;
+    /* set by polyc__walk_enter; until then steps count down from far away
+     * (polyc__traverse never calls it: no use of indeterminate values) */
+    w->idx = 0;
+    w->left_x = w->left_y = INT32_MAX;
 }
 
 /* To the next cell. Returns 1 when it left the tile (or the grid): then

@@ -252,8 +252,8 @@ class Context:
             raise PolycError(ERR_CONFIG, "memory size", "the limits are too large for size_t")
         size = need if memory_bytes is None else int(memory_bytes)
         if size < need:
-            raise PolycError(ERR_NOMEM, "init", "memory block too small: %d bytes given, "
-                             "polyc_memory_size says %d are needed" % (size, need))
+            raise PolycError(ERR_NOMEM, "init", "%d bytes given, polyc_memory_size says %d "
+                             "are needed" % (size, need))
         self.memory_size = need
         self._block = ctypes.create_string_buffer(size)
         self._ctx = ctypes.c_void_p()
