@@ -55,6 +55,58 @@ static int segs_at(const polyc__opt *o, int32_t v, float x, float y, float *xy)
     return n;
 }
 
+/* Commits the move of v to (x, y) found by hill_climb from its local
+ * evaluation: every point whose cost can change is in the prepared list
+ * (those on v's segments are never pruned), so nothing is rescored twice. */
+static void commit_move(polyc__opt *o, int32_t v, float x, float y)
+{
+    polyc__vertex *V = o->s->v;
+    int32_t p = V[v].prev, n = V[v].next;
+    int32_t nb[3] = {p, v, n};
+    for (int k = 0; k < 3; k++)
+        if (nb[k] != POLYC__NONE) {
+            o->angle -= o->acost[nb[k]];
+            o->v_touch[nb[k]] = o->touch_stamp;
+        }
+    if (p != POLYC__NONE)
+        polyc__hash_remove(o, p);
+    if (n != POLYC__NONE)
+        polyc__hash_remove(o, v);
+    V[v].x = x;
+    V[v].y = y;
+    int ok = 1;
+    if (p != POLYC__NONE)
+        ok &= polyc__hash_insert(o, p);
+    if (n != POLYC__NONE)
+        ok &= polyc__hash_insert(o, v);
+    (void)ok; /* a full hash is reported by the search loop */
+    float xy[8];
+    int32_t id[2];
+    int ns = segs_at(o, v, x, y, xy);
+    id[0] = p != POLYC__NONE ? p : v;
+    id[1] = v;
+    for (int32_t k = 0; k < o->loc_n; k++) {
+        int32_t i = o->loc_pt[k];
+        double c = o->loc_base[k];
+        int32_t sg = o->loc_seg[k];
+        for (int j = 0; j < ns; j++) {
+            double cj = polyc__cost(&o->pts[i], xy[4 * j], xy[4 * j + 1], xy[4 * j + 2], xy[4 * j + 3]);
+            if (cj < c) {
+                c = cj;
+                sg = id[j];
+            }
+        }
+        o->err += c - o->pt_cost[i];
+        o->pt_cost[i] = c;
+        o->pt_seg[i] = sg;
+    }
+    for (int k = 0; k < 3; k++)
+        if (nb[k] != POLYC__NONE) {
+            o->acost[nb[k]] = polyc__vertex_angle_cost(o, nb[k]);
+            o->angle += o->acost[nb[k]];
+        }
+}
+
 /* Moves v by steps of step_m while the local score (error plus gamma times
  * the angle terms) falls; the move is then committed as one change. */
 int polyc__hill_climb(polyc__opt *o, int32_t v)
@@ -70,11 +122,16 @@ int polyc__hill_climb(polyc__opt *o, int32_t v)
     int ns = segs_at(o, v, x, y, xy);
     polyc__local_prepare(o, old, 2, xy, ns, reach + step);
     double cur = polyc__local_current(o) + (double)gamma * local_angles(o, v, x, y);
-    int moved = 0;
+    int moved = 0, last = -1;
     for (int it = 0; it < 64; it++) {
         double best = cur;
         int best_d = -1;
-        for (int d = 0; d < 8; d++) {
+        /* the direction that paid last time first: if it pays again, take
+         * it without trying the other seven */
+        for (int k = 0; k < 9; k++) {
+            int d = k == 0 ? last : k - 1;
+            if (d < 0 || (k > 0 && d == last))
+                continue;
             float cx = x + step * DIR_X[d], cy = y + step * DIR_Y[d];
             if ((cx - x0) * (cx - x0) + (cy - y0) * (cy - y0) > reach * reach)
                 continue;
@@ -83,6 +140,8 @@ int polyc__hill_climb(polyc__opt *o, int32_t v)
             if (e < best - 1e-12 * (1.0 + fabs(best))) {
                 best = e;
                 best_d = d;
+                if (k == 0)
+                    break;
             }
         }
         if (best_d < 0)
@@ -90,28 +149,26 @@ int polyc__hill_climb(polyc__opt *o, int32_t v)
         x += step * DIR_X[best_d];
         y += step * DIR_Y[best_d];
         cur = best;
+        last = best_d;
         moved = 1;
     }
     if (!moved)
         return 0;
-    polyc__chg_begin(o);
-    polyc__op_move(o, v, x, y);
-    polyc__chg_commit(o);
+    commit_move(o, v, x, y);
     return 1;
 }
 
 /* Rounds of hill climbing; after the first, only vertices next to one that
- * moved in the previous round are climbed again. With touched_only, the
- * first round takes only the vertices edited since the last adjustment. */
-int polyc__op_adjust(polyc__opt *o, int max_rounds, int touched_only)
+ * moved in the previous round are climbed again. The first round takes the
+ * vertices edited at or after touch stamp `since` (0: all). */
+int polyc__op_adjust(polyc__opt *o, int max_rounds, uint32_t since)
 {
     const polyc__store *s = o->s;
     int total = 0;
     uint32_t stamp = ++o->work_stamp;
     for (int32_t v = 0; v < s->v_high; v++)
-        if (!touched_only || o->v_touch[v] == o->touch_stamp)
+        if (o->v_touch[v] >= since)
             o->v_work[v] = stamp;
-    o->touch_stamp++;
     for (int r = 0; r < max_rounds; r++) {
         uint32_t next = ++o->work_stamp;
         int moved = 0;

@@ -53,7 +53,7 @@ void polyc_config_default(polyc_config *c)
     c->contour_threshold = 0.5f;
     c->data_min_m = 0.2f;
     c->free_range_m = 10.0f;
-    c->grazing_cells = 1.0f;
+    c->grazing_cells = 3.0f;
     c->max_extent_m = 2000.0f;
     c->alpha = 500.0f;
     c->gamma = 0.02f;

@@ -94,12 +94,15 @@ double polyc__removal_delta(polyc__opt *o, int32_t v)
     return (double)o->cfg->alpha * (derr + gamma * dangle) + dk * o->log_n;
 }
 
-int polyc__op_remove_vertices(polyc__opt *o)
+/* Candidates: the vertices edited at or after touch stamp `since` (0: all);
+ * a removal that did not pay before pays later only if something near it
+ * changed. */
+int polyc__op_remove_vertices(polyc__opt *o, uint32_t since)
 {
     polyc__store *s = o->s;
     o->heap_n = 0;
     for (int32_t v = 0; v < s->v_high; v++) {
-        if (s->v[v].line == POLYC__NONE)
+        if (s->v[v].line == POLYC__NONE || o->v_touch[v] < since)
             continue;
         double d = polyc__removal_delta(o, v);
         if (d < 0.0)

@@ -25,6 +25,7 @@ size_t polyc__optimizer_bytes(const polyc_config *cfg, const polyc_limits *lim)
     n = polyc__add(n, polyc__bytes(P, sizeof(double)));           /* pt_cost */
     n = polyc__add(n, polyc__bytes(P, sizeof(int32_t)));          /* loc_pt */
     n = polyc__add(n, polyc__bytes(P, sizeof(double)));           /* loc_base */
+    n = polyc__add(n, polyc__bytes(P, sizeof(int32_t)));          /* loc_seg */
     n = polyc__add(n, polyc__bytes(P + V, sizeof(float)));        /* split_t */
     n = polyc__add(n, polyc__bytes(V, sizeof(float)));            /* trim_head */
     n = polyc__add(n, polyc__bytes(V + 1, sizeof(int32_t)));      /* split_off */
@@ -68,6 +69,7 @@ static polyc_status setup(polyc_ctx *ctx, polyc__opt *o)
     ALLOC(o->pt_cost, P);
     ALLOC(o->loc_pt, P);
     ALLOC(o->loc_base, P);
+    ALLOC(o->loc_seg, P);
     ALLOC(o->split_t, P > V ? P : V);
     ALLOC(o->trim_head, V);
     ALLOC(o->split_off, V + 1);
@@ -129,27 +131,37 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
     double sigma = cfg->noise_m;
     uint32_t quiet = 0, it;
     polyc_status result = POLYC_OK;
+    uint32_t prev_start = 0;
     for (it = 0; it < cfg->max_iterations; it++) {
-        if (it > 0 && sigma > 0.0) {
-            /* F: leave local minima; the noise shrinks every iteration */
-            polyc__op_noise(&o, sigma);
+        uint32_t start = ++o.touch_stamp;
+        /* F: noise to leave local minima, shrinking every iteration. Below
+         * half a hill-climbing step it is not applied any more: the steps
+         * could not correct it. Without noise, only what changed since the
+         * previous iteration is adjusted and offered for removal again. */
+        double noise = it > 0 && sigma >= 0.5 * (double)cfg->step_m ? sigma : 0.0;
+        if (noise > 0.0) {
+            polyc__op_noise(&o, noise);
             if ((st = polyc__rebuild(&o)) != POLYC_OK)
                 return st;
         }
+        uint32_t since = it == 0 || noise > 0.0 ? 0 : prev_start;
+        prev_start = start;
         polyc__op_overlaps(&o);          /* A */
         polyc__op_merge(&o);             /* B */
         polyc__op_split(&o);             /* C */
-        polyc__op_remove_vertices(&o);   /* G: fewer vertices first, so that */
-        polyc__op_adjust(&o, ADJUST_ROUNDS, 0); /* D moves what is left */
+        polyc__op_remove_vertices(&o, since); /* G: fewer vertices first, so that */
+        polyc__op_adjust(&o, ADJUST_ROUNDS, since); /* D moves what is left */
+        uint32_t mark = ++o.touch_stamp;
         polyc__op_zigzag(&o);            /* E */
         polyc__op_corners(&o);           /* corners (not in the paper) */
-        polyc__op_remove_vertices(&o);   /* G */
+        polyc__op_remove_vertices(&o, mark); /* G */
         polyc__op_add_vertices(&o, ADD_ROUNDS); /* G, more vertices */
-        polyc__op_adjust(&o, ADJUST_ROUNDS, 1);
+        polyc__op_adjust(&o, ADJUST_ROUNDS, mark);
         /* moves and additions can leave segments without data or hairpins:
          * clean them before the model is judged, so the best one is clean */
+        mark = ++o.touch_stamp;
         if (polyc__op_split(&o) + polyc__op_zigzag(&o) + polyc__op_corners(&o) > 0)
-            polyc__op_adjust(&o, ADJUST_ROUNDS, 1);
+            polyc__op_adjust(&o, ADJUST_ROUNDS, mark);
         polyc__op_trim_ends(&o); /* last: moves could push ends past the data */
         if (o.h.out_of_entries)
             return polyc__fail(ctx, POLYC_ERR_NOMEM, "spatial hash full");
@@ -168,7 +180,7 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
         rep.polylines = (uint32_t)live_lines(o.s);
         rep.bic = bic;
         rep.best_bic = best;
-        rep.noise_m = it > 0 ? sigma / (double)cfg->noise_decay : 0.0;
+        rep.noise_m = noise;
         if (it > 0)
             sigma *= (double)cfg->noise_decay;
         if (progress && progress(user, &rep)) {

@@ -41,6 +41,7 @@ typedef struct polyc__opt {
     uint32_t *v_dirty;             /* per vertex: == epoch when its angle is pending */
     int32_t *dirty_list, dirty_n;
     int32_t *added, added_n;       /* segments inserted in this change */
+    int added_overflow;            /* more than added_cap: rescore the region fully */
     uint32_t *bucket_mark;         /* per bucket: == epoch when listed */
     int32_t *bucket_list, bucket_n;
     int32_t added_cap, dirty_cap;
@@ -48,6 +49,7 @@ typedef struct polyc__opt {
     /* local evaluation scratch */
     int32_t *loc_pt;               /* points near the edited segments */
     double *loc_base;              /* their cost without the edited segments */
+    int32_t *loc_seg;              /* and the segment giving it */
     int32_t loc_n;
     double loc_fixed, loc_fixed_cur; /* pruned points: base and current sums */
 
@@ -66,7 +68,7 @@ typedef struct polyc__opt {
 
     uint32_t *v_work;              /* per vertex: == round stamp when to be climbed */
     uint32_t work_stamp;
-    uint32_t *v_touch;             /* per vertex: == touch_stamp when an edit touched it */
+    uint32_t *v_touch;             /* per vertex: touch_stamp of the last edit near it */
     uint32_t touch_stamp;
     polyc__rng rng;
     polyc__flat best;
@@ -122,12 +124,12 @@ int polyc__op_link(polyc__opt *o, int32_t tail, int32_t head); /* join or close 
 int polyc__op_overlaps(polyc__opt *o);
 int polyc__op_merge(polyc__opt *o);
 int polyc__op_split(polyc__opt *o);
-int polyc__op_adjust(polyc__opt *o, int max_rounds, int touched_only);
+int polyc__op_adjust(polyc__opt *o, int max_rounds, uint32_t since);
 int polyc__op_zigzag(polyc__opt *o);
 int polyc__op_corners(polyc__opt *o);
 int polyc__op_trim_ends(polyc__opt *o);
 void polyc__op_noise(polyc__opt *o, double sigma_m);
-int polyc__op_remove_vertices(polyc__opt *o);
+int polyc__op_remove_vertices(polyc__opt *o, uint32_t since);
 double polyc__removal_delta(polyc__opt *o, int32_t v);
 int polyc__op_add_vertices(polyc__opt *o, int max_tries);
 int polyc__hill_climb(polyc__opt *o, int32_t v);

@@ -138,6 +138,7 @@ void polyc__chg_begin(polyc__opt *o)
     o->epoch++;
     o->bucket_n = 0;
     o->added_n = 0;
+    o->added_overflow = 0;
     o->dirty_n = 0;
 }
 
@@ -159,7 +160,7 @@ int polyc__chg_seg_in(polyc__opt *o, int32_t seg)
     if (o->added_n < o->added_cap)
         o->added[o->added_n++] = seg;
     else
-        o->seg_dead[seg] = o->epoch; /* too many: fall back to full queries */
+        o->added_overflow = 1; /* too many to compare: full queries in the region */
     return ok;
 }
 
@@ -184,7 +185,7 @@ void polyc__chg_commit(polyc__opt *o)
         for (uint32_t i = h->pt_start[b]; i < h->pt_start[b + 1]; i++) {
             double old = o->pt_cost[i], c;
             int32_t seg = o->pt_seg[i];
-            if (seg != POLYC__NONE && o->seg_dead[seg] == o->epoch) {
+            if (o->added_overflow || (seg != POLYC__NONE && o->seg_dead[seg] == o->epoch)) {
                 c = polyc__nearest(o, (int32_t)i, NULL, 0, &seg);
             } else {
                 c = old;
@@ -264,10 +265,10 @@ static double point_seg_dist(const polyc__point *p, const float *xy)
 }
 
 /* Collects the points near the `old` segments and the candidate geometry,
- * with their cost when the old segments are gone (loc_base). With reach > 0
- * the candidates stay within `reach` of seg_xy: a point whose base cost is
- * below any cost it could get from them never changes, and is summed once
- * into loc_fixed instead of being listed. */
+ * with their cost when the old segments are gone (loc_base, loc_seg). With
+ * reach > 0 the candidates stay within `reach` of seg_xy: a point not on an
+ * old segment whose cost is below any cost it could get from them never
+ * changes, and is summed once into loc_fixed instead of being listed. */
 void polyc__local_prepare(polyc__opt *o, const int32_t *old, int n_old, const float *seg_xy,
                           int n_new, float reach)
 {
@@ -291,8 +292,9 @@ void polyc__local_prepare(polyc__opt *o, const int32_t *old, int n_old, const fl
             int hit = 0;
             for (int j = 0; j < n_old; j++)
                 hit |= seg != POLYC__NONE && seg == old[j];
-            double base = hit ? polyc__nearest(o, (int32_t)i, old, n_old, NULL) : o->pt_cost[i];
-            if (reach > 0.0f) {
+            int32_t base_seg = seg;
+            double base = hit ? polyc__nearest(o, (int32_t)i, old, n_old, &base_seg) : o->pt_cost[i];
+            if (reach > 0.0f && !hit) {
                 const polyc__point *p = &o->pts[i];
                 double dmin = 1e30;
                 for (int j = 0; j < n_new; j++) {
@@ -309,6 +311,7 @@ void polyc__local_prepare(polyc__opt *o, const int32_t *old, int n_old, const fl
             }
             o->loc_pt[o->loc_n] = (int32_t)i;
             o->loc_base[o->loc_n] = base;
+            o->loc_seg[o->loc_n] = base_seg;
             o->loc_n++;
         }
     }

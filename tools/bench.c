@@ -39,6 +39,9 @@ static const char usage_text[] =
     "  --single K       single-scan maps from K scans of each real log (default 10;\n"
     "                   0: no single-scan section)\n"
     "  --iterations N   optimiser iteration cap (default: the library's)\n"
+    "  --alpha A, --gamma G, --cell M, --grazing C, --data-min M\n"
+    "                   override polyc_config's alpha, gamma, cell_m,\n"
+    "                   grazing_cells, data_min_m (default: the library's)\n"
     "  -h, --help       this text\n"
     "Columns: stage times in ms (parse = reading the log, add = polyc_add_scan,\n"
     "grid, contour, trace, optimise, output = JSON to /dev/null); block and used\n"
@@ -57,6 +60,8 @@ typedef struct options {
     const char *only;          /* NULL: every scene */
     unsigned single;
     long iterations;           /* < 0: library default */
+    double alpha, gamma, cell; /* <= 0 (gamma < 0): library default */
+    double grazing, data_min;  /* < 0: library default */
     const char *data;
 } options;
 
@@ -210,6 +215,16 @@ static int pipeline_open(pipeline *p, const options *o, const polyc_scan *scans,
     polyc_config_default(&p->config);
     if (o->iterations >= 0)
         p->config.max_iterations = (uint32_t)o->iterations;
+    if (o->alpha > 0.0)
+        p->config.alpha = (float)o->alpha;
+    if (o->gamma >= 0.0)
+        p->config.gamma = (float)o->gamma;
+    if (o->cell > 0.0)
+        p->config.cell_m = (float)o->cell;
+    if (o->grazing >= 0.0)
+        p->config.grazing_cells = (float)o->grazing;
+    if (o->data_min >= 0.0)
+        p->config.data_min_m = (float)o->data_min;
     if (step(p, polyc_limits_for_scans(&p->config, scans, n, &p->limits),
              "polyc_limits_for_scans"))
         return -1;
@@ -504,6 +519,7 @@ static int parse_options(int argc, char **argv, options *o)
     o->runs = 3;
     o->single = 10;
     o->iterations = -1;
+    o->gamma = o->grazing = o->data_min = -1.0;
     for (i = 1; i < argc; i++) {
         const char *a = argv[i];
         if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
@@ -521,6 +537,18 @@ static int parse_options(int argc, char **argv, options *o)
             if (parse_count(argv[++i], 0, 100000000, &v))
                 return -1;
             o->iterations = v;
+        } else if ((strcmp(a, "--alpha") == 0 || strcmp(a, "--gamma") == 0 ||
+                    strcmp(a, "--cell") == 0 || strcmp(a, "--grazing") == 0 ||
+                    strcmp(a, "--data-min") == 0) && i + 1 < argc) {
+            char *end;
+            double d = strtod(argv[++i], &end);
+            if (*end || !(d >= 0.0 && d < 1e9))
+                return -1;
+            if (strcmp(a, "--alpha") == 0) o->alpha = d;
+            else if (strcmp(a, "--gamma") == 0) o->gamma = d;
+            else if (strcmp(a, "--cell") == 0) o->cell = d;
+            else if (strcmp(a, "--grazing") == 0) o->grazing = d;
+            else o->data_min = d;
         } else if (strcmp(a, "--only") == 0 && i + 1 < argc) {
             o->only = argv[++i];
         } else if (a[0] == '-' || o->data) {
