@@ -96,7 +96,10 @@ typedef struct polyc_limits {
     uint32_t max_beams;        /* beams, summed over all scans */
     uint32_t max_grid_cells;   /* grid cells the map may touch (allocated in
                                   tiles of 32 x 32 cells as beams reach them) */
-    uint32_t max_vertices;     /* polyline vertices (0: derived from max_beams) */
+    uint32_t max_vertices;     /* polyline vertices (0: max_beams + 1024, enough
+                                  for any contour) */
+    uint32_t max_points;       /* weighted data points (0: max_beams, enough
+                                  for any input) */
 } polyc_limits;
 
 /* One scan, as the laser saw it. Beam i points at
@@ -185,7 +188,11 @@ POLYC_API void polyc_config_default(polyc_config *config);
 POLYC_API polyc_status polyc_config_check(const polyc_config *config, const char **why);
 
 /* Limits for a known set of scans: counts and a grid bound from the extent
- * of their endpoints (the same rule the grid uses). Pure; no memory. */
+ * of their endpoints (the same rule the grid uses). Pure; no memory.
+ * Vertices and weighted points are sized for a contour of at most a quarter
+ * of the beams plus 4096 (logs of many scans need 1 to 10 %, single scans
+ * are covered whole); a map that needs more fails with POLYC_ERR_NOMEM in
+ * polyc_trace or polyc_optimize: retry with max_vertices and max_points 0. */
 POLYC_API polyc_status polyc_limits_for_scans(const polyc_config *config,
                                               const polyc_scan *scans, uint32_t scan_count,
                                               polyc_limits *out);

@@ -165,6 +165,12 @@ polyc_status polyc_limits_for_scans(const polyc_config *config, const polyc_scan
         return POLYC_ERR_LIMIT;
     out->max_scans = scan_count;
     out->max_beams = (uint32_t)beams;
+    uint64_t typical = beams / 4 + 4096;
+    if (typical < beams) {
+        out->max_vertices = (uint32_t)typical + 1024u;
+        if (!(config->flags & POLYC_FLAG_EXACT_POINTS))
+            out->max_points = (uint32_t)typical;
+    }
     if (box.min_x_m <= box.max_x_m) {
         double cell = (double)config->cell_m, ext = (double)config->max_extent_m;
         double pad = 4.0 * cell;

@@ -12,14 +12,10 @@ size_t polyc__contour_bytes(const polyc_limits *lim)
     return polyc__bytes((size_t)lim->max_beams * 2 + 2, sizeof(int32_t));
 }
 
-static int occupied(const polyc__tile *t, int idx)
+/* Labels cell (ix, iy) once; 0 when the list is full. */
+static int label(polyc_ctx *ctx, int32_t ix, int32_t iy)
 {
-    return (t->mark[idx >> POLYC__TILE_SHIFT] >> (idx & (POLYC__TILE_SIDE - 1))) & 1u;
-}
-
-/* Labels cell (ix, iy) of tile t once; 0 when the list is full. */
-static int label(polyc_ctx *ctx, polyc__tile *t, int32_t ix, int32_t iy)
-{
+    polyc__tile *t = polyc__grid_tile(&ctx->grid, ix, iy);
     uint32_t bit = 1u << (ix & (POLYC__TILE_SIDE - 1));
     uint32_t *row = &t->contour[iy & (POLYC__TILE_SIDE - 1)];
     if (*row & bit)
@@ -33,27 +29,112 @@ static int label(polyc_ctx *ctx, polyc__tile *t, int32_t ix, int32_t iy)
     return 1;
 }
 
-/* Walks the beam to its first occupied cell and labels it; the walk stops
- * at the grid's edge. 0 when the list is full. */
-static int contour_beam(polyc_ctx *ctx, const polyc__beam *b)
+static int occupied(const polyc__tile *t, int idx)
+{
+    return (t->mark[idx >> POLYC__TILE_SHIFT] >> (idx & (POLYC__TILE_SIDE - 1))) & 1u;
+}
+
+/* The end cell, visited last whatever the rounding. */
+static int end_cell(polyc_ctx *ctx, const polyc__walk *w)
+{
+    const polyc__tile *t = polyc__grid_tile(&ctx->grid, w->ex, w->ey);
+    return t && occupied(t, polyc__cell_index(w->ex, w->ey)) ? label(ctx, w->ex, w->ey) : 1;
+}
+
+/* Occupancy of the grid's whole box, one bit per cell, row after row, with a
+ * border of set bits. A set bit stops the walk: an occupied cell, or the
+ * edge of the grid or an untouched tile, where the walk stops unlabelled. */
+typedef struct occ_map {
+    uint32_t *bits;
+    int64_t stride;                /* width + 2 */
+} occ_map;
+
+static int occ_bit(const occ_map *m, int64_t p)
+{
+    return (m->bits[p >> 5] >> (p & 31)) & 1u;
+}
+
+static void occ_set_bits(occ_map *m, int64_t p, uint32_t bits)
+{
+    uint32_t s = (uint32_t)(p & 31);
+    m->bits[p >> 5] |= bits << s;
+    if (s)
+        m->bits[(p >> 5) + 1] |= bits >> (32 - s);
+}
+
+static size_t occ_words(const polyc__grid *g)
+{
+    return (size_t)((((int64_t)g->width + 2) * ((int64_t)g->height + 2) + 31) / 32 + 1);
+}
+
+static void occ_fill(occ_map *m, const polyc__grid *g)
+{
+    memset(m->bits, 0, occ_words(g) * sizeof(uint32_t));
+    m->stride = (int64_t)g->width + 2;
+    for (int32_t ty = 0; ty < g->tiles_y; ty++)
+        for (int32_t tx = 0; tx < g->tiles_x; tx++) {
+            const polyc__tile *t = polyc__grid_tile(g, tx << POLYC__TILE_SHIFT, ty << POLYC__TILE_SHIFT);
+            int32_t x0 = tx << POLYC__TILE_SHIFT, y0 = ty << POLYC__TILE_SHIFT;
+            int32_t cols = g->width - x0 < POLYC__TILE_SIDE ? g->width - x0 : POLYC__TILE_SIDE;
+            uint32_t in_grid = cols == 32 ? ~0u : (1u << cols) - 1u;
+            for (int32_t r = 0; r < POLYC__TILE_SIDE && y0 + r < g->height; r++)
+                occ_set_bits(m, (int64_t)(y0 + r + 1) * m->stride + x0 + 1,
+                             (t ? t->mark[r] : ~0u) & in_grid);
+        }
+    for (int64_t x = 0; x < m->stride; x++) {
+        occ_set_bits(m, x, 1u);
+        occ_set_bits(m, ((int64_t)g->height + 1) * m->stride + x, 1u);
+    }
+    for (int64_t y = 1; y <= g->height; y++) {
+        occ_set_bits(m, y * m->stride, 1u);
+        occ_set_bits(m, y * m->stride + m->stride - 1, 1u);
+    }
+}
+
+/* Walks the beam to its first occupied cell and labels it; 0 when the list
+ * is full. With a map, the walk reads one bit per cell; without one (no room
+ * for it), the marks of the tiles. */
+static int contour_beam(polyc_ctx *ctx, const occ_map *m, const polyc__beam *b)
 {
     polyc__grid *g = &ctx->grid;
     polyc__walk w;
     polyc__walk_start(&w, b);
-    polyc__tile *t = NULL;
-    if (w.n > 0 && (!polyc__walk_enter(&w, g->width, g->height) || !(t = polyc__grid_tile(g, w.ix, w.iy))))
+    if (w.n == 0)
+        return end_cell(ctx, &w);
+    if (!polyc__walk_enter(&w, g->width, g->height))
+        return 1;
+    if (m) {
+        int64_t p = ((int64_t)w.iy + 1) * m->stride + w.ix + 1;
+        const int64_t step_y = w.sty > 0 ? m->stride : -m->stride;
+        while (w.n > 0) {
+            if (occ_bit(m, p)) {
+                int32_t ix = (int32_t)(p % m->stride) - 1, iy = (int32_t)(p / m->stride) - 1;
+                if (ix < 0 || iy < 0 || ix >= g->width || iy >= g->height || !polyc__grid_tile(g, ix, iy))
+                    return 1;
+                return label(ctx, ix, iy);
+            }
+            w.n--;
+            if (w.tmx < w.tmy) {
+                w.tmx += w.tdx;
+                p += w.stx;
+            } else {
+                w.tmy += w.tdy;
+                p += step_y;
+            }
+        }
+        return end_cell(ctx, &w);
+    }
+    const polyc__tile *t = polyc__grid_tile(g, w.ix, w.iy);
+    if (!t)
         return 1;
     while (w.n > 0) {
         if (occupied(t, w.idx))
-            return label(ctx, t, w.ix, w.iy);
+            return label(ctx, w.ix, w.iy);
         if (polyc__walk_step(&w) && w.n > 0 &&
             (!polyc__walk_enter(&w, g->width, g->height) || !(t = polyc__grid_tile(g, w.ix, w.iy))))
             return 1;
     }
-    t = polyc__grid_tile(g, w.ex, w.ey);
-    if (t && occupied(t, polyc__cell_index(w.ex, w.ey)))
-        return label(ctx, t, w.ex, w.ey);
-    return 1;
+    return end_cell(ctx, &w);
 }
 
 polyc_status polyc__contour_build(polyc_ctx *ctx)
@@ -63,8 +144,7 @@ polyc_status polyc__contour_build(polyc_ctx *ctx)
     ctx->contour_xy = polyc__alloc(&ctx->arena, (size_t)ctx->lim.max_beams * 2 + 2, sizeof(int32_t));
     if (!ctx->contour_xy)
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the contour");
-    /* m > threshold once per cell, as bits in the scratch marks: the walk
-     * then tests a bit instead of two counters */
+    /* m > threshold once per cell, as bits in the scratch marks */
     float threshold = ctx->cfg.contour_threshold;
     for (uint32_t k = 0; k < g->tile_count; k++) {
         polyc__tile *t = &g->tiles[k];
@@ -77,15 +157,23 @@ polyc_status polyc__contour_build(polyc_ctx *ctx)
             t->mark[r] = bits;
         }
     }
+    /* The map of the whole box is scratch in memory budgeted for the later
+     * stages, so it is there unless the limits are tight; it saves the walk
+     * the tile bookkeeping, which costs about as much as the walk itself. */
+    size_t mark = ctx->arena.used;
+    occ_map map = {NULL, 0};
+    if (g->tile_count > 0 && (map.bits = polyc__alloc(&ctx->arena, occ_words(g), sizeof(uint32_t))))
+        occ_fill(&map, g);
     int full = 0;
     for (uint32_t si = 0; si < ctx->scan_count; si++) {
         const polyc__scan *s = &ctx->scans[si];
         for (uint32_t i = 0; i < s->count; i++) {
             polyc__beam b;
-            if (polyc__beam_path(ctx, s, i, &b) && !contour_beam(ctx, &b))
+            if (polyc__beam_path(ctx, s, i, &b) && !contour_beam(ctx, map.bits ? &map : NULL, &b))
                 full = 1;
         }
     }
+    ctx->arena.used = mark;
     POLYC_ASSERT(!full);
     ctx->stats.contour_cells = ctx->contour_count;
     return POLYC_OK;

@@ -142,20 +142,20 @@ int polyc__op_remove_vertices(polyc__opt *o, uint32_t since)
 static void segment_stats(polyc__opt *o)
 {
     for (int32_t v = 0; v < o->s->v_high; v++) {
-        o->seg_sum[v] = 0.0;
-        o->seg_w[v] = 0.0;
+        o->seg_sum[v] = 0.0f;
+        o->seg_w[v] = 0.0f;
         o->seg_far[v] = POLYC__NONE;
-        o->seg_far_d[v] = -1.0;
+        o->seg_far_d[v] = -1.0f;
     }
     for (int32_t i = 0; i < o->np; i++) {
         int32_t sg = o->pt_seg[i];
         if (sg == POLYC__NONE)
             continue;
-        double w = (double)o->pts[i].w;
-        o->seg_sum[sg] += o->pt_cost[i];
+        float w = o->pts[i].w, c = (float)o->pt_cost[i];
+        o->seg_sum[sg] += c;
         o->seg_w[sg] += w;
-        if (o->pt_cost[i] / w > o->seg_far_d[sg]) {
-            o->seg_far_d[sg] = o->pt_cost[i] / w;
+        if (c / w > o->seg_far_d[sg]) {
+            o->seg_far_d[sg] = c / w;
             o->seg_far[sg] = i;
         }
     }
@@ -176,10 +176,10 @@ int polyc__op_add_vertices(polyc__opt *o, int max_tries)
         double score[ADD_CANDIDATES];
         int nc = 0;
         for (int32_t v = 0; v < s->v_high; v++) {
-            if (s->v[v].line == POLYC__NONE || s->v[v].next == POLYC__NONE || o->seg_w[v] < 4.0 ||
+            if (s->v[v].line == POLYC__NONE || s->v[v].next == POLYC__NONE || o->seg_w[v] < 4.0f ||
                 o->seg_far[v] == POLYC__NONE)
                 continue;
-            double m = o->seg_sum[v] / o->seg_w[v];
+            double m = (double)(o->seg_sum[v] / o->seg_w[v]);
             if (nc == ADD_CANDIDATES && m <= score[nc - 1])
                 continue;
             int k = nc < ADD_CANDIDATES ? nc++ : nc - 1;

@@ -29,10 +29,10 @@ size_t polyc__optimizer_bytes(const polyc_config *cfg, const polyc_limits *lim)
     n = polyc__add(n, polyc__bytes(P + V, sizeof(float)));        /* split_t */
     n = polyc__add(n, polyc__bytes(V, sizeof(float)));            /* trim_head */
     n = polyc__add(n, polyc__bytes(V + 1, sizeof(int32_t)));      /* split_off */
-    n = polyc__add(n, polyc__bytes(V, 4 * sizeof(float) + 2 * sizeof(int32_t))); /* cuts */
-    n = polyc__add(n, polyc__bytes(V, 4 * sizeof(double)));       /* acost, seg stats */
+    n = polyc__add(n, polyc__bytes(V / 4 + 64, 2 * sizeof(float) + 2 * sizeof(int32_t))); /* cuts */
+    n = polyc__add(n, polyc__bytes(V, sizeof(double) + 3 * sizeof(float))); /* acost, seg stats */
     n = polyc__add(n, polyc__bytes(V, 6 * sizeof(int32_t) + 1));  /* marks, lists, seg_in */
-    n = polyc__add(n, polyc__bytes(V * 3 + 16, sizeof(polyc__heap_entry)));
+    n = polyc__add(n, polyc__bytes(V + 1024, sizeof(polyc__heap_entry)));
     n = polyc__add(n, polyc__bytes(ADDED_CAP, sizeof(int32_t)));
     n = polyc__add(n, polyc__bytes(NB, 4 * sizeof(int32_t)));     /* heads, starts, marks, list */
     n = polyc__add(n, polyc__bytes(NE, sizeof(polyc__hash_entry)));
@@ -43,8 +43,9 @@ size_t polyc__optimizer_bytes(const polyc_config *cfg, const polyc_limits *lim)
 #define ALLOC(ptr, count) \
     do { if (!((ptr) = polyc__alloc(&ctx->arena, (size_t)(count), sizeof *(ptr)))) goto nomem; } while (0)
 
-/* Everything the optimiser needs, carved from the arena after the trace. */
-static polyc_status setup(polyc_ctx *ctx, polyc__opt *o)
+/* Everything the optimiser needs, carved from the arena after the trace
+ * (also the entry point of the optimiser's unit tests). */
+polyc_status polyc__opt_setup(polyc_ctx *ctx, polyc__opt *o)
 {
     memset(o, 0, sizeof *o);
     o->ctx = ctx;
@@ -73,11 +74,12 @@ static polyc_status setup(polyc_ctx *ctx, polyc__opt *o)
     ALLOC(o->split_t, P > V ? P : V);
     ALLOC(o->trim_head, V);
     ALLOC(o->split_off, V + 1);
-    ALLOC(o->cut_seg, V);
-    ALLOC(o->cut_next, V);
-    ALLOC(o->cut_t0, V);
-    ALLOC(o->cut_t1, V);
-    o->cut_cap = V;
+    /* cuts per pass (more wait for the next pass) */
+    ALLOC(o->cut_seg, V / 4 + 64);
+    ALLOC(o->cut_next, V / 4 + 64);
+    ALLOC(o->cut_t0, V / 4 + 64);
+    ALLOC(o->cut_t1, V / 4 + 64);
+    o->cut_cap = V / 4 + 64;
     ALLOC(o->acost, V);
     ALLOC(o->seg_sum, V);
     ALLOC(o->seg_w, V);
@@ -91,8 +93,8 @@ static polyc_status setup(polyc_ctx *ctx, polyc__opt *o)
     memset(o->v_work, 0, (size_t)V * sizeof(uint32_t));
     ALLOC(o->v_touch, V);
     memset(o->v_touch, 0, (size_t)V * sizeof(uint32_t));
-    ALLOC(o->heap, V * 3 + 16);
-    o->heap_cap = V * 3 + 16;
+    ALLOC(o->heap, V + 1024); /* a candidate that finds it full is not retried */
+    o->heap_cap = V + 1024;
     ALLOC(o->added, ADDED_CAP);
     o->added_cap = ADDED_CAP;
     o->dirty_cap = V;
@@ -122,7 +124,7 @@ static int32_t live_lines(const polyc__store *s)
 polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *user)
 {
     polyc__opt o;
-    polyc_status st = setup(ctx, &o);
+    polyc_status st = polyc__opt_setup(ctx, &o);
     if (st != POLYC_OK)
         return st;
     const polyc_config *cfg = &ctx->cfg;
@@ -204,7 +206,7 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
 polyc_status polyc__score(polyc_ctx *ctx, double *bic, double *err)
 {
     polyc__opt o;
-    polyc_status st = setup(ctx, &o);
+    polyc_status st = polyc__opt_setup(ctx, &o);
     if (st != POLYC_OK)
         return st;
     fill_stats(&o);

@@ -61,7 +61,7 @@ typedef struct polyc__opt {
     float *trim_head;              /* end trimming: farthest point from the head side */
 
     /* model size scratch: per segment sums, farthest point; removal heap */
-    double *seg_sum, *seg_w, *seg_far_d;
+    float *seg_sum, *seg_w, *seg_far_d;
     int32_t *seg_far;
     polyc__heap_entry *heap;
     int32_t heap_n, heap_cap;
@@ -74,6 +74,9 @@ typedef struct polyc__opt {
     polyc__flat best;
     double noise_m;
 } polyc__opt;
+
+/* optimize.c: carves the state from the arena after the trace, scores it */
+polyc_status polyc__opt_setup(polyc_ctx *ctx, polyc__opt *o);
 
 /* points.c */
 int32_t polyc__points_bound(const polyc_config *cfg, const polyc_limits *lim);

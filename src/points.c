@@ -95,7 +95,7 @@ static polyc_status collect_cells(polyc__opt *o, polyc__point *tmp, int32_t cap,
         n += in_tile;
     }
     if (n > (uint32_t)cap)
-        return polyc__fail(ctx, POLYC_ERR_NOMEM, "more data cells than the memory bound");
+        return polyc__fail(ctx, POLYC_ERR_NOMEM, "more weighted data points than limits.max_points");
     memset(tmp, 0, (size_t)n * sizeof *tmp);
     for (uint32_t si = 0; si < ctx->scan_count; si++)
         for (uint32_t i = 0; i < ctx->scans[si].count; i++) {
@@ -162,7 +162,7 @@ static polyc_status collect_raw(polyc__opt *o, polyc__point *tmp, int32_t cap, i
             if (!endpoint_of(ctx, &ctx->scans[si], i, &e))
                 continue;
             if (n >= cap)
-                return polyc__fail(ctx, POLYC_ERR_NOMEM, "more data points than the memory bound");
+                return polyc__fail(ctx, POLYC_ERR_NOMEM, "more data points than limits.max_points");
             polyc__point *p = &tmp[n++];
             memset(p, 0, sizeof *p);
             p->x = cell_centre(ox, e.ix, g->cell_m) + e.fx;
@@ -175,7 +175,7 @@ static polyc_status collect_raw(polyc__opt *o, polyc__point *tmp, int32_t cap, i
 
 int32_t polyc__points_bound(const polyc_config *cfg, const polyc_limits *lim)
 {
-    uint32_t b = lim->max_beams;
+    uint32_t b = lim->max_points ? lim->max_points : lim->max_beams;
     if (!(cfg->flags & POLYC_FLAG_EXACT_POINTS) && lim->max_grid_cells < b)
         b = lim->max_grid_cells;
     return b > 0x3fffffffu ? 0x3fffffff : (int32_t)b;

@@ -14,14 +14,14 @@
 int32_t polyc__hash_bucket_cap(const polyc_limits *lim)
 {
     size_t tiles = ((size_t)lim->max_grid_cells + POLYC__TILE_CELLS - 1) / POLYC__TILE_CELLS;
-    size_t cap = 16 * (tiles * 4 + 64) + 1024;
+    size_t cap = 4 * (tiles * 4 + 64) + 1024; /* wider buckets when the map is larger */
     return cap > 0x3fffffff ? 0x3fffffff : (int32_t)cap;
 }
 
 int32_t polyc__hash_entry_cap(const polyc_limits *lim)
 {
     int64_t v = polyc__max_vertices(lim);
-    int64_t cap = 4 * v + 4096;
+    int64_t cap = 3 * v + 4096;
     return cap > 0x3fffffff ? 0x3fffffff : (int32_t)cap;
 }
 

@@ -429,61 +429,137 @@ static int convert(const options *o, run *r)
     return emit(o->output, r->out.data, r->out.len);
 }
 
+static const char *input_name(const options *o)
+{
+    return strcmp(o->input, "-") == 0 ? "<stdin>" : o->input;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* The data are too wide for the grid. Names the scan that reaches farthest
+ * from the median pose (a far-away scan or hit is the usual cause), before
+ * any memory is sized. */
+static int extent_fail(const options *o, const scanlog *log, const polyc_config *cfg)
+{
+    uint32_t n = log->count;
+    double *v = malloc(2 * (size_t)n * sizeof *v);
+    if (!v)
+        return complain(EXIT_INPUT, "%s: the data span more than %g m", input_name(o),
+                        (double)cfg->max_extent_m);
+    for (uint32_t i = 0; i < n; i++) {
+        v[i] = log->scans[i].pose_x_m;
+        v[n + i] = log->scans[i].pose_y_m;
+    }
+    qsort(v, n, sizeof *v, cmp_double);
+    qsort(v + n, n, sizeof *v, cmp_double);
+    double mx = v[n / 2], my = v[n + n / 2], worst = -1.0;
+    free(v);
+    polyc_box all = {1.0, 1.0, 0.0, 0.0};
+    uint32_t far = 0;
+    for (uint32_t i = 0; i < n; i++) {
+        polyc_box b = {1.0, 1.0, 0.0, 0.0};
+        polyc_scan_extent(cfg, &log->scans[i], &b);
+        polyc_scan_extent(cfg, &log->scans[i], &all);
+        double d = fmax(fmax(fabs(b.min_x_m - mx), fabs(b.max_x_m - mx)),
+                        fmax(fabs(b.min_y_m - my), fabs(b.max_y_m - my)));
+        if (b.min_x_m <= b.max_x_m && d > worst) {
+            worst = d;
+            far = i;
+        }
+    }
+    double w = all.max_x_m - all.min_x_m, h = all.max_y_m - all.min_y_m;
+    const polyc_scan *s = &log->scans[far];
+    if (w > (double)cfg->max_extent_m || h > (double)cfg->max_extent_m || worst < 0)
+        return complain(EXIT_INPUT,
+                        "%s:%llu: this scan (pose %.2f %.2f) reaches %.0f m from the median pose"
+                        " (%.2f %.2f): the data would span %.0f x %.0f m, more than the grid's"
+                        " limit of %g m",
+                        input_name(o), (unsigned long long)log->line_of_scan[far], s->pose_x_m,
+                        s->pose_y_m, worst, mx, my, w, h, (double)cfg->max_extent_m);
+    return complain(EXIT_INPUT, "%s: the data span %.1f x %.1f m: more than 2^32 grid cells of"
+                                " %g m (try a larger --cell)",
+                    input_name(o), w, h, (double)cfg->cell_m);
+}
+
 static int make_map(const options *o, run *r, double t_start, mapout_times *t)
 {
     polyc_config cfg = o->config;
     polyc_limits lim;
     polyc_ctx *ctx = NULL;
     polyc_status st = polyc_limits_for_scans(&cfg, r->log.scans, r->log.count, &lim);
+    double t4 = 0.0;
     if (st == POLYC_ERR_EXTENT)
-        return complain(EXIT_INPUT, "%s: the data span more than %g m (a far-away scan or hit?)",
-                        o->input, (double)cfg.max_extent_m);
+        return extent_fail(o, &r->log, &cfg);
     if (st != POLYC_OK)
         return library_fail("sizing", st, NULL, 0);
-    size_t size = polyc_memory_size(&cfg, &lim);
-    if (size == 0)
-        return complain(EXIT_MEMORY, "memory budget too small: need more than %zu bytes",
-                        (size_t)SIZE_MAX);
-    if (o->memory_mb > 0 && (double)size > o->memory_mb * 1048576.0)
-        return complain(EXIT_MEMORY, "memory budget too small: need %zu bytes", size);
-    r->block = malloc(size);
-    if (!r->block)
-        return complain(EXIT_MEMORY, "memory budget too small: need %zu bytes (malloc failed)",
-                        size);
-    if ((st = polyc_init(r->block, size, &cfg, &lim, &ctx)) != POLYC_OK)
-        return library_fail("init", st, ctx, size);
+    /* polyc_limits_for_scans sizes vertices and data points for a usual
+     * contour; a map that needs more is run again with the worst-case bound */
+    size_t size = 0;
+    for (int attempt = 0;; attempt++) {
+        int retry = attempt == 0 && (lim.max_vertices != 0 || lim.max_points != 0);
+        size = polyc_memory_size(&cfg, &lim);
+        if (size == 0)
+            return complain(EXIT_MEMORY, "memory budget too small: need more than %zu bytes",
+                            (size_t)SIZE_MAX);
+        if (o->memory_mb > 0 && (double)size > o->memory_mb * 1048576.0)
+            return complain(EXIT_MEMORY, "memory budget too small: need %zu bytes", size);
+        free(r->block);
+        r->block = malloc(size);
+        if (!r->block)
+            return complain(EXIT_MEMORY, "memory budget too small: need %zu bytes (malloc failed)",
+                            size);
+        if ((st = polyc_init(r->block, size, &cfg, &lim, &ctx)) != POLYC_OK)
+            return library_fail("init", st, ctx, size);
 
-    double t0 = now_ms();
-    for (uint32_t i = 0; i < r->log.count; i++)
-        if ((st = polyc_add_scan(ctx, &r->log.scans[i])) != POLYC_OK) {
-            if (st == POLYC_ERR_SCAN)
-                return complain(EXIT_INPUT, "%s:%llu: scan rejected by the library: %s", o->input,
-                                (unsigned long long)r->log.line_of_scan[i], polyc_last_error(ctx));
-            return library_fail("add scan", st, ctx, size);
+        double t0 = now_ms();
+        for (uint32_t i = 0; i < r->log.count; i++)
+            if ((st = polyc_add_scan(ctx, &r->log.scans[i])) != POLYC_OK) {
+                if (st == POLYC_ERR_SCAN)
+                    return complain(EXIT_INPUT, "%s:%llu: scan rejected by the library: %s",
+                                    input_name(o), (unsigned long long)r->log.line_of_scan[i],
+                                    polyc_last_error(ctx));
+                return library_fail("add scan", st, ctx, size);
+            }
+        double t1 = now_ms();
+        t->add_ms = t1 - t0;
+        if ((st = polyc_build_grid(ctx)) != POLYC_OK)
+            return library_fail("grid", st, ctx, size);
+        double t2 = now_ms();
+        t->grid_ms = t2 - t1;
+        if ((st = polyc_extract_contour(ctx)) != POLYC_OK)
+            return library_fail("contour", st, ctx, size);
+        double t3 = now_ms();
+        t->contour_ms = t3 - t2;
+        st = polyc_trace(ctx);
+        if (st == POLYC_ERR_NOMEM && retry) {
+            lim.max_vertices = lim.max_points = 0;
+            continue;
         }
-    double t1 = now_ms();
-    t->add_ms = t1 - t0;
-    if ((st = polyc_build_grid(ctx)) != POLYC_OK)
-        return library_fail("grid", st, ctx, size);
-    double t2 = now_ms();
-    t->grid_ms = t2 - t1;
-    if ((st = polyc_extract_contour(ctx)) != POLYC_OK)
-        return library_fail("contour", st, ctx, size);
-    double t3 = now_ms();
-    t->contour_ms = t3 - t2;
-    if ((st = polyc_trace(ctx)) != POLYC_OK)
-        return library_fail("trace", st, ctx, size);
-    double t4 = now_ms();
-    t->trace_ms = t4 - t3;
-    if (o->trace) {
-        if (membuf_open(&r->trace))
-            return EXIT_INPUT;
-        fputs("# iteration bic best_bic vertices polylines noise_m\n", r->trace.f);
-    }
-    if (!o->no_optimize && cfg.max_iterations > 0) {
-        st = polyc_optimize(ctx, o->trace ? on_iteration : NULL, r->trace.f);
         if (st != POLYC_OK)
-            return library_fail("optimize", st, ctx, size);
+            return library_fail("trace", st, ctx, size);
+        t4 = now_ms();
+        t->trace_ms = t4 - t3;
+        if (o->trace && !r->trace.f) {
+            if (membuf_open(&r->trace))
+                return EXIT_INPUT;
+            fputs("# iteration bic best_bic vertices polylines noise_m\n", r->trace.f);
+        }
+        if (!o->no_optimize && cfg.max_iterations > 0) {
+            st = polyc_optimize(ctx, o->trace ? on_iteration : NULL, r->trace.f);
+            if (st == POLYC_ERR_NOMEM && retry) {
+                lim.max_vertices = lim.max_points = 0;
+                if (r->trace.f)
+                    rewind(r->trace.f); /* (the rerun writes the same lines again) */
+                continue;
+            }
+            if (st != POLYC_OK)
+                return library_fail("optimize", st, ctx, size);
+        }
+        break;
     }
     double t5 = now_ms();
     t->optimize_ms = t5 - t4;

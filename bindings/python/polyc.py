@@ -64,7 +64,7 @@ class _Config(ctypes.Structure):
 
 class _Limits(ctypes.Structure):
     _fields_ = [("max_scans", _u32), ("max_beams", _u32), ("max_grid_cells", _u32),
-                ("max_vertices", _u32)]
+                ("max_vertices", _u32), ("max_points", _u32)]
 
 
 class _Scan(ctypes.Structure):
@@ -237,7 +237,7 @@ def _progress(fn):
 class Context:
     """A libpolyc context in a block this object owns.
 
-    limits: dict or (max_scans, max_beams, max_grid_cells, max_vertices);
+    limits: dict or (max_scans, max_beams, max_grid_cells, max_vertices[, max_points]);
     memory_bytes: block size (default: polyc_memory_size); other keywords
     override polyc_config fields (cell_m=0.05, max_iterations=0, seed=3, ...)."""
 
@@ -325,9 +325,10 @@ def build_map(scans, memory_bytes=None, max_vertices=0, progress=None, **config)
     if status != OK:
         raise PolycError(status, "limits for scans",
                          "the data span more than max_extent_m" if status == ERR_EXTENT else "")
-    lim.max_vertices = max_vertices
-    ctx = Context((lim.max_scans, lim.max_beams, lim.max_grid_cells, lim.max_vertices),
-                  memory_bytes, **config)
+    if max_vertices:
+        lim.max_vertices = max_vertices
+    ctx = Context((lim.max_scans, lim.max_beams, lim.max_grid_cells, lim.max_vertices,
+                   lim.max_points), memory_bytes, **config)
     for i, (s, _) in enumerate(held):
         ctx._check(_lib.polyc_add_scan(ctx._ctx, ctypes.byref(s)), "add scan %d" % i)
     ctx.build(progress)
