@@ -189,10 +189,11 @@ POLYC_API polyc_status polyc_config_check(const polyc_config *config, const char
 
 /* Limits for a known set of scans: counts and a grid bound from the extent
  * of their endpoints (the same rule the grid uses). Pure; no memory.
- * Vertices and weighted points are sized for a contour of at most a quarter
- * of the beams plus 4096 (logs of many scans need 1 to 10 %, single scans
- * are covered whole); a map that needs more fails with POLYC_ERR_NOMEM in
- * polyc_trace or polyc_optimize: retry with max_vertices and max_points 0. */
+ * Vertices and weighted points are sized for a usual contour: the lesser of
+ * a quarter of the beams and one cell in 64 of the bounding box, plus 4096
+ * (1.25 times that for the points; small inputs are covered whole). A map
+ * that needs more fails with POLYC_ERR_NOMEM in polyc_trace or
+ * polyc_optimize: retry with max_vertices and max_points 0 (worst case). */
 POLYC_API polyc_status polyc_limits_for_scans(const polyc_config *config,
                                               const polyc_scan *scans, uint32_t scan_count,
                                               polyc_limits *out);

@@ -194,7 +194,8 @@ int polyc__op_adjust(polyc__opt *o, int max_rounds, uint32_t since)
     return total;
 }
 
-/* Gaussian noise of std-dev sigma on every vertex, then a fresh score. */
+/* Gaussian noise of std-dev sigma on every vertex; the caller rescores
+ * from scratch (polyc__rebuild) before anything else. */
 void polyc__op_noise(polyc__opt *o, double sigma_m)
 {
     polyc__store *s = o->s;

@@ -165,12 +165,6 @@ polyc_status polyc_limits_for_scans(const polyc_config *config, const polyc_scan
         return POLYC_ERR_LIMIT;
     out->max_scans = scan_count;
     out->max_beams = (uint32_t)beams;
-    uint64_t typical = beams / 4 + 4096;
-    if (typical < beams) {
-        out->max_vertices = (uint32_t)typical + 1024u;
-        if (!(config->flags & POLYC_FLAG_EXACT_POINTS))
-            out->max_points = (uint32_t)typical;
-    }
     if (box.min_x_m <= box.max_x_m) {
         double cell = (double)config->cell_m, ext = (double)config->max_extent_m;
         double pad = 4.0 * cell;
@@ -183,6 +177,18 @@ polyc_status polyc_limits_for_scans(const polyc_config *config, const polyc_scan
         if (cells > 4294967295.0)
             return POLYC_ERR_EXTENT;
         out->max_grid_cells = (uint32_t)cells;
+    }
+    /* Contours and weighted points follow the map (its walls), not the
+     * log's length: sized for a quarter of the beams or a wall every 64
+     * cells of the bounding box, whichever is less, with room to spare. */
+    uint64_t typical = beams / 4;
+    if ((uint64_t)out->max_grid_cells / 64 < typical)
+        typical = (uint64_t)out->max_grid_cells / 64;
+    typical += 4096;
+    if (typical < beams) {
+        out->max_vertices = (uint32_t)typical + 1024u;
+        if (!(config->flags & POLYC_FLAG_EXACT_POINTS) && typical * 5 / 4 < beams)
+            out->max_points = (uint32_t)(typical * 5 / 4);
     }
     return POLYC_OK;
 }

@@ -4,6 +4,8 @@
  * a list (each beam labels at most one cell, so the list is bounded). */
 #include "walk.h"
 
+#include <stddef.h>
+#include <stdint.h>
 #include <string.h>
 
 size_t polyc__contour_bytes(const polyc_limits *lim)
@@ -46,15 +48,15 @@ static int end_cell(polyc_ctx *ctx, const polyc__walk *w)
  * edge of the grid or an untouched tile, where the walk stops unlabelled. */
 typedef struct occ_map {
     uint32_t *bits;
-    int64_t stride;                /* width + 2 */
+    ptrdiff_t stride;              /* width + 2 */
 } occ_map;
 
-static int occ_bit(const occ_map *m, int64_t p)
+static int occ_bit(const occ_map *m, ptrdiff_t p)
 {
     return (m->bits[p >> 5] >> (p & 31)) & 1u;
 }
 
-static void occ_set_bits(occ_map *m, int64_t p, uint32_t bits)
+static void occ_set_bits(occ_map *m, ptrdiff_t p, uint32_t bits)
 {
     uint32_t s = (uint32_t)(p & 31);
     m->bits[p >> 5] |= bits << s;
@@ -62,15 +64,19 @@ static void occ_set_bits(occ_map *m, int64_t p, uint32_t bits)
         m->bits[(p >> 5) + 1] |= bits >> (32 - s);
 }
 
+/* 0 when the bit positions do not fit a ptrdiff_t */
 static size_t occ_words(const polyc__grid *g)
 {
-    return (size_t)((((int64_t)g->width + 2) * ((int64_t)g->height + 2) + 31) / 32 + 1);
+    ptrdiff_t w = (ptrdiff_t)g->width + 2, h = (ptrdiff_t)g->height + 2;
+    if (h > (PTRDIFF_MAX - 64) / w)
+        return 0;
+    return (size_t)(w * h / 32 + 2);
 }
 
 static void occ_fill(occ_map *m, const polyc__grid *g)
 {
     memset(m->bits, 0, occ_words(g) * sizeof(uint32_t));
-    m->stride = (int64_t)g->width + 2;
+    m->stride = (ptrdiff_t)g->width + 2;
     for (int32_t ty = 0; ty < g->tiles_y; ty++)
         for (int32_t tx = 0; tx < g->tiles_x; tx++) {
             const polyc__tile *t = polyc__grid_tile(g, tx << POLYC__TILE_SHIFT, ty << POLYC__TILE_SHIFT);
@@ -78,63 +84,72 @@ static void occ_fill(occ_map *m, const polyc__grid *g)
             int32_t cols = g->width - x0 < POLYC__TILE_SIDE ? g->width - x0 : POLYC__TILE_SIDE;
             uint32_t in_grid = cols == 32 ? ~0u : (1u << cols) - 1u;
             for (int32_t r = 0; r < POLYC__TILE_SIDE && y0 + r < g->height; r++)
-                occ_set_bits(m, (int64_t)(y0 + r + 1) * m->stride + x0 + 1,
+                occ_set_bits(m, (ptrdiff_t)(y0 + r + 1) * m->stride + x0 + 1,
                              (t ? t->mark[r] : ~0u) & in_grid);
         }
-    for (int64_t x = 0; x < m->stride; x++) {
+    for (ptrdiff_t x = 0; x < m->stride; x++) {
         occ_set_bits(m, x, 1u);
-        occ_set_bits(m, ((int64_t)g->height + 1) * m->stride + x, 1u);
+        occ_set_bits(m, ((ptrdiff_t)g->height + 1) * m->stride + x, 1u);
     }
-    for (int64_t y = 1; y <= g->height; y++) {
+    for (ptrdiff_t y = 1; y <= g->height; y++) {
         occ_set_bits(m, y * m->stride, 1u);
         occ_set_bits(m, y * m->stride + m->stride - 1, 1u);
     }
 }
 
+/* The walk on the map: one bit per cell, no tiles, no bounds. */
+static int walk_map(polyc_ctx *ctx, const occ_map *m, polyc__walk *w)
+{
+    const polyc__grid *g = &ctx->grid;
+    ptrdiff_t p = ((ptrdiff_t)w->iy + 1) * m->stride + w->ix + 1;
+    const ptrdiff_t step_y = w->sty > 0 ? m->stride : -m->stride;
+    while (w->n > 0) {
+        if (occ_bit(m, p)) {
+            int32_t ix = (int32_t)(p % m->stride) - 1, iy = (int32_t)(p / m->stride) - 1;
+            if (ix < 0 || iy < 0 || ix >= g->width || iy >= g->height || !polyc__grid_tile(g, ix, iy))
+                return 1;
+            return label(ctx, ix, iy);
+        }
+        w->n--;
+        if (w->tmx < w->tmy) {
+            w->tmx += w->tdx;
+            p += w->stx;
+        } else {
+            w->tmy += w->tdy;
+            p += step_y;
+        }
+    }
+    return end_cell(ctx, w);
+}
+
+/* The walk on the tiles' marks, when there is no room for the map. */
+static int walk_tiles(polyc_ctx *ctx, polyc__walk *w)
+{
+    const polyc__grid *g = &ctx->grid;
+    const polyc__tile *t = polyc__grid_tile(g, w->ix, w->iy);
+    if (!t)
+        return 1;
+    while (w->n > 0) {
+        if (occupied(t, w->idx))
+            return label(ctx, w->ix, w->iy);
+        if (polyc__walk_step(w) && w->n > 0 &&
+            (!polyc__walk_enter(w, g->width, g->height) || !(t = polyc__grid_tile(g, w->ix, w->iy))))
+            return 1;
+    }
+    return end_cell(ctx, w);
+}
+
 /* Walks the beam to its first occupied cell and labels it; 0 when the list
- * is full. With a map, the walk reads one bit per cell; without one (no room
- * for it), the marks of the tiles. */
+ * is full. */
 static int contour_beam(polyc_ctx *ctx, const occ_map *m, const polyc__beam *b)
 {
-    polyc__grid *g = &ctx->grid;
     polyc__walk w;
     polyc__walk_start(&w, b);
     if (w.n == 0)
         return end_cell(ctx, &w);
-    if (!polyc__walk_enter(&w, g->width, g->height))
+    if (!polyc__walk_enter(&w, ctx->grid.width, ctx->grid.height))
         return 1;
-    if (m) {
-        int64_t p = ((int64_t)w.iy + 1) * m->stride + w.ix + 1;
-        const int64_t step_y = w.sty > 0 ? m->stride : -m->stride;
-        while (w.n > 0) {
-            if (occ_bit(m, p)) {
-                int32_t ix = (int32_t)(p % m->stride) - 1, iy = (int32_t)(p / m->stride) - 1;
-                if (ix < 0 || iy < 0 || ix >= g->width || iy >= g->height || !polyc__grid_tile(g, ix, iy))
-                    return 1;
-                return label(ctx, ix, iy);
-            }
-            w.n--;
-            if (w.tmx < w.tmy) {
-                w.tmx += w.tdx;
-                p += w.stx;
-            } else {
-                w.tmy += w.tdy;
-                p += step_y;
-            }
-        }
-        return end_cell(ctx, &w);
-    }
-    const polyc__tile *t = polyc__grid_tile(g, w.ix, w.iy);
-    if (!t)
-        return 1;
-    while (w.n > 0) {
-        if (occupied(t, w.idx))
-            return label(ctx, w.ix, w.iy);
-        if (polyc__walk_step(&w) && w.n > 0 &&
-            (!polyc__walk_enter(&w, g->width, g->height) || !(t = polyc__grid_tile(g, w.ix, w.iy))))
-            return 1;
-    }
-    return end_cell(ctx, &w);
+    return m ? walk_map(ctx, m, &w) : walk_tiles(ctx, &w);
 }
 
 polyc_status polyc__contour_build(polyc_ctx *ctx)
@@ -162,7 +177,8 @@ polyc_status polyc__contour_build(polyc_ctx *ctx)
      * the tile bookkeeping, which costs about as much as the walk itself. */
     size_t mark = ctx->arena.used;
     occ_map map = {NULL, 0};
-    if (g->tile_count > 0 && (map.bits = polyc__alloc(&ctx->arena, occ_words(g), sizeof(uint32_t))))
+    size_t words = occ_words(g);
+    if (g->tile_count > 0 && words > 0 && (map.bits = polyc__alloc(&ctx->arena, words, sizeof(uint32_t))))
         occ_fill(&map, g);
     int full = 0;
     for (uint32_t si = 0; si < ctx->scan_count; si++) {
@@ -175,6 +191,7 @@ polyc_status polyc__contour_build(polyc_ctx *ctx)
     }
     ctx->arena.used = mark;
     POLYC_ASSERT(!full);
+    (void)full;
     ctx->stats.contour_cells = ctx->contour_count;
     return POLYC_OK;
 }

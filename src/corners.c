@@ -77,7 +77,7 @@ int polyc__op_corners(polyc__opt *o)
 {
     int changed = 0;
     for (int32_t b = 0; b < o->s->v_high; b++) {
-        for (int k = 0; k <= CHAIN_MAX; k++) {
+        for (int k = 1; k <= CHAIN_MAX; k++) { /* (k = 0 would be b itself) */
             if (o->s->v[b].line == POLYC__NONE || o->s->l[o->s->v[b].line].count < CHAIN_MAX + 4)
                 break;
             int32_t c = b;

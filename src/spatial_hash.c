@@ -109,9 +109,34 @@ static int visit_bucket(void *u, int32_t ix, int32_t iy, float t_enter, int last
     return 0;
 }
 
-static float clampf(float v, float hi)
+/* Clips segment (ax, ay)-(bx, by), in bucket units, to [0, w] x [0, h]
+ * (Liang-Barsky); 0 if nothing is left. Parts outside the area are farther
+ * than its margin from every data point, so they matter to no query. */
+static int clip(float *ax, float *ay, float *bx, float *by, float w, float h)
 {
-    return v < 0.0f ? 0.0f : (v > hi ? hi : v);
+    float dx = *bx - *ax, dy = *by - *ay, t0 = 0.0f, t1 = 1.0f;
+    float p[4] = {-dx, dx, -dy, dy}, q[4] = {*ax, w - *ax, *ay, h - *ay};
+    for (int i = 0; i < 4; i++) {
+        if (p[i] == 0.0f) {
+            if (q[i] < 0.0f)
+                return 0;
+            continue;
+        }
+        float r = q[i] / p[i];
+        if (p[i] < 0.0f) {
+            if (r > t1) return 0;
+            if (r > t0) t0 = r;
+        } else {
+            if (r < t0) return 0;
+            if (r < t1) t1 = r;
+        }
+    }
+    float x0 = *ax + t0 * dx, y0 = *ay + t0 * dy;
+    *bx = *ax + t1 * dx;
+    *by = *ay + t1 * dy;
+    *ax = x0;
+    *ay = y0;
+    return 1;
 }
 
 void polyc__segment_buckets(polyc__opt *o, float ax, float ay, float bx, float by, int dilate,
@@ -120,10 +145,12 @@ void polyc__segment_buckets(polyc__opt *o, float ax, float ay, float bx, float b
     const polyc__hash *h = &o->h;
     float wx = (float)h->bx - 0.001f, wy = (float)h->by - 0.001f;
     polyc__beam b;
-    b.sx = clampf((ax - h->origin_x) * h->inv_bucket, wx);
-    b.sy = clampf((ay - h->origin_y) * h->inv_bucket, wy);
-    b.ex = clampf((bx - h->origin_x) * h->inv_bucket, wx);
-    b.ey = clampf((by - h->origin_y) * h->inv_bucket, wy);
+    b.sx = (ax - h->origin_x) * h->inv_bucket;
+    b.sy = (ay - h->origin_y) * h->inv_bucket;
+    b.ex = (bx - h->origin_x) * h->inv_bucket;
+    b.ey = (by - h->origin_y) * h->inv_bucket;
+    if (!clip(&b.sx, &b.sy, &b.ex, &b.ey, wx, wy))
+        return;
     b.hit = 1;
     b.miss_end = 1.0f;
     walk_ctx w = {o, fn, dilate};

@@ -190,6 +190,60 @@ static int redundant(const int32_t *a, const int32_t *b, const int32_t *c)
     return ux * vy - uy * vx == 0 && ux * vx + uy * vy >= 0;
 }
 
+/* Douglas-Peucker with a tolerance of half a cell, in place: on walls that
+ * are not grid-aligned the walk is a staircase whose steps are pure
+ * discretisation (the paper's length rule removes them only on aligned
+ * walls). Explicit stack: no recursion; a full stack keeps the rest. */
+#define DP_STACK 48
+static uint32_t simplify(int32_t *xy, uint32_t n)
+{
+    if (n < 3)
+        return n;
+    uint32_t lo[DP_STACK], hi[DP_STACK];
+    int top = 0;
+    lo[0] = 0;
+    hi[0] = n - 1;
+    top = 1;
+    /* keep[i]: the x of a dropped point is set to INT32_MIN below */
+    while (top > 0) {
+        top--;
+        uint32_t a = lo[top], b = hi[top];
+        if (b <= a + 1)
+            continue;
+        double ax = xy[2 * a], ay = xy[2 * a + 1], dx = xy[2 * b] - ax, dy = xy[2 * b + 1] - ay;
+        double len = sqrt(dx * dx + dy * dy);
+        double worst = -1.0;
+        uint32_t at = a;
+        for (uint32_t i = a + 1; i < b; i++) {
+            double px = xy[2 * i] - ax, py = xy[2 * i + 1] - ay;
+            double d = len > 0.0 ? fabs(px * dy - py * dx) / len : sqrt(px * px + py * py);
+            if (d > worst) {
+                worst = d;
+                at = i;
+            }
+        }
+        if (worst <= 0.5 || top + 2 > DP_STACK) {
+            if (worst <= 0.5)
+                for (uint32_t i = a + 1; i < b; i++)
+                    xy[2 * i] = INT32_MIN;
+            continue;
+        }
+        lo[top] = a;
+        hi[top++] = at;
+        lo[top] = at;
+        hi[top++] = b;
+    }
+    uint32_t m = 0;
+    for (uint32_t i = 0; i < n; i++) {
+        if (xy[2 * i] == INT32_MIN)
+            continue;
+        xy[2 * m] = xy[2 * i];
+        xy[2 * m + 1] = xy[2 * i + 1];
+        m++;
+    }
+    return m;
+}
+
 static polyc_status emit(polyc_ctx *ctx, walk *w, int closed)
 {
     const polyc__grid *g = &ctx->grid;
@@ -215,6 +269,7 @@ static polyc_status emit(polyc_ctx *ctx, walk *w, int closed)
         if (m >= 4 && redundant(&w->xy[2 * (m - 2)], &w->xy[2 * (m - 1)], &w->xy[0]))
             m--;
     }
+    m = simplify(w->xy, m);
     if (closed && m < 3)
         closed = 0;
     int32_t l = polyc__line_new(s);

@@ -243,6 +243,23 @@ static void pipeline_close(pipeline *p)
     p->block = NULL;
 }
 
+/* polyc_limits_for_scans sizes vertices and points for a usual map; as
+ * the polyc tool does, a map that needs more runs again with the worst case. */
+static int pipeline_grow(pipeline *p)
+{
+    if (p->status != POLYC_ERR_NOMEM || (!p->limits.max_vertices && !p->limits.max_points))
+        return -1;
+    p->limits.max_vertices = p->limits.max_points = 0;
+    free(p->block);
+    p->block_size = polyc_memory_size(&p->config, &p->limits);
+    p->block = p->block_size ? malloc(p->block_size) : NULL;
+    if (!p->block)
+        return -1;
+    p->failed_at = NULL;
+    p->status = POLYC_OK;
+    return 0;
+}
+
 /* init, add, grid, contour, trace, optimise; times[] gets each stage. */
 static int pipeline_run(pipeline *p, const polyc_scan *scans, uint32_t n, double *times)
 {
@@ -262,11 +279,11 @@ static int pipeline_run(pipeline *p, const polyc_scan *scans, uint32_t n, double
         return -1;
     t1 = now_ms(); times[ST_CONTOUR] = t1 - t; t = t1;
     if (step(p, polyc_trace(p->ctx), "polyc_trace"))
-        return -1;
+        return pipeline_grow(p) ? -1 : pipeline_run(p, scans, n, times);
     t1 = now_ms(); times[ST_TRACE] = t1 - t; t = t1;
     if (p->config.max_iterations > 0 &&
         step(p, polyc_optimize(p->ctx, NULL, NULL), "polyc_optimize"))
-        return -1;
+        return pipeline_grow(p) ? -1 : pipeline_run(p, scans, n, times);
     times[ST_OPT] = now_ms() - t;
     return 0;
 }
