@@ -481,7 +481,9 @@ int polyc__op_trim_ends(polyc__opt *o)
 
 /* A vertex where the polyline folds back on itself (turn above 150 degrees)
  * is a zigzag left by vertex moves: it goes, unless that raises the BIC (a
- * fold can be real: removing every fold unconditionally lost whole walls). */
+ * fold can be real: removing every fold unconditionally lost whole walls).
+ * A spike (turn above 120 degrees on two legs shorter than 30 cm, as moves
+ * leave at corners) goes even if the BIC rises by up to one vertex's worth. */
 int polyc__op_zigzag(polyc__opt *o)
 {
     polyc__store *s = o->s;
@@ -493,10 +495,13 @@ int polyc__op_zigzag(polyc__opt *o)
         const polyc__vertex *a = &s->v[c->prev], *b = &s->v[c->next];
         float ux = c->x - a->x, uy = c->y - a->y, wx = b->x - c->x, wy = b->y - c->y;
         float lu = sqrtf(ux * ux + uy * uy), lw = sqrtf(wx * wx + wy * wy);
+        float dot = ux * wx + uy * wy;
         /* (a zero-length segment counts: its vertex is a duplicate) */
-        if (lu * lw > 0.0f && (ux * wx + uy * wy) > -0.866f * lu * lw)
+        int fold = lu * lw <= 0.0f || dot < -0.866f * lu * lw;
+        int spike = lu < 0.3f && lw < 0.3f && dot < -0.5f * lu * lw;
+        if (!fold && !spike)
             continue;
-        if (polyc__removal_delta(o, v) > 0.0)
+        if (polyc__removal_delta(o, v) > (spike ? o->log_n : 0.0))
             continue;
         polyc__chg_begin(o);
         polyc__op_remove(o, v);

@@ -161,9 +161,12 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
         polyc__op_adjust(&o, ADJUST_ROUNDS, mark);
         /* moves and additions can leave segments without data or hairpins:
          * clean them before the model is judged, so the best one is clean */
-        mark = ++o.touch_stamp;
-        if (polyc__op_split(&o) + polyc__op_zigzag(&o) + polyc__op_corners(&o) > 0)
+        for (int round = 0; round < 3; round++) {
+            mark = ++o.touch_stamp;
+            if (polyc__op_split(&o) + polyc__op_zigzag(&o) + polyc__op_corners(&o) == 0)
+                break;
             polyc__op_adjust(&o, ADJUST_ROUNDS, mark);
+        }
         polyc__op_trim_ends(&o); /* last: moves could push ends past the data */
         if (o.h.out_of_entries)
             return polyc__fail(ctx, POLYC_ERR_NOMEM, "spatial hash full");

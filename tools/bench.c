@@ -42,6 +42,7 @@ static const char usage_text[] =
     "  --alpha A, --gamma G, --cell M, --grazing C, --data-min M\n"
     "                   override polyc_config's alpha, gamma, cell_m,\n"
     "                   grazing_cells, data_min_m (default: the library's)\n"
+    "  --seed N         the optimiser's PRNG seed (default: the library's)\n"
     "  -h, --help       this text\n"
     "Columns: stage times in ms (parse = reading the log, add = polyc_add_scan,\n"
     "grid, contour, trace, optimise, output = JSON to /dev/null); block and used\n"
@@ -62,6 +63,7 @@ typedef struct options {
     long iterations;           /* < 0: library default */
     double alpha, gamma, cell; /* <= 0 (gamma < 0): library default */
     double grazing, data_min;  /* < 0: library default */
+    long seed;                 /* < 0: library default */
     const char *data;
 } options;
 
@@ -225,6 +227,8 @@ static int pipeline_open(pipeline *p, const options *o, const polyc_scan *scans,
         p->config.grazing_cells = (float)o->grazing;
     if (o->data_min >= 0.0)
         p->config.data_min_m = (float)o->data_min;
+    if (o->seed >= 0)
+        p->config.seed = (uint64_t)o->seed;
     if (step(p, polyc_limits_for_scans(&p->config, scans, n, &p->limits),
              "polyc_limits_for_scans"))
         return -1;
@@ -537,6 +541,7 @@ static int parse_options(int argc, char **argv, options *o)
     o->single = 10;
     o->iterations = -1;
     o->gamma = o->grazing = o->data_min = -1.0;
+    o->seed = -1;
     for (i = 1; i < argc; i++) {
         const char *a = argv[i];
         if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
@@ -566,6 +571,10 @@ static int parse_options(int argc, char **argv, options *o)
             else if (strcmp(a, "--cell") == 0) o->cell = d;
             else if (strcmp(a, "--grazing") == 0) o->grazing = d;
             else o->data_min = d;
+        } else if (strcmp(a, "--seed") == 0 && i + 1 < argc) {
+            if (parse_count(argv[++i], 0, 2147483647, &v))
+                return -1;
+            o->seed = v;
         } else if (strcmp(a, "--only") == 0 && i + 1 < argc) {
             o->only = argv[++i];
         } else if (a[0] == '-' || o->data) {
