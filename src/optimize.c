@@ -8,7 +8,7 @@
 #include <math.h>
 #include <string.h>
 
-#define ADJUST_ROUNDS 20
+#define ADJUST_ROUNDS 4
 #define ADD_ROUNDS 4
 #define ADDED_CAP 64
 
