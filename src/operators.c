@@ -334,8 +334,9 @@ static int cmp_float(const void *a, const void *b)
 }
 
 /* A segment with a stretch longer than split_gap_m (or 2.5 beam spacings
- * where the data are sparser than that) onto which no data point projects
- * is cut there: the polyline ends on either side of the gap. */
+ * where the data are sparser than that), plus the span of a weighted point,
+ * onto which no data point projects is cut there: the polyline ends on
+ * either side of the gap. */
 int polyc__op_split(polyc__opt *o)
 {
     polyc__store *s = o->s;
@@ -389,7 +390,8 @@ int polyc__op_split(polyc__opt *o)
          * spacings between neighbouring points: those are no gaps */
         float gx = a->x + (b->x - a->x) * (g0 + 0.5f * best) / len;
         float gy = a->y + (b->y - a->y) * (g0 + 0.5f * best) / len;
-        float need = fmaxf(gap_min, 2.5f * polyc__spacing_at(&o->spacing, gx, gy));
+        float need = fmaxf(gap_min, 2.5f * polyc__spacing_at(&o->spacing, gx, gy)) +
+                     o->point_span_m;
         if (best > need && n_cut < o->cut_cap) {
             o->cut_seg[n_cut] = v;
             o->cut_next[n_cut] = a->next;

@@ -23,6 +23,7 @@ typedef struct polyc__opt {
     double *pt_cost;               /* capped cost of the point's endpoints */
     double n, log_n;               /* BIC's n: every endpoint */
     float R, R2;                   /* search radius: the cost of a point is capped at w R^2 */
+    float point_span_m;            /* side of the block a weighted point stands for */
 
     /* model terms, kept incrementally */
     double err;                    /* sum of pt_cost */

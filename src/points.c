@@ -218,6 +218,10 @@ polyc_status polyc__points_collect(polyc__opt *o)
     ctx->arena.used = mark;
     o->np = n;
     o->n = total;
+    /* the span of one weighted point: gaps between points shorter than it
+     * say nothing (split) */
+    o->point_span_m = (o->cfg->flags & POLYC_FLAG_EXACT_POINTS) ? 0.0f
+                                                               : ctx->grid.cell_m * (float)BLOCK_SIDE;
     ctx->point_weight = total;
     ctx->stats.data_points = (uint64_t)total;
     ctx->stats.weighted_points = (uint32_t)n;
