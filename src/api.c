@@ -53,7 +53,7 @@ void polyc_config_default(polyc_config *c)
     c->contour_threshold = 0.5f;
     c->data_min_m = 0.2f;
     c->free_range_m = 10.0f;
-    c->grazing_cells = 3.0f;
+    c->grazing_cells = 4.0f;
     c->max_extent_m = 2000.0f;
     c->alpha = 500.0f;
     c->gamma = 0.02f;
@@ -63,7 +63,7 @@ void polyc_config_default(polyc_config *c)
     c->noise_m = 0.05f;
     c->noise_decay = 0.7f;
     c->overlap_m = 0.05f;
-    c->search_radius_m = 0.25f;
+    c->search_radius_m = 0.15f;
     c->patience = 5;
     c->max_iterations = 100;
     c->flags = 0;
