@@ -45,7 +45,8 @@ static int end_cell(polyc_ctx *ctx, const polyc__walk *w)
 
 /* Occupancy of the grid's whole box, one bit per cell, row after row, with a
  * border of set bits. A set bit stops the walk: an occupied cell, or the
- * edge of the grid or an untouched tile, where the walk stops unlabelled. */
+ * edge of the grid, where it stops unlabelled. (Tiles the grid did not store
+ * hold no hit, so no occupied cell.) */
 typedef struct occ_map {
     uint32_t *bits;
     ptrdiff_t stride;              /* width + 2 */
@@ -79,13 +80,12 @@ static void occ_fill(occ_map *m, const polyc__grid *g)
     m->stride = (ptrdiff_t)g->width + 2;
     for (int32_t ty = 0; ty < g->tiles_y; ty++)
         for (int32_t tx = 0; tx < g->tiles_x; tx++) {
-            const polyc__tile *t = polyc__grid_tile(g, tx << POLYC__TILE_SHIFT, ty << POLYC__TILE_SHIFT);
             int32_t x0 = tx << POLYC__TILE_SHIFT, y0 = ty << POLYC__TILE_SHIFT;
+            const polyc__tile *t = polyc__grid_tile(g, x0, y0);
             int32_t cols = g->width - x0 < POLYC__TILE_SIDE ? g->width - x0 : POLYC__TILE_SIDE;
-            uint32_t in_grid = cols == 32 ? ~0u : (1u << cols) - 1u;
-            for (int32_t r = 0; r < POLYC__TILE_SIDE && y0 + r < g->height; r++)
-                occ_set_bits(m, (ptrdiff_t)(y0 + r + 1) * m->stride + x0 + 1,
-                             (t ? t->mark[r] : ~0u) & in_grid);
+            uint32_t in_grid = cols == POLYC__TILE_SIDE ? ~0u : (1u << cols) - 1u;
+            for (int32_t r = 0; t && r < POLYC__TILE_SIDE && y0 + r < g->height; r++)
+                occ_set_bits(m, (ptrdiff_t)(y0 + r + 1) * m->stride + x0 + 1, t->mark[r] & in_grid);
         }
     for (ptrdiff_t x = 0; x < m->stride; x++) {
         occ_set_bits(m, x, 1u);
@@ -106,7 +106,7 @@ static int walk_map(polyc_ctx *ctx, const occ_map *m, polyc__walk *w)
     while (w->n > 0) {
         if (occ_bit(m, p)) {
             int32_t ix = (int32_t)(p % m->stride) - 1, iy = (int32_t)(p / m->stride) - 1;
-            if (ix < 0 || iy < 0 || ix >= g->width || iy >= g->height || !polyc__grid_tile(g, ix, iy))
+            if (ix < 0 || iy < 0 || ix >= g->width || iy >= g->height)
                 return 1;
             return label(ctx, ix, iy);
         }
@@ -127,14 +127,14 @@ static int walk_tiles(polyc_ctx *ctx, polyc__walk *w)
 {
     const polyc__grid *g = &ctx->grid;
     const polyc__tile *t = polyc__grid_tile(g, w->ix, w->iy);
-    if (!t)
-        return 1;
     while (w->n > 0) {
-        if (occupied(t, w->idx))
+        if (t && occupied(t, w->idx))
             return label(ctx, w->ix, w->iy);
-        if (polyc__walk_step(w) && w->n > 0 &&
-            (!polyc__walk_enter(w, g->width, g->height) || !(t = polyc__grid_tile(g, w->ix, w->iy))))
-            return 1;
+        if (polyc__walk_step(w) && w->n > 0) {
+            if (!polyc__walk_enter(w, g->width, g->height))
+                return 1;
+            t = polyc__grid_tile(g, w->ix, w->iy);
+        }
     }
     return end_cell(ctx, w);
 }

@@ -1,7 +1,7 @@
 /* grid.c - the hit/miss grid (paper section III, eq. 1).
  * Takes: the stored scans. Gives: per cell hits and misses, counted by exact
- * traversal of every beam (Amanatides-Woo), in 32 x 32 tiles allocated only
- * where beams pass, over the extent of the data. */
+ * traversal of every beam (Amanatides-Woo), in 32 x 32 tiles over the extent
+ * of the data, stored only where some beam ends in a hit. */
 #include "walk.h"
 
 #include <math.h>
@@ -17,13 +17,21 @@ static void count_inc(polyc__count *a, polyc__count *b)
     (*a)++;
 }
 
+/* bytes of the bit per directory entry that says a tile is wanted */
+static size_t wanted_bytes(size_t dir_n)
+{
+    return polyc__bytes(dir_n / 32 + 1, sizeof(uint32_t));
+}
+
 size_t polyc__grid_budget_bytes(const polyc_limits *lim)
 {
     size_t tiles = ((size_t)lim->max_grid_cells + POLYC__TILE_CELLS - 1) / POLYC__TILE_CELLS;
     /* directory: one entry per tile of the bounding box; a bounding box up to
      * 4x the tile budget (plus a small fixed part) fits */
-    size_t dir = polyc__bytes(tiles * 4 + 64, sizeof(uint32_t));
-    return polyc__add(polyc__bytes(tiles, sizeof(polyc__tile)), dir);
+    size_t dir_n = tiles * 4 + 64;
+    size_t dir = polyc__add(polyc__bytes(dir_n, sizeof(uint32_t)), wanted_bytes(dir_n));
+    /* the tiles and one more, the spill tile of count_beam */
+    return polyc__add(polyc__bytes(tiles + 1, sizeof(polyc__tile)), dir);
 }
 
 int polyc__cell_occupied(const polyc__tile *t, int idx, float threshold)
@@ -169,49 +177,64 @@ void polyc__traverse(const polyc__beam *b, polyc__cell_fn visit, void *u)
     visit(u, w.ex, w.ey, w.t, 1);
 }
 
-/* The tile of cell (ix, iy) inside the grid, allocated on first use; NULL
- * when the tile budget is spent (out_of_tiles). Tiles stay contiguous
- * because nothing else allocates during the grid pass. */
-static polyc__tile *tile_get(polyc__grid *g, polyc__arena *a, int32_t ix, int32_t iy)
+/* The grid pass stores a tile only where some beam ends in a hit (`wanted`,
+ * a bit per directory entry from a pass over the endpoints). Elsewhere the
+ * misses go to `spill`, a scratch tile that is never read: a tile without a
+ * hit holds no occupied cell and no data point, so nothing downstream needs
+ * it, and outdoors such free space is most of what the beams cross. */
+typedef struct count_pass {
+    polyc__grid *g;
+    polyc__arena *a;
+    const uint32_t *wanted;
+    polyc__tile *spill;
+} count_pass;
+
+/* The tile of cell (ix, iy) inside the grid: stored (allocated on first use
+ * if wanted) or the spill tile; NULL when the tile budget is spent
+ * (out_of_tiles). Tiles stay contiguous: nothing else allocates meanwhile. */
+static polyc__tile *tile_get(const count_pass *p, int32_t ix, int32_t iy)
 {
-    uint32_t *d = &g->dir[(iy >> POLYC__TILE_SHIFT) * g->tiles_x + (ix >> POLYC__TILE_SHIFT)];
-    if (*d == 0) {
+    polyc__grid *g = p->g;
+    size_t d = (size_t)(iy >> POLYC__TILE_SHIFT) * (size_t)g->tiles_x + (size_t)(ix >> POLYC__TILE_SHIFT);
+    if (g->dir[d] == 0) {
+        if (!((p->wanted[d >> 5] >> (d & 31)) & 1u))
+            return p->spill;
         if (g->tile_count >= g->tile_cap) {
             g->out_of_tiles = 1;
             return NULL;
         }
-        polyc__tile *t = polyc__alloc_zero(a, 1, sizeof(polyc__tile));
+        polyc__tile *t = polyc__alloc_zero(p->a, 1, sizeof(polyc__tile));
         if (!t || t != g->tiles + g->tile_count) {
             g->out_of_tiles = 1;
             return NULL;
         }
-        *d = ++g->tile_count;
+        g->dir[d] = ++g->tile_count;
     }
-    return &g->tiles[*d - 1];
+    return &g->tiles[g->dir[d] - 1];
 }
 
 /* One beam into the counters: a miss in every cell the beam enters before
- * miss_end, a hit in the end cell of a reflection. Every cell walked gets
- * its tile, even past miss_end; the walk stops at the grid's edge. The tile
- * directory is read only when the walk crosses into another tile. */
-static void count_beam(polyc__grid *g, polyc__arena *a, const polyc__beam *b)
+ * miss_end, a hit in the end cell of a reflection; the walk stops at the
+ * grid's edge. The tile is looked up only when the walk crosses into
+ * another one. */
+static void count_beam(const count_pass *p, const polyc__beam *b)
 {
+    polyc__grid *g = p->g;
     polyc__walk w;
     polyc__walk_start(&w, b);
     const float miss_end = b->miss_end;
     polyc__tile *t = NULL;
-    if (w.n > 0 && (!polyc__walk_enter(&w, g->width, g->height) || !(t = tile_get(g, a, w.ix, w.iy))))
+    if (w.n > 0 && (!polyc__walk_enter(&w, g->width, g->height) || !(t = tile_get(p, w.ix, w.iy))))
         return;
     while (w.n > 0) {
         if (w.t < miss_end)
             count_inc(&t->misses[w.idx], &t->hits[w.idx]);
         if (polyc__walk_step(&w) && w.n > 0 &&
-            (!polyc__walk_enter(&w, g->width, g->height) || !(t = tile_get(g, a, w.ix, w.iy))))
+            (!polyc__walk_enter(&w, g->width, g->height) || !(t = tile_get(p, w.ix, w.iy))))
             return;
     }
     /* the end cell, where the walk is unless rounding took it elsewhere */
-    if (w.ex < 0 || w.ey < 0 || w.ex >= g->width || w.ey >= g->height ||
-        !(t = tile_get(g, a, w.ex, w.ey)))
+    if (w.ex < 0 || w.ey < 0 || w.ex >= g->width || w.ey >= g->height || !(t = tile_get(p, w.ex, w.ey)))
         return;
     int idx = polyc__cell_index(w.ex, w.ey);
     if (b->hit)
@@ -248,17 +271,33 @@ polyc_status polyc__grid_build(polyc_ctx *ctx)
 
     size_t budget = polyc__grid_budget_bytes(&ctx->lim);
     size_t dir_n = (size_t)g->tiles_x * (size_t)g->tiles_y;
-    size_t dir_bytes = polyc__bytes(dir_n, sizeof(uint32_t));
-    if (dir_bytes == 0 || dir_bytes >= budget)
+    size_t fixed = polyc__add(polyc__add(polyc__bytes(dir_n, sizeof(uint32_t)), wanted_bytes(dir_n)),
+                              polyc__bytes(1, sizeof(polyc__tile)));
+    if (polyc__bytes(dir_n, sizeof(uint32_t)) == 0 || fixed >= budget)
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "grid extent too large for limits.max_grid_cells");
+    count_pass p;
+    p.g = g;
+    p.a = &ctx->arena;
     g->dir = polyc__alloc_zero(&ctx->arena, dir_n, sizeof(uint32_t));
-    if (!g->dir)
+    uint32_t *wanted = polyc__alloc_zero(&ctx->arena, dir_n / 32 + 1, sizeof(uint32_t));
+    p.spill = polyc__alloc_zero(&ctx->arena, 1, sizeof(polyc__tile));
+    if (!g->dir || !wanted || !p.spill)
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the grid directory");
-    g->tile_cap = (uint32_t)((budget - dir_bytes) / sizeof(polyc__tile));
-    /* tiles are allocated one by one as beams reach them; they stay
-     * contiguous because nothing else allocates during this pass */
+    p.wanted = wanted;
+    g->tile_cap = (uint32_t)((budget - fixed) / sizeof(polyc__tile));
     g->tiles = (polyc__tile *)(ctx->arena.base + ctx->arena.used);
 
+    for (uint32_t si = 0; si < ctx->scan_count; si++)
+        for (uint32_t i = 0; i < ctx->scans[si].count; i++) {
+            polyc__beam b;
+            if (!polyc__beam_path(ctx, &ctx->scans[si], i, &b) || !b.hit)
+                continue;
+            int32_t ix = (int32_t)floorf(b.ex), iy = (int32_t)floorf(b.ey);
+            if (ix >= 0 && iy >= 0 && ix < g->width && iy < g->height) {
+                size_t d = (size_t)(iy >> POLYC__TILE_SHIFT) * (size_t)g->tiles_x + (size_t)(ix >> POLYC__TILE_SHIFT);
+                wanted[d >> 5] |= 1u << (d & 31);
+            }
+        }
     for (uint32_t si = 0; si < ctx->scan_count; si++) {
         const polyc__scan *s = &ctx->scans[si];
         step_rot rot = {cosf(s->step_rad), sinf(s->step_rad)};
@@ -266,7 +305,7 @@ polyc_status polyc__grid_build(polyc_ctx *ctx)
             polyc__beam b;
             if (!beam_fill(ctx, s, i, &b, 1, &rot))
                 continue;
-            count_beam(g, &ctx->arena, &b);
+            count_beam(&p, &b);
             if (g->out_of_tiles)
                 return polyc__fail(ctx, POLYC_ERR_NOMEM,
                                    "grid needs more cells than limits.max_grid_cells");
@@ -275,6 +314,6 @@ polyc_status polyc__grid_build(polyc_ctx *ctx)
     ctx->stats.grid_width = (uint32_t)g->width;
     ctx->stats.grid_height = (uint32_t)g->height;
     ctx->stats.grid_tiles = g->tile_count;
-    ctx->stats.grid_bytes = (uint64_t)dir_bytes + (uint64_t)g->tile_count * sizeof(polyc__tile);
+    ctx->stats.grid_bytes = (uint64_t)fixed + (uint64_t)g->tile_count * sizeof(polyc__tile);
     return POLYC_OK;
 }

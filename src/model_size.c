@@ -121,9 +121,7 @@ int polyc__op_remove_vertices(polyc__opt *o, uint32_t since)
             continue;
         }
         int32_t p = s->v[e.v].prev, n = s->v[e.v].next;
-        polyc__chg_begin(o);
-        polyc__op_remove(o, e.v);
-        polyc__chg_commit(o);
+        polyc__apply_remove(o, e.v);
         removed++;
         /* the neighbours' removals changed: offer them again */
         int32_t nb[2] = {p, n};

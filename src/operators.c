@@ -156,6 +156,21 @@ int polyc__op_link(polyc__opt *o, int32_t tail, int32_t head)
     return 1;
 }
 
+/* One edit as a change of its own. */
+void polyc__apply_remove(polyc__opt *o, int32_t v)
+{
+    polyc__chg_begin(o);
+    polyc__op_remove(o, v);
+    polyc__chg_commit(o);
+}
+
+void polyc__apply_move(polyc__opt *o, int32_t v, float x, float y)
+{
+    polyc__chg_begin(o);
+    polyc__op_move(o, v, x, y);
+    polyc__chg_commit(o);
+}
+
 /* ---- geometry helpers ---- */
 
 static float seg_dist2(float px, float py, float ax, float ay, float bx, float by)
@@ -231,9 +246,7 @@ int polyc__op_overlaps(polyc__opt *o)
                 if (other_dist2(o, s->v[e].x, s->v[e].y, e) > lim2 ||
                     other_dist2(o, s->v[e2].x, s->v[e2].y, e2) > lim2)
                     break;
-                polyc__chg_begin(o);
-                polyc__op_remove(o, e);
-                polyc__chg_commit(o);
+                polyc__apply_remove(o, e);
                 changed++;
             }
         }
@@ -464,15 +477,11 @@ int polyc__op_trim_ends(polyc__opt *o)
         float margin = fmaxf(0.01f, 0.5f * polyc__spacing_at(&o->spacing, bx, by)) / len;
         float keep_tail = o->split_t[v] + margin, keep_head = o->trim_head[v] + margin;
         if (s->v[w].next == POLYC__NONE && o->split_t[v] >= 0.0f && keep_tail < 1.0f) {
-            polyc__chg_begin(o);
-            polyc__op_move(o, w, ax + keep_tail * (bx - ax), ay + keep_tail * (by - ay));
-            polyc__chg_commit(o);
+            polyc__apply_move(o, w, ax + keep_tail * (bx - ax), ay + keep_tail * (by - ay));
             changed++;
         }
         if (a->prev == POLYC__NONE && o->trim_head[v] >= 0.0f && keep_head < 1.0f) {
-            polyc__chg_begin(o);
-            polyc__op_move(o, v, bx + keep_head * (ax - bx), by + keep_head * (ay - by));
-            polyc__chg_commit(o);
+            polyc__apply_move(o, v, bx + keep_head * (ax - bx), by + keep_head * (ay - by));
             changed++;
         }
     }
@@ -505,9 +514,7 @@ int polyc__op_zigzag(polyc__opt *o)
             continue;
         if (polyc__removal_delta(o, v) > (spike ? o->log_n : 0.0))
             continue;
-        polyc__chg_begin(o);
-        polyc__op_remove(o, v);
-        polyc__chg_commit(o);
+        polyc__apply_remove(o, v);
         changed++;
     }
     return changed;
