@@ -144,7 +144,7 @@ typedef struct polyc_stats {
     uint32_t scans;
     uint32_t grid_width;       /* grid size in cells */
     uint32_t grid_height;
-    uint32_t grid_tiles;       /* tiles allocated */
+    uint32_t grid_tiles;       /* tiles stored (those where some beam ends in a hit) */
     uint32_t contour_cells;
     uint32_t initial_polylines;
     uint32_t initial_vertices;
@@ -241,7 +241,9 @@ POLYC_API polyc_status polyc_get_stats(const polyc_ctx *ctx, polyc_stats *out);
 POLYC_API polyc_status polyc_score(polyc_ctx *ctx, double *bic, double *error_sq_m2);
 
 /* The grid (after polyc_build_grid): origin of cell (0, 0)'s lower-left
- * corner, size, and one cell's counters (0, 0 for cells never reached). */
+ * corner, size, and one cell's counters. Only tiles of 32 x 32 cells where
+ * some beam ends in a hit are stored: elsewhere (and in cells never reached)
+ * hits and misses read 0. */
 POLYC_API polyc_status polyc_grid_info(const polyc_ctx *ctx, double *origin_x_m,
                                        double *origin_y_m, float *cell_m, uint32_t *width,
                                        uint32_t *height);

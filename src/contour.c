@@ -156,7 +156,8 @@ polyc_status polyc__contour_build(polyc_ctx *ctx)
 {
     polyc__grid *g = &ctx->grid;
     ctx->contour_count = 0;
-    ctx->contour_xy = polyc__alloc(&ctx->arena, (size_t)ctx->lim.max_beams * 2 + 2, sizeof(int32_t));
+    ctx->contour_xy = polyc__alloc(&ctx->arena, (size_t)ctx->lim.max_beams * 2 + 2,
+                                   sizeof(int32_t));
     if (!ctx->contour_xy)
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the contour");
     /* m > threshold once per cell, as bits in the scratch marks */
@@ -178,7 +179,9 @@ polyc_status polyc__contour_build(polyc_ctx *ctx)
     size_t mark = ctx->arena.used;
     occ_map map = {NULL, 0};
     size_t words = occ_words(g);
-    if (g->tile_count > 0 && words > 0 && (map.bits = polyc__alloc(&ctx->arena, words, sizeof(uint32_t))))
+    if (g->tile_count > 0 && words > 0)
+        map.bits = polyc__alloc(&ctx->arena, words, sizeof(uint32_t));
+    if (map.bits)
         occ_fill(&map, g);
     int full = 0;
     for (uint32_t si = 0; si < ctx->scan_count; si++) {

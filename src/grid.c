@@ -41,11 +41,18 @@ int polyc__cell_occupied(const polyc__tile *t, int idx, float threshold)
     return h > 0 && (float)h > threshold * (float)(h + m);
 }
 
+/* directory entry of the tile of cell (ix, iy), inside the grid */
+static size_t dir_index(const polyc__grid *g, int32_t ix, int32_t iy)
+{
+    size_t tx = (size_t)(ix >> POLYC__TILE_SHIFT), ty = (size_t)(iy >> POLYC__TILE_SHIFT);
+    return ty * (size_t)g->tiles_x + tx;
+}
+
 polyc__tile *polyc__grid_tile(const polyc__grid *g, int32_t ix, int32_t iy)
 {
     if (ix < 0 || iy < 0 || ix >= g->width || iy >= g->height)
         return NULL;
-    uint32_t d = g->dir[(iy >> POLYC__TILE_SHIFT) * g->tiles_x + (ix >> POLYC__TILE_SHIFT)];
+    uint32_t d = g->dir[dir_index(g, ix, iy)];
     return d ? &g->tiles[d - 1] : NULL;
 }
 
@@ -195,7 +202,7 @@ typedef struct count_pass {
 static polyc__tile *tile_get(const count_pass *p, int32_t ix, int32_t iy)
 {
     polyc__grid *g = p->g;
-    size_t d = (size_t)(iy >> POLYC__TILE_SHIFT) * (size_t)g->tiles_x + (size_t)(ix >> POLYC__TILE_SHIFT);
+    size_t d = dir_index(g, ix, iy);
     if (g->dir[d] == 0) {
         if (!((p->wanted[d >> 5] >> (d & 31)) & 1u))
             return p->spill;
@@ -234,7 +241,8 @@ static void count_beam(const count_pass *p, const polyc__beam *b)
             return;
     }
     /* the end cell, where the walk is unless rounding took it elsewhere */
-    if (w.ex < 0 || w.ey < 0 || w.ex >= g->width || w.ey >= g->height || !(t = tile_get(p, w.ex, w.ey)))
+    if (w.ex < 0 || w.ey < 0 || w.ex >= g->width || w.ey >= g->height ||
+        !(t = tile_get(p, w.ex, w.ey)))
         return;
     int idx = polyc__cell_index(w.ex, w.ey);
     if (b->hit)
@@ -271,9 +279,10 @@ polyc_status polyc__grid_build(polyc_ctx *ctx)
 
     size_t budget = polyc__grid_budget_bytes(&ctx->lim);
     size_t dir_n = (size_t)g->tiles_x * (size_t)g->tiles_y;
-    size_t fixed = polyc__add(polyc__add(polyc__bytes(dir_n, sizeof(uint32_t)), wanted_bytes(dir_n)),
-                              polyc__bytes(1, sizeof(polyc__tile)));
-    if (polyc__bytes(dir_n, sizeof(uint32_t)) == 0 || fixed >= budget)
+    size_t dir_bytes = polyc__bytes(dir_n, sizeof(uint32_t));
+    size_t fixed = polyc__add(polyc__add(dir_bytes, wanted_bytes(dir_n)),
+                              polyc__bytes(1, sizeof(polyc__tile))); /* + the spill tile */
+    if (dir_bytes == 0 || fixed >= budget)
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "grid extent too large for limits.max_grid_cells");
     count_pass p;
     p.g = g;
@@ -294,7 +303,7 @@ polyc_status polyc__grid_build(polyc_ctx *ctx)
                 continue;
             int32_t ix = (int32_t)floorf(b.ex), iy = (int32_t)floorf(b.ey);
             if (ix >= 0 && iy >= 0 && ix < g->width && iy < g->height) {
-                size_t d = (size_t)(iy >> POLYC__TILE_SHIFT) * (size_t)g->tiles_x + (size_t)(ix >> POLYC__TILE_SHIFT);
+                size_t d = dir_index(g, ix, iy);
                 wanted[d >> 5] |= 1u << (d & 31);
             }
         }

@@ -67,7 +67,7 @@ typedef struct polyc__grid {
     float cell_m, inv_cell;
     int32_t width, height;         /* cells */
     int32_t tiles_x, tiles_y;
-    uint32_t *dir;                 /* tiles_x * tiles_y; 0 = untouched, else index + 1 */
+    uint32_t *dir;                 /* tiles_x * tiles_y; 0 = not stored, else index + 1 */
     polyc__tile *tiles;            /* contiguous, tile_count used of tile_cap */
     uint32_t tile_count, tile_cap;
     int out_of_tiles;              /* set when a beam needed a tile past tile_cap */
@@ -223,7 +223,8 @@ polyc_status polyc__fail(polyc_ctx *ctx, polyc_status st, const char *msg);
 size_t polyc__grid_budget_bytes(const polyc_limits *lim);
 polyc_status polyc__grid_build(polyc_ctx *ctx);
 polyc__tile *polyc__grid_tile(const polyc__grid *g, int32_t ix, int32_t iy);
-/* NULL for cells outside the grid or in untouched tiles */
+/* NULL for cells outside the grid or in tiles not stored (no beam ends in a
+ * hit there: free space or never reached) */
 static inline int polyc__cell_index(int32_t ix, int32_t iy)
 {
     return ((iy & (POLYC__TILE_SIDE - 1)) << POLYC__TILE_SHIFT) | (ix & (POLYC__TILE_SIDE - 1));

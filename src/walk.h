@@ -36,7 +36,8 @@ static inline void polyc__walk_start(polyc__walk *w, const polyc__beam *b)
     if (dx == 0.0f) w->tmx = 1e30f;
     if (dy == 0.0f) w->tmy = 1e30f;
     /* the step count is fixed in advance, so the walk always ends */
-    w->n = (w->ex > w->ix ? w->ex - w->ix : w->ix - w->ex) + (w->ey > w->iy ? w->ey - w->iy : w->iy - w->ey);
+    w->n = (w->ex > w->ix ? w->ex - w->ix : w->ix - w->ex) +
+           (w->ey > w->iy ? w->ey - w->iy : w->iy - w->ey);
     w->t = 0.0f;
     /* set by polyc__walk_enter; until then steps count down from far away
      * (polyc__traverse never calls it: no use of indeterminate values) */

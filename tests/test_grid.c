@@ -1,0 +1,350 @@
+/* test_grid.c - the grid and contour passes (grid.c, contour.c) against a
+ * plain re-implementation on polyc__traverse, the generic walk with a
+ * callback per cell that keeps every tile a beam crosses: the grid stores
+ * exactly the tiles where some beam ends in a hit, in the order beams first
+ * reach them, with the same counters in every cell; the contour list is the
+ * same, in the same order. Scenes: a room with clutter, no-return, short and
+ * NaN ranges at several cell sizes; one pose seen 200 times (the sensor's
+ * cell saturates); the contour with and without room for its bitmap. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "internal.h"
+
+#define PI_D 3.14159265358979323846
+#define BEAMS 361
+#define MAX_SCANS 200
+
+typedef struct scene {
+    polyc_scan scans[MAX_SCANS];
+    float ranges[MAX_SCANS][BEAMS];
+    uint32_t count;
+} scene;
+
+static uint32_t lcg(uint32_t *s)
+{
+    *s = *s * 1664525u + 1013904223u;
+    return *s >> 8;
+}
+
+/* The room [0, 18] x [0, 12]: wider than the laser's 8 m, so beams cross
+ * free space that no beam ends in. */
+#define ROOM_W 18.0
+#define ROOM_H 12.0
+
+/* distance from (px, py) along (c, s) to the walls of the room */
+static double room_range(double px, double py, double c, double s)
+{
+    double t = 1e30;
+    if (c > 1e-12) t = fmin(t, (ROOM_W - px) / c);
+    if (c < -1e-12) t = fmin(t, (0.0 - px) / c);
+    if (s > 1e-12) t = fmin(t, (ROOM_H - py) / s);
+    if (s < -1e-12) t = fmin(t, (0.0 - py) / s);
+    return t;
+}
+
+/* One scan at (x, y, th); with clutter, some beams end early (people), pass
+ * through an open door (no return) or are short or NaN. */
+static void add_scan(scene *sc, double x, double y, double th, int clutter, uint32_t *rng)
+{
+    polyc_scan *s = &sc->scans[sc->count];
+    memset(s, 0, sizeof *s);
+    s->pose_x_m = x;
+    s->pose_y_m = y;
+    s->pose_theta_rad = th;
+    s->start_angle_rad = (float)(-PI_D / 2.0);
+    s->angle_step_rad = (float)(PI_D / (BEAMS - 1));
+    s->min_range_m = 0.05f;
+    s->max_range_m = 8.0f;
+    s->beam_count = BEAMS;
+    for (uint32_t i = 0; i < BEAMS; i++) {
+        double a = th + (double)s->start_angle_rad + (double)i * (double)s->angle_step_rad;
+        float r = (float)room_range(x, y, cos(a), sin(a));
+        r += 0.01f * ((float)(lcg(rng) & 1023u) / 512.0f - 1.0f);
+        uint32_t u = lcg(rng) % 100u;
+        if (clutter && u < 3)
+            r *= 0.3f + 0.2f * (float)u;  /* a person */
+        else if (clutter && u < 9)
+            r = 8.5f;                      /* no return */
+        else if (clutter && u == 9)
+            r = 0.01f;                     /* too short */
+        else if (clutter && u == 10)
+            r = NAN;
+        else if (r >= 8.0f)
+            r = 8.5f;
+        sc->ranges[sc->count][i] = r;
+    }
+    s->range_m = sc->ranges[sc->count];
+    sc->count++;
+}
+
+static void clutter_scene(scene *sc)
+{
+    uint32_t rng = 777u;
+    memset(sc, 0, sizeof *sc);
+    for (int k = 0; k < 40; k++) {
+        double x = 0.5 + (ROOM_W - 1.0) * (double)(lcg(&rng) % 1000u) / 1000.0;
+        double y = 0.5 + (ROOM_H - 1.0) * (double)(lcg(&rng) % 1000u) / 1000.0;
+        double th = 2.0 * PI_D * (double)(lcg(&rng) % 1000u) / 1000.0;
+        add_scan(sc, x, y, th, 1, &rng);
+    }
+}
+
+/* ---- the passes again, on polyc__traverse ---- */
+
+typedef struct oracle {
+    const polyc__grid *g;
+    polyc__count *hits, *misses;   /* width * height */
+    int32_t *tile_rank;            /* per directory entry: 0 untouched, else order + 1 */
+    int32_t *touched;              /* directory entries in the order beams reach them */
+    uint8_t *wanted;               /* per directory entry: a beam ends in a hit there */
+    int32_t tiles;
+    const polyc__beam *beam;
+    uint8_t *labelled;
+    int32_t *list;
+    uint32_t count;
+    float threshold;
+} oracle;
+
+static void inc(polyc__count *a, polyc__count *b)
+{
+    if (*a == POLYC__COUNT_MAX) {
+        *a = (polyc__count)(*a >> 1);
+        *b = (polyc__count)(*b >> 1);
+    }
+    (*a)++;
+}
+
+static int in_grid(const polyc__grid *g, int32_t ix, int32_t iy)
+{
+    return ix >= 0 && iy >= 0 && ix < g->width && iy < g->height;
+}
+
+static size_t tile_of(const polyc__grid *g, int32_t ix, int32_t iy)
+{
+    return (size_t)(iy >> POLYC__TILE_SHIFT) * (size_t)g->tiles_x +
+           (size_t)(ix >> POLYC__TILE_SHIFT);
+}
+
+static int count_visit(void *u, int32_t ix, int32_t iy, float t_enter, int last)
+{
+    oracle *o = u;
+    if (!in_grid(o->g, ix, iy))
+        return 1;
+    size_t d = tile_of(o->g, ix, iy), c = (size_t)iy * (size_t)o->g->width + (size_t)ix;
+    if (!o->tile_rank[d]) {
+        o->touched[o->tiles] = (int32_t)d;
+        o->tile_rank[d] = ++o->tiles;
+    }
+    if (last && o->beam->hit)
+        inc(&o->hits[c], &o->misses[c]);
+    else if (t_enter < o->beam->miss_end)
+        inc(&o->misses[c], &o->hits[c]);
+    return 0;
+}
+
+static int contour_visit(void *u, int32_t ix, int32_t iy, float t_enter, int last)
+{
+    (void)t_enter;
+    (void)last;
+    oracle *o = u;
+    if (!in_grid(o->g, ix, iy) || !o->tile_rank[tile_of(o->g, ix, iy)])
+        return 1;
+    size_t c = (size_t)iy * (size_t)o->g->width + (size_t)ix;
+    unsigned h = o->hits[c], m = o->misses[c];
+    if (!(h > 0 && (float)h > o->threshold * (float)(h + m)))
+        return 0;
+    if (!o->labelled[c]) {
+        o->labelled[c] = 1;
+        o->list[2 * o->count] = ix;
+        o->list[2 * o->count + 1] = iy;
+        o->count++;
+    }
+    return 1;
+}
+
+static void oracle_run(oracle *o, const polyc_ctx *ctx)
+{
+    const polyc__grid *g = &ctx->grid;
+    size_t cells = (size_t)g->width * (size_t)g->height;
+    memset(o, 0, sizeof *o);
+    o->g = g;
+    o->hits = calloc(cells, sizeof *o->hits);
+    o->misses = calloc(cells, sizeof *o->misses);
+    o->labelled = calloc(cells, 1);
+    size_t dir_n = (size_t)g->tiles_x * (size_t)g->tiles_y;
+    o->tile_rank = calloc(dir_n, sizeof *o->tile_rank);
+    o->touched = calloc(dir_n, sizeof *o->touched);
+    o->wanted = calloc(dir_n, 1);
+    o->list = calloc((size_t)ctx->lim.max_beams * 2 + 2, sizeof *o->list);
+    o->threshold = ctx->cfg.contour_threshold;
+    assert_true(o->hits && o->misses && o->labelled && o->tile_rank);
+    assert_true(o->touched && o->wanted && o->list);
+    for (int pass = 0; pass < 2; pass++)
+        for (uint32_t si = 0; si < ctx->scan_count; si++)
+            for (uint32_t i = 0; i < ctx->scans[si].count; i++) {
+                polyc__beam b;
+                if (!polyc__beam_get(ctx, &ctx->scans[si], i, &b))
+                    continue;
+                int32_t ex = (int32_t)floorf(b.ex), ey = (int32_t)floorf(b.ey);
+                if (b.hit && in_grid(g, ex, ey))
+                    o->wanted[tile_of(g, ex, ey)] = 1;
+                o->beam = &b;
+                polyc__traverse(&b, pass ? contour_visit : count_visit, o);
+            }
+}
+
+static void oracle_free(oracle *o)
+{
+    free(o->hits);
+    free(o->misses);
+    free(o->labelled);
+    free(o->tile_rank);
+    free(o->touched);
+    free(o->wanted);
+    free(o->list);
+}
+
+/* Returns how many tiles beams crossed that the grid did not store. */
+static uint32_t check_grid(const polyc_ctx *ctx, const oracle *o)
+{
+    const polyc__grid *g = &ctx->grid;
+    size_t dir_n = (size_t)g->tiles_x * (size_t)g->tiles_y;
+    uint32_t *want_dir = calloc(dir_n, sizeof *want_dir);
+    assert_non_null(want_dir);
+    uint32_t stored = 0, skipped = 0;
+    for (int32_t k = 0; k < o->tiles; k++) {
+        if (o->wanted[o->touched[k]])
+            want_dir[o->touched[k]] = ++stored;
+        else
+            skipped++;
+    }
+    assert_int_equal(g->tile_count, stored);
+    for (size_t d = 0; d < dir_n; d++)
+        assert_int_equal(g->dir[d], want_dir[d]);
+    free(want_dir);
+    for (int32_t y = 0; y < g->height; y++)
+        for (int32_t x = 0; x < g->width; x++) {
+            const polyc__tile *t = polyc__grid_tile(g, x, y);
+            size_t c = (size_t)y * (size_t)g->width + (size_t)x;
+            int idx = polyc__cell_index(x, y);
+            if (t) {
+                assert_int_equal(t->hits[idx], o->hits[c]);
+                assert_int_equal(t->misses[idx], o->misses[c]);
+            } else {
+                assert_int_equal(o->hits[c], 0);
+            }
+        }
+    return skipped;
+}
+
+static void check_contour(const polyc_ctx *ctx, const oracle *o)
+{
+    assert_int_equal(ctx->contour_count, o->count);
+    assert_memory_equal(ctx->contour_xy, o->list, (size_t)o->count * 2 * sizeof(int32_t));
+}
+
+/* ---- context ---- */
+
+typedef struct fixture {
+    void *block;
+    polyc_ctx *ctx;
+    polyc_limits lim;
+} fixture;
+
+static void make_ctx(fixture *f, const scene *sc, float cell_m)
+{
+    polyc_config cfg;
+    polyc_config_default(&cfg);
+    cfg.cell_m = cell_m;
+    assert_int_equal(polyc_limits_for_scans(&cfg, sc->scans, sc->count, &f->lim), POLYC_OK);
+    size_t size = polyc_memory_size(&cfg, &f->lim);
+    assert_true(size > 0);
+    f->block = malloc(size);
+    assert_non_null(f->block);
+    assert_int_equal(polyc_init(f->block, size, &cfg, &f->lim, &f->ctx), POLYC_OK);
+    for (uint32_t i = 0; i < sc->count; i++)
+        assert_int_equal(polyc_add_scan(f->ctx, &sc->scans[i]), POLYC_OK);
+    assert_int_equal(polyc_build_grid(f->ctx), POLYC_OK);
+}
+
+static void test_passes_match_traversal(void **state)
+{
+    (void)state;
+    static scene sc;
+    clutter_scene(&sc);
+    static const float cells[] = {0.025f, 0.037f, 0.05f, 0.1f, 0.3f};
+    for (size_t k = 0; k < sizeof cells / sizeof cells[0]; k++) {
+        fixture f;
+        make_ctx(&f, &sc, cells[k]);
+        assert_int_equal(polyc_extract_contour(f.ctx), POLYC_OK);
+        oracle o;
+        oracle_run(&o, f.ctx);
+        uint32_t skipped = check_grid(f.ctx, &o);
+        check_contour(f.ctx, &o);
+        assert_true(o.count > 20);
+        if (cells[k] < 0.04f)
+            assert_true(skipped > 0);
+        oracle_free(&o);
+        free(f.block);
+    }
+}
+
+/* 200 scans from one pose: 72,200 misses in the sensor's cell, past the
+ * 16-bit counters' limit, so the counters halve in the order of the beams */
+static void test_saturation_matches_traversal(void **state)
+{
+    (void)state;
+    static scene sc;
+    uint32_t rng = 99u;
+    memset(&sc, 0, sizeof sc);
+    for (int k = 0; k < MAX_SCANS; k++)
+        add_scan(&sc, 3.3, 2.1, 0.7, k % 2, &rng);
+    fixture f;
+    make_ctx(&f, &sc, 0.05f);
+    assert_int_equal(polyc_extract_contour(f.ctx), POLYC_OK);
+    oracle o;
+    oracle_run(&o, f.ctx);
+    check_grid(f.ctx, &o);
+    check_contour(f.ctx, &o);
+    oracle_free(&o);
+    free(f.block);
+}
+
+/* Without room for the contour's bitmap the pass walks the tiles: the same
+ * contour. */
+static void test_contour_without_bitmap(void **state)
+{
+    (void)state;
+    static scene sc;
+    clutter_scene(&sc);
+    fixture f;
+    make_ctx(&f, &sc, 0.04f);
+    size_t size = f.ctx->arena.size;
+    f.ctx->arena.size = f.ctx->grid_mark + polyc__contour_bytes(&f.lim);
+    assert_int_equal(polyc_extract_contour(f.ctx), POLYC_OK);
+    f.ctx->arena.size = size;
+    assert_true(f.ctx->arena.peak <= f.ctx->grid_mark + polyc__contour_bytes(&f.lim));
+    oracle o;
+    oracle_run(&o, f.ctx);
+    check_contour(f.ctx, &o);
+    oracle_free(&o);
+    free(f.block);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_passes_match_traversal),
+        cmocka_unit_test(test_saturation_matches_traversal),
+        cmocka_unit_test(test_contour_without_bitmap),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
