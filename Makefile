@@ -16,7 +16,8 @@ TOOL_MOD = $(filter-out tools/polyc.c tools/bench.c,$(wildcard tools/*.c))
 TOOL_OBJ = $(TOOL_MOD:tools/%.c=$(BUILD)/tobj/%.o)
 TOOL_CFLAGS = $(WARN) $(OPT) $(CFLAGS) -Iinclude -Itools -D_POSIX_C_SOURCE=200809L
 
-.PHONY: all lib test unit bench clean install cross test-cxx test-install test-python test-embedded
+.PHONY: all lib test unit bench clean install cross deps check test-cxx test-install test-python test-embedded
+.PHONY: test-cli test-fuzz-replay test-asan test-valgrind fuzz fuzz-merge
 all: $(BUILD)/libpolyc.a $(BUILD)/libpolyc.so $(BUILD)/polyc
 
 $(BUILD)/obj/%.o: src/%.c include/polyc.h $(wildcard src/*.h)
@@ -58,12 +59,23 @@ $(BUILD)/tests/%: tests/%.c $(TOOL_OBJ) $(BUILD)/libpolyc.a $(wildcard tests/*.h
 	@mkdir -p $(dir $@)
 	$(CC) $(TOOL_CFLAGS) -Isrc -Itests $< $(TOOL_OBJ) $(BUILD)/libpolyc.a -o $@ -lcmocka $(LDLIBS)
 
+# every suite runs even when an earlier one fails; the target fails at the end
 unit: $(TEST_BIN) $(BUILD)/polyc
-	@set -e; for t in $(TEST_BIN); do echo "== $$t"; $$t; done
+	@fail=0; for t in $(TEST_BIN); do echo "== $$t"; $$t || fail=1; done; exit $$fail
+
+# What a newcomer and CI run (README.md): dependencies, every suite, the
+# valgrind run and the Cortex-M cross build.
+check: deps
+	$(MAKE) test
+	$(MAKE) test-valgrind
+	$(MAKE) cross
+deps:
+	sh tools/install-deps.sh
+
 
 # Also: the header as C++, an installed copy used through pkg-config, the
 # Python binding against build/libpolyc.so, the 128 KiB example on the host
-test: unit test-cxx test-install test-python test-embedded
+test: unit test-cli test-fuzz-replay test-asan test-cxx test-install test-python test-embedded
 test-cxx: $(BUILD)/tests/cxx_header
 	$(BUILD)/tests/cxx_header
 $(BUILD)/tests/cxx_header: tests/cxx_header.cpp include/polyc.h $(BUILD)/libpolyc.a
@@ -92,6 +104,62 @@ $(BUILD)/footprint: examples/footprint.c $(BUILD)/libpolyc.a
 $(BUILD)/footprint8: examples/footprint.c $(EMB_OBJ)
 	$(CC) $(WARN) $(OPT) $(CFLAGS) -Iinclude $^ -o $@ $(LDLIBS)
 
+# Robustness (docs/security.md). test-cli: every bad input of the tool
+# (tests/cli_bad_input.sh). test-fuzz-replay: the committed fuzz corpus through
+# the fuzz targets, built with $(CC). test-asan: unit tests, corpus replay and
+# the quick bad-input tests again in build-asan/ under ASan and UBSan.
+# test-valgrind: the tool over a sample log and a bad one, no error or leak.
+FUZZ_TARGETS = scanlog library
+FUZZ_REPLAY  = $(FUZZ_TARGETS:%=$(BUILD)/tests/fuzz_replay_%)
+$(BUILD)/tests/fuzz_replay_%: tests/fuzz_%.c tests/fuzz_replay.c $(TOOL_OBJ) $(BUILD)/libpolyc.a
+	@mkdir -p $(dir $@)
+	$(CC) $(TOOL_CFLAGS) $^ -o $@ $(LDLIBS)
+test-fuzz-replay: $(FUZZ_REPLAY)
+	@set -e; for t in $(FUZZ_TARGETS); do $(BUILD)/tests/fuzz_replay_$$t tests/corpus/$$t; done
+CLI_TEST_ARGS ?=
+test-cli: $(BUILD)/polyc
+	tests/cli_bad_input.sh $(CLI_TEST_ARGS) $(BUILD)/polyc
+SAN_LIST  = address,undefined,float-cast-overflow
+SAN_FLAGS = -fsanitize=$(SAN_LIST) -fno-sanitize-recover=all
+test-asan:
+	ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
+	$(MAKE) BUILD=build-asan OPT='-O1 -g $(SAN_FLAGS)' CLI_TEST_ARGS=--quick \
+	    unit test-fuzz-replay test-cli
+# (the bad log must exit 1 from polyc itself, so valgrind's own code is 99 there)
+VALGRIND = valgrind -q --leak-check=full --errors-for-leak-kinds=definite,indirect,possible
+test-valgrind: $(BUILD)/polyc
+	$(VALGRIND) --error-exitcode=1 $(BUILD)/polyc --stats --iterations 20 \
+	    -o $(BUILD)/valgrind.svg examples/office.log
+	$(VALGRIND) --error-exitcode=1 $(BUILD)/polyc convert -o $(BUILD)/valgrind.txt examples/office.log
+	printf 'SCAN 0 0 0 0 0.1 0.05 4 3 1 1 1\nSCAN 0 0 0 0 0.1 0.05 4 3 1 x 1\n' > $(BUILD)/valgrind_bad.log
+	$(VALGRIND) --error-exitcode=99 $(BUILD)/polyc -o $(BUILD)/valgrind.svg $(BUILD)/valgrind_bad.log; \
+	    test $$? = 1
+	rm -f $(BUILD)/valgrind.svg $(BUILD)/valgrind.txt $(BUILD)/valgrind_bad.log
+
+# libFuzzer (`make fuzz FUZZ_TIME=600`; needs clang): both targets in
+# build-fuzz/, run one after the other on a scratch corpus seeded from
+# tests/corpus/; `make fuzz-merge` adds to tests/corpus/ the inputs that reach
+# new edges (hit counts ignored, which keeps the committed corpus small).
+FUZZ_CC   ?= clang
+FUZZ_TIME ?= 60
+FUZZ_BIN   = $(FUZZ_TARGETS:%=build-fuzz/fuzz_%)
+FUZZ_CFLAGS = $(WARN) -g -O2 -fno-omit-frame-pointer -fsanitize=fuzzer,$(SAN_LIST) -fno-sanitize-recover=all \
+              -Iinclude -Itools -D_POSIX_C_SOURCE=200809L
+build-fuzz/fuzz_scanlog: tests/fuzz_scanlog.c tools/scanlog.c $(LIB_SRC)
+build-fuzz/fuzz_library: tests/fuzz_library.c $(LIB_SRC)
+# the optimiser's float compares drown the run in comparison tracing: off
+build-fuzz/fuzz_library: FUZZ_CFLAGS += -fno-sanitize-coverage=trace-cmp
+$(FUZZ_BIN): include/polyc.h $(wildcard src/*.h) tools/scanlog.h
+	@mkdir -p $(dir $@)
+	$(FUZZ_CC) $(FUZZ_CFLAGS) $(filter %.c,$^) -o $@ -lm
+fuzz: $(FUZZ_BIN)
+	@set -e; for t in $(FUZZ_TARGETS); do mkdir -p build-fuzz/corpus/$$t build-fuzz/findings/$$t; \
+	  nice build-fuzz/fuzz_$$t -max_total_time=$(FUZZ_TIME) -print_final_stats=1 \
+	    -artifact_prefix=build-fuzz/findings/$$t/ build-fuzz/corpus/$$t tests/corpus/$$t; done
+fuzz-merge: $(FUZZ_BIN)
+	@set -e; for t in $(FUZZ_TARGETS); do \
+	  build-fuzz/fuzz_$$t -merge=1 -use_counters=0 tests/corpus/$$t build-fuzz/corpus/$$t; done
+
 # Cortex-M4 (`make cross`; needs gcc-arm-none-eabi, libnewlib-arm-none-eabi): the
 # library at -Os -Werror and its sizes; FAILS if it references an allocator or
 # stdio (nm -u), or if the linked example (nosys.specs) contains one; then the
@@ -117,7 +185,8 @@ cross: $(XBUILD)/libpolyc.a $(XBUILD)/embedded_scan.elf
 	@bad=$$($(CROSS)nm $(XBUILD)/embedded_scan.elf | awk '{print $$3}' | grep -Ex '$(X_ALLOC)|$(X_STDIO)' | sort -u); \
 	if [ -n "$$bad" ]; then echo "cross: FAIL: the linked example contains" $$bad; exit 1; fi
 	@echo "cross: no allocator and no stdio in the library or the linked example"
-	python3 tools/stack_usage.py --cross $(CROSS) --elf $(XBUILD)/embedded_scan.elf $(XBUILD)/*.ci
+	python3 tools/stack_usage.py --cross $(CROSS) --elf $(XBUILD)/embedded_scan.elf \
+	    $(XOBJ:.o=.ci) $(XBUILD)/embedded_scan.ci
 $(XBUILD)/%.o: src/%.c include/polyc.h $(wildcard src/*.h)
 	@mkdir -p $(dir $@)
 	$(CROSS)gcc $(XFLAGS) -c $< -o $@

@@ -222,7 +222,9 @@ POLYC_API polyc_status polyc_add_scan(polyc_ctx *ctx, const polyc_scan *scan);
 POLYC_API polyc_status polyc_build_grid(polyc_ctx *ctx);   /* hit/miss grid */
 POLYC_API polyc_status polyc_extract_contour(polyc_ctx *ctx);
 POLYC_API polyc_status polyc_trace(polyc_ctx *ctx);        /* initial polylines */
-/* Optimise the current polylines; progress may be NULL. */
+/* Optimise the current polylines; progress may be NULL. If it fails once
+ * the search has started (POLYC_ERR_NOMEM), the best map found so far is
+ * the result, as after POLYC_ERR_STOPPED. */
 POLYC_API polyc_status polyc_optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *user);
 /* build_grid + extract_contour + trace + optimize (if max_iterations > 0). */
 POLYC_API polyc_status polyc_build(polyc_ctx *ctx, polyc_progress_fn progress, void *user);

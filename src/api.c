@@ -465,7 +465,9 @@ polyc_status polyc_optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *us
     st = polyc__optimize(ctx, progress, user);
     note_memory(ctx);
     ctx->arena.used = ctx->trace_mark;
-    if (st == POLYC_OK || st == POLYC_ERR_STOPPED) {
+    if (ctx->opt_result_valid) {
+        /* the best map found (after a failure mid-search too: the store
+         * and the published result never disagree) */
         export_result(ctx);
         ctx->stage = POLYC__STAGE_OPTIMIZED;
     }

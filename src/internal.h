@@ -205,6 +205,7 @@ struct polyc_ctx {
 
     polyc__store store;
     polyc__flat flat;
+    int opt_result_valid;          /* the store holds a map to publish */
     size_t trace_mark;             /* arena use after the initial polylines */
 
     polyc__point *points;

@@ -121,16 +121,27 @@ static int32_t live_lines(const polyc__store *s)
     return s->l_live;
 }
 
+/* After a failure mid-search the store holds the best map so far (at worst
+ * the traced one), which polyc_optimize then publishes with the status. */
+static polyc_status restore_best(polyc__opt *o, polyc_status st)
+{
+    if (polyc__store_from_flat(o->s, &o->best) != POLYC_OK)
+        return POLYC_ERR_NOMEM;
+    o->ctx->opt_result_valid = 1;
+    return st;
+}
+
 polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *user)
 {
     polyc__opt o;
+    ctx->opt_result_valid = 0;
     polyc_status st = polyc__opt_setup(ctx, &o);
     if (st != POLYC_OK)
         return st;
     const polyc_config *cfg = &ctx->cfg;
     polyc__flat_from_store(&o.best, o.s);
     double best = polyc__bic(&o);
-    double sigma = cfg->noise_m;
+    double sigma = (double)cfg->noise_m;
     uint32_t quiet = 0, it;
     polyc_status result = POLYC_OK;
     uint32_t prev_start = 0;
@@ -144,7 +155,7 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
         if (noise > 0.0) {
             polyc__op_noise(&o, noise);
             if ((st = polyc__rebuild(&o)) != POLYC_OK)
-                return st;
+                return restore_best(&o, st);
         }
         uint32_t since = it == 0 || noise > 0.0 ? 0 : prev_start;
         prev_start = start;
@@ -169,7 +180,7 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
         }
         polyc__op_trim_ends(&o); /* last: moves could push ends past the data */
         if (o.h.out_of_entries)
-            return polyc__fail(ctx, POLYC_ERR_NOMEM, "spatial hash full");
+            return restore_best(&o, polyc__fail(ctx, POLYC_ERR_NOMEM, "spatial hash full"));
         double bic = polyc__bic(&o);
         if (bic < best - 1e-9 * fabs(best)) {
             best = bic;
@@ -200,6 +211,7 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
     /* the best model found is the result */
     if (polyc__store_from_flat(o.s, &o.best) != POLYC_OK)
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room to restore the best map");
+    ctx->opt_result_valid = 1;
     if ((st = polyc__rebuild(&o)) != POLYC_OK)
         return st;
     fill_stats(&o);

@@ -12,7 +12,7 @@
  *   byte 0  flags: bit 0 exact points, 1 no grazing, 2 gamma 0, 3 no free
  *           space, 4-5 cell (0.05, 0.1, 0.025, 0.2 m), 6-7 memory (0, 1:
  *           the queried size, 2: a share of it, 3: a tiny max_grid_cells)
- *   byte 1  bits 0-2 max_iterations, 3-5 stop after this many iterations
+ *   byte 1  bits 0-1 max_iterations (bit 2 unused), 3-5 stop after this many iterations
  *           (0: never), 6-7 patience - 1
  *   byte 2  memory share for mode 2 (n / 256 of the queried size)
  *   byte 3  seed
@@ -20,9 +20,10 @@
  *   pi/64), step (uint8, pi/512 each; 0 is a zero step), min (uint8, cm),
  *   max (uint8, 0.25 m), special (uint8, below), beam count (uint8), range
  *   encoding (uint8: even: uint8 of 5 cm each, odd: uint16 of mm each);
- *   then the ranges. Special: 0 none, else bits 0-2 pick a field (x, y,
- *   theta, start, step, min, max, reserved) and bits 3-5 a value (NaN, inf,
- *   -inf, 1e30, -1e30, 1e7, -0, 1e-30). A range byte 255 (uint16 65535) is
+ *   then the ranges. Special: bit 7 clear: none (most scans stay good),
+ *   else bits 0-2 pick a field (x, y, theta, start, step, min, max,
+ *   reserved) and bits 3-5 a value (NaN, inf, -inf, 1e30, -1e30, 1e7, -0,
+ *   1e-30). A range byte 255 (uint16 65535) is
  *   NaN, 254 (65534) is inf. */
 #include <math.h>
 #include <stdint.h>
@@ -76,7 +77,8 @@ typedef struct scene {
     uint32_t scan_count;
 } scene;
 
-static const double specials[8] = {NAN, INFINITY, -INFINITY, 1e30, -1e30, 1e7, -0.0, 1e-30};
+static const double specials[8] = {(double)NAN, (double)INFINITY, -(double)INFINITY, 1e30, -1e30,
+                                   1e7, -0.0, 1e-30};
 
 static void apply_special(polyc_scan *s, uint8_t sp)
 {
@@ -106,7 +108,7 @@ static void decode(const uint8_t *data, size_t size, scene *sc)
     if (flags & 2) c->flags |= POLYC_FLAG_NO_GRAZING;
     if (flags & 4) c->gamma = 0.0f;
     if (flags & 8) c->free_range_m = 0.0f;
-    c->max_iterations = iters & 7u;
+    c->max_iterations = iters & 3u;   /* a few iterations reach every operator */
     c->patience = 1u + (iters >> 6);
     sc->stop_after = (iters >> 3) & 7u;
     sc->memory_mode = flags >> 6;
@@ -127,7 +129,7 @@ static void decode(const uint8_t *data, size_t size, scene *sc)
         uint8_t sp = u8(&in);
         uint32_t n = u8(&in);
         uint8_t wide = u8(&in) & 1;
-        if (sp)
+        if (sp & 0x80)
             apply_special(s, sp);
         if (n > MAX_BEAMS - beams)
             n = MAX_BEAMS - beams;
@@ -144,11 +146,25 @@ static void decode(const uint8_t *data, size_t size, scene *sc)
     }
 }
 
+typedef struct progress {
+    uint32_t stop_after, max_iterations, calls;
+} progress;
+
+/* One call per iteration, numbered from 0, never more than the cap; asks
+ * to stop after stop_after calls. */
 static int stop_at(void *user, const polyc_iteration *it)
 {
-    const uint32_t *after = user;
-    CHECK(isfinite(it->best_bic) || isnan(it->bic) || isinf(it->bic));
-    return *after && it->iteration >= *after;
+    progress *p = user;
+    CHECK(it->iteration == p->calls);
+    CHECK(p->calls < p->max_iterations);
+    /* the optimiser takes a new best only if it is better by 1e-9 relative */
+    int worse = it->best_bic > it->bic + 1e-9 * fabs(it->best_bic);
+    if (worse)
+        fprintf(stderr, "fuzz_library: iteration %u: bic %.17g, best %.17g\n",
+                (unsigned)it->iteration, it->bic, it->best_bic);
+    CHECK(!worse);
+    p->calls++;
+    return p->stop_after && p->calls >= p->stop_after;
 }
 
 static int known_status(polyc_status st)
@@ -178,8 +194,10 @@ static void read_result(polyc_ctx *ctx, result *r)
             CHECK(isfinite(pl.xy_m[j]));
         if (i < 1024)
             r->count[i] = pl.point_count;
-        if (r->points + pl.point_count <= 8192)
-            memcpy(r->xy + 2 * r->points, pl.xy_m, 2 * sizeof(float) * pl.point_count);
+        uint32_t fit = r->points < 8192 ? 8192 - r->points : 0;
+        fit = pl.point_count < fit ? pl.point_count : fit;
+        if (fit)
+            memcpy(r->xy + 2 * r->points, pl.xy_m, 2 * sizeof(float) * fit);
         r->points += pl.point_count;
         uint32_t n = 0, closed = 9;
         CHECK(polyc_copy_polyline(ctx, i, NULL, 0, &n, &closed) == POLYC_OK);
@@ -201,10 +219,19 @@ static void run(polyc_ctx *ctx, scene *sc, result *r)
         if (st != POLYC_OK && r->add == POLYC_OK)
             r->add = st;
     }
-    r->build = polyc_build(ctx, stop_at, &sc->stop_after);
+    progress p = {sc->stop_after, sc->cfg.max_iterations, 0};
+    r->build = polyc_build(ctx, stop_at, &p);
     CHECK(known_status(r->build));
     CHECK(r->build != POLYC_ERR_NULL && r->build != POLYC_ERR_RANGE);
+    /* the callback's stop is obeyed at once and reported as STOPPED */
+    CHECK((r->build == POLYC_ERR_STOPPED) == (p.stop_after && p.calls >= p.stop_after));
+    CHECK(p.calls <= p.stop_after || !p.stop_after);
     read_result(ctx, r);
+    if (r->build == POLYC_OK || r->build == POLYC_ERR_STOPPED) {
+        polyc_stats stats;
+        CHECK(polyc_get_stats(ctx, &stats) == POLYC_OK);
+        CHECK(stats.iterations == p.calls);
+    }
     if (r->build == POLYC_OK || r->build == POLYC_ERR_STOPPED) {
         double bic = 0, err = 0;
         polyc_status st = polyc_score(ctx, &bic, &err);

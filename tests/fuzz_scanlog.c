@@ -59,9 +59,11 @@ static void check_library_accepts(const scanlog *log)
 {
     static unsigned char block[1 << 16];
     polyc_config cfg;
-    polyc_limits lim = {1, 0, 0, 0};
+    polyc_limits lim;
     polyc_ctx *ctx = NULL;
     polyc_config_default(&cfg);
+    memset(&lim, 0, sizeof lim);
+    lim.max_scans = 1;
     for (uint32_t i = 0; i < log->count; i++) {
         polyc_scan s = log->scans[i];
         lim.max_beams = s.beam_count;

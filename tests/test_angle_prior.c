@@ -251,7 +251,7 @@ static void test_empty_context(void **state)
 {
     (void)state;
     fixture f;
-    polyc_limits lim = {4, 1000, 1 << 16, 0};
+    polyc_limits lim = {4, 1000, 1 << 16, 0, 0};
     make_ctx(&f, NULL, NULL, &lim);
     memset(&f.prior, 0xab, sizeof f.prior);
     assert_int_equal(polyc__prior_build(f.ctx, &f.prior), POLYC_OK);
@@ -390,7 +390,7 @@ static void test_coarse_prior_for_thin_extent(void **state)
 static void test_size_query(void **state)
 {
     (void)state;
-    polyc_limits lim = {1, 1, 0, 0};
+    polyc_limits lim = {1, 1, 0, 0, 0};
     size_t cell = POLYC__ANGLE_BINS * sizeof(uint16_t) + sizeof(uint32_t);
     assert_true(polyc__prior_bytes(&lim) >= 64 * cell);
     lim.max_grid_cells = 1u << 20; /* 1024 tiles */

@@ -318,7 +318,7 @@ static void test_plain_fields(void **state)
     scanlog_free(&log);
     EXPECT_ERROR("# polyc-scans 2\nSCAN 1 2 0.5 -1 0.25 0.1 4 0\n",
                  "t.log:1: unsupported polyc-scans version '2' (this reader: 1)");
-    EXPECT_ERROR("SCAN 1 2 0.5 -1 0 0.1 4 0\n", "t.log:1: angle step 0 must be > 0");
+    EXPECT_ERROR("SCAN 1 2 0.5 -1 0 0.1 4 0\n", "t.log:1: angle step 0 rad not in (0, 6.2832]");
 }
 
 /* ---- line handling ---- */
@@ -393,9 +393,59 @@ static void test_errors(void **state)
                  "t.log:1: pose theta is not a number: '0x' (field 7)");
     EXPECT_ERROR("ODOM 1\nFL\001ASER 1 2\n", "t.log:2: binary data (byte 0x01 at column 3)");
     EXPECT_ERROR("ODOM 1\nFLASER\0 1 2\n", "t.log:2: binary data (byte 0x00 at column 7)");
-    EXPECT_ERROR("\x89PNG\r\n", "t.log:1: not a log line: starts with '\x89PNG'");
+    EXPECT_ERROR("\x89PNG\r\n", "t.log:1: not a log line: starts with '\\x89PNG'");
     EXPECT_ERROR("", "t.log: no scans found (0 lines read)");
     EXPECT_ERROR("# only\nODOM 1\n", "t.log: no scans found (2 lines read)");
+}
+
+/* Every scan read is one the library accepts (fuzz_scanlog findings): the
+ * library's angle and range rules are checked by line, on the float values. */
+static void test_library_rules(void **state)
+{
+    (void)state;
+    scanlog log;
+    /* ROBOTLASER1 without beams and a negative step: nothing to reverse */
+    assert_int_equal(parse(&log, "ROBOTLASER1 0 1.57 3.14 -0.5 8 0.01 0 0 0 0.5 0.25 0.1 0.5 "
+                                 "0.25 0.1 0 0 0.5 0.5 0 1.0 host 1.0\n"),
+                     0);
+    near((double)log.scans[0].start_angle_rad, 1.57, 1e-6);
+    assert_true(log.scans[0].angle_step_rad > 0.0f);
+    scanlog_free(&log);
+    /* a FLASER log of zero-beam scans: no ranges, no pool */
+    assert_int_equal(parse(&log, "FLASER 0 0 0 0 0 0 0 0 h 0\n"), 0);
+    assert_int_equal(log.count, 1);
+    scanlog_free(&log);
+    EXPECT_ERROR("SCAN 0 0 0 150 0.1 0.05 4 1 1\n",
+                 "t.log:1: start angle 150 rad beyond +-100 rad");
+    EXPECT_ERROR("SCAN 0 0 0 0 7 0.05 4 1 1\n", "t.log:1: angle step 7 rad not in (0, 6.2832]");
+    EXPECT_ERROR("SCAN 0 0 0 0 1e-50 0.05 4 2 1 1\n",
+                 "t.log:1: angle step 0 rad not in (0, 6.2832]");
+    EXPECT_ERROR("ROBOTLASER1 0 -1 3 0.5 8 0.01 0 300 0 0\n",
+                 "t.log:1: ROBOTLASER1 with 300 beams has only 2 fields after the count");
+    /* min and max equal as floats */
+    EXPECT_ERROR("SCAN 0 0 0 0 0.1 0.99999999999 1 1 1\n",
+                 "t.log:1: max range 1 m not above min range 1 m");
+    /* --max-range below a SCAN line's min range */
+    assert_int_equal(parse_len(&log, "SCAN 0 0 0 0 0.1 6 8 1 7\n", 25, 5.0), -1);
+    assert_string_equal(log.error, "t.log:1: max range 5 m not above min range 6 m"
+                                   " (max range lowered by option)");
+    scanlog_free(&log);
+    /* a no-return code at 2 cm: the threshold stays above the min range */
+    scanlog_noreturn nr;
+    float r[40];
+    for (int i = 0; i < 40; i++)
+        r[i] = 0.02f;
+    scanlog_detect_noreturn(r, 40, &nr);
+    assert_true(nr.max_range_m > SCANLOG_MIN_RANGE_M);
+    /* a field quoted in a message carries no raw bytes */
+    EXPECT_ERROR("SCAN 0 0 0 0 0.1 0.05 4 1 \x9b[2J\n",
+                 "t.log:1: range is not a number: '\\x9b[2J' (field 10)");
+    /* a last line cut short says so */
+    EXPECT_ERROR("SCAN 0 0 0 0 0.1 0.05 4 3 1 1",
+                 "t.log:1: SCAN with 3 beams needs 3 fields after the count, found 2"
+                 " (the file ends inside this line: truncated?)");
+    EXPECT_ERROR("FLASER 99999999999999999999999 1\n",
+                 "t.log:1: beam count 99999999999999999999999 out of range (at most 1048576)");
 }
 
 static void test_long_lines(void **state)
@@ -446,6 +496,7 @@ int main(void)
         cmocka_unit_test(test_bad_ranges_counted),
         cmocka_unit_test(test_errors),
         cmocka_unit_test(test_long_lines),
+        cmocka_unit_test(test_library_rules),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -248,16 +248,68 @@ static int parse_args(int argc, char **argv, options *o)
 
 /* ---- output: all or nothing ---- */
 
+/* An output written in two steps, so that a run with two outputs (the map
+ * and --trace) writes both or neither: emit_prepare writes a file's bytes to
+ * a temporary file in the same directory, emit_commit renames it over the
+ * file (or writes stdout), emit_abort removes what is left. */
+typedef struct pending {
+    const char *path;          /* NULL or "-": stdout, written at commit */
+    const char *data;
+    size_t len;
+    char *tmp;                 /* the prepared temporary file, or NULL */
+} pending;
+
+static int emit_file(const char *path, const char *data, size_t len, char **tmp_out);
+
+static int emit_prepare(pending *p, const char *path, const char *data, size_t len)
+{
+    p->path = path;
+    p->data = data;
+    p->len = len;
+    p->tmp = NULL;
+    if (!path || strcmp(path, "-") == 0)
+        return 0;
+    return emit_file(path, data, len, &p->tmp);
+}
+
+static int emit_commit(pending *p)
+{
+    if (!p->path || strcmp(p->path, "-") == 0) {
+        if (fwrite(p->data, 1, p->len, stdout) != p->len || fflush(stdout) != 0)
+            return complain(EXIT_INPUT, "writing stdout: %s", strerror(errno));
+        return 0;
+    }
+    int err = rename(p->tmp, p->path) != 0 ? errno : 0;
+    if (err)
+        unlink(p->tmp);
+    free(p->tmp);
+    p->tmp = NULL;
+    return err ? complain(EXIT_INPUT, "%s: %s", p->path, strerror(err)) : 0;
+}
+
+static void emit_abort(pending *p)
+{
+    if (p->tmp) {
+        unlink(p->tmp);
+        free(p->tmp);
+        p->tmp = NULL;
+    }
+}
+
 /* Writes len bytes to stdout, or to path through a temporary file in the
  * same directory renamed over it, so that a failure never leaves a partial
  * file. Returns 0 or EXIT_INPUT with a message. */
 static int emit(const char *path, const char *data, size_t len)
 {
-    if (!path || strcmp(path, "-") == 0) {
-        if (fwrite(data, 1, len, stdout) != len || fflush(stdout) != 0)
-            return complain(EXIT_INPUT, "writing stdout: %s", strerror(errno));
-        return 0;
-    }
+    pending p;
+    int rc = emit_prepare(&p, path, data, len);
+    return rc ? rc : emit_commit(&p);
+}
+
+/* The bytes in a synced temporary file next to path; *tmp_out gets its
+ * name (to rename or remove). 0 or EXIT_INPUT with a message. */
+static int emit_file(const char *path, const char *data, size_t len, char **tmp_out)
+{
     size_t n = strlen(path);
     char *tmp = malloc(n + 16);
     if (!tmp)
@@ -284,12 +336,13 @@ static int emit(const char *path, const char *data, size_t len)
         err = errno;
     if (close(fd) != 0 && !err)
         err = errno;
-    if (!err && rename(tmp, path) != 0)
-        err = errno;
-    if (err)
+    if (err) {
         unlink(tmp);
-    free(tmp);
-    return err ? complain(EXIT_INPUT, "%s: %s", path, strerror(err)) : 0;
+        free(tmp);
+        return complain(EXIT_INPUT, "%s: %s", path, strerror(err));
+    }
+    *tmp_out = tmp;
+    return 0;
 }
 
 /* A memory stream to render into before anything is written. */
@@ -602,9 +655,18 @@ static int make_map(const options *o, run *r, double t_start, mapout_times *t)
         return EXIT_INPUT;
     if (o->trace && membuf_close(&r->trace, 0))
         return EXIT_INPUT;
-    int rc = emit(o->output, r->out.data, r->out.len);
+    /* both outputs or neither */
+    pending map_out, trace_out;
+    memset(&trace_out, 0, sizeof trace_out);
+    int rc = emit_prepare(&map_out, o->output, r->out.data, r->out.len);
     if (!rc && o->trace)
-        rc = emit(o->trace, r->trace.data, r->trace.len);
+        rc = emit_prepare(&trace_out, o->trace, r->trace.data, r->trace.len);
+    if (!rc)
+        rc = emit_commit(&map_out);
+    if (!rc && o->trace)
+        rc = emit_commit(&trace_out);
+    emit_abort(&map_out);
+    emit_abort(&trace_out);
     double t6 = now_ms();
     if (o->stats)
         print_stats(o, &r->log, &stats, t, t6 - t5, t6 - t_start);

@@ -134,6 +134,8 @@ static void nr_pick(const nr_hist *h, uint64_t *prefix, scanlog_noreturn *out)
         if (h->bin[b] > h->bin[mode])
             mode = b;
     out->max_range_m = (float)((bottom - 0.5) * NR_BIN_M);
+    if (out->max_range_m <= SCANLOG_MIN_RANGE_M)   /* a code at 2 cm: keep max > min */
+        out->max_range_m = SCANLOG_MIN_RANGE_M + (float)(NR_BIN_M / 2);
     out->code_lo_m = bottom * NR_BIN_M;
     out->code_mode_m = mode * NR_BIN_M;
     out->code_beams = prefix[top + 1] - prefix[bottom] + h->beyond;
@@ -162,6 +164,7 @@ typedef struct reader {
     double max_range_m;              /* opts->max_range_m or 0 */
     char *buf;
     size_t cap;
+    int partial;                     /* the last line read ended at EOF, not '\n' */
 } reader;
 
 /* A cursor over the whitespace-separated fields of one line. */
@@ -188,6 +191,35 @@ static int fail(reader *r, const char *fmt, ...)
 static int is_space(int c)
 {
     return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
+}
+
+/* Up to 24 bytes of field s for a message, with "..." if longer. Bytes
+ * outside printable ASCII are written as \xNN, so that a message never
+ * carries raw bytes of the input (terminal escapes, broken UTF-8). */
+typedef struct excerpt {
+    char text[24 * 4 + 4];
+} excerpt;
+
+static const char *quote(excerpt *e, const char *s)
+{
+    static const char hex[] = "0123456789abcdef";
+    size_t o = 0, i;
+    for (i = 0; s[i] && i < 24; i++) {
+        unsigned char c = (unsigned char)s[i];
+        if (c >= 0x20 && c < 0x7f) {
+            e->text[o++] = (char)c;
+        } else {
+            e->text[o++] = '\\';
+            e->text[o++] = 'x';
+            e->text[o++] = hex[c >> 4];
+            e->text[o++] = hex[c & 15];
+        }
+    }
+    if (s[i])
+        for (int k = 0; k < 3; k++)
+            e->text[o++] = '.';
+    e->text[o] = '\0';
+    return e->text;
 }
 
 /* Reads one line into r->buf without its '\n' (a final line may lack it).
@@ -226,6 +258,7 @@ static int read_line(reader *r, FILE *f, size_t *len_out)
         r->cap = 4096;
     }
     r->buf[len] = '\0';
+    r->partial = c == EOF;
     *len_out = len;
     return 1;
 }
@@ -276,9 +309,10 @@ static int take_double(reader *r, fields *fs, const char *what, double *out)
     char *end = NULL;
     if (len <= MAX_NUMBER_CHARS)
         *out = strtod(s, &end);
-    if (len > MAX_NUMBER_CHARS || end != s + len)
-        return fail(r, "%s is not a number: '%.24s%s' (field %u)", what, s,
-                    len > 24 ? "..." : "", fs->index);
+    if (len > MAX_NUMBER_CHARS || end != s + len) {
+        excerpt e;
+        return fail(r, "%s is not a number: '%s' (field %u)", what, quote(&e, s), fs->index);
+    }
     /* Overflow gives +-HUGE_VAL, underflow a tiny number (errno ERANGE):
      * the callers' range checks judge both. */
     return 0;
@@ -291,14 +325,15 @@ static int take_count(reader *r, fields *fs, const char *what, uint32_t max, uin
         return fail(r, "missing %s (field %u)", what, fs->index + 1);
     size_t len = strlen(s);
     unsigned long long v = 0;
+    excerpt e;
     for (size_t i = 0; i < len; i++) {
-        if (s[i] < '0' || s[i] > '9' || len > 18)
-            return fail(r, "%s is not a count: '%.24s%s' (field %u)", what, s,
-                        len > 24 ? "..." : "", fs->index);
-        v = v * 10 + (unsigned)(s[i] - '0');
+        if (s[i] < '0' || s[i] > '9')
+            return fail(r, "%s is not a count: '%s' (field %u)", what, quote(&e, s), fs->index);
+        if (v <= max)                /* stops growing once too big: no overflow */
+            v = v * 10 + (unsigned)(s[i] - '0');
     }
     if (v > max)
-        return fail(r, "%s %llu out of range (at most %u)", what, v, max);
+        return fail(r, "%s %s out of range (at most %u)", what, quote(&e, s), max);
     *out = (uint32_t)v;
     return 0;
 }
@@ -455,12 +490,29 @@ static int parse_flaser(reader *r, fields *fs)
 /* Beam order reversed so that the step is positive (the library's rule). */
 static void reverse_last(scanlog *log, size_t n)
 {
-    float *a = log->pool + log->pool_len;
+    float *a = log->pool + log->pool_len;    /* n > 1: the pool holds them */
     for (size_t i = 0; i < n / 2; i++) {
         float t = a[i];
         a[i] = a[n - 1 - i];
         a[n - 1 - i] = t;
     }
+}
+
+/* The library's rules (polyc_add_scan) on the float values it will get, so
+ * that every scan read is one it accepts and a bad one is named by line. */
+static int check_scan(reader *r, const polyc_scan *s)
+{
+    if (!(fabsf(s->start_angle_rad) <= SCANLOG_MAX_START_RAD))
+        return fail(r, "start angle %g rad beyond +-%g rad", (double)s->start_angle_rad,
+                    (double)SCANLOG_MAX_START_RAD);
+    if (!(s->angle_step_rad > 0.0f && s->angle_step_rad <= SCANLOG_MAX_STEP_RAD))
+        return fail(r, "angle step %g rad not in (0, %g]", (double)s->angle_step_rad,
+                    (double)SCANLOG_MAX_STEP_RAD);
+    if (!(s->max_range_m > s->min_range_m))
+        return fail(r, "max range %g m not above min range %g m%s", (double)s->max_range_m,
+                    (double)s->min_range_m,
+                    r->max_range_m > 0 ? " (max range lowered by option)" : "");
+    return 0;
 }
 
 static int check_max_range(reader *r, double max_range_m, polyc_scan *s)
@@ -505,15 +557,17 @@ static int parse_robotlaser1(reader *r, fields *fs)
         return -1;
     if (res == 0 && n > 1)
         return fail(r, "angular_res is 0 with %u beams", n);
-    if (res < 0) {
+    if (res < 0 && n > 1) {
         reverse_last(r->log, n);
         start += (n - 1) * res;
         res = -res;
     }
     s.start_angle_rad = (float)start;
-    s.angle_step_rad = res > 0 ? (float)res : 1.0f;   /* one beam: any step */
+    s.angle_step_rad = n > 1 ? (float)res : 1.0f;   /* one beam or none: any step */
     s.min_range_m = SCANLOG_MIN_RANGE_M;
     s.beam_count = n;
+    if (check_scan(r, &s))
+        return -1;
     return push_scan(r, &s, SCANLOG_ROBOTLASER1);
 }
 
@@ -530,8 +584,6 @@ static int parse_plain(reader *r, fields *fs)
         take_count(r, fs, "beam count", SCANLOG_MAX_BEAMS_SCAN, &n) ||
         check_tail(r, fs, "SCAN", "beams", n, 0) || take_ranges(r, fs, n, 0.0f))
         return -1;
-    if (!(step > 0))
-        return fail(r, "angle step %g must be > 0", step);
     if (!isfinite(min_r) || min_r < 0 || min_r >= max_r)
         return fail(r, "min range %g m must be finite, >= 0 and below max range", min_r);
     if (check_max_range(r, max_r, &s))
@@ -540,6 +592,8 @@ static int parse_plain(reader *r, fields *fs)
     s.angle_step_rad = (float)step;
     s.min_range_m = (float)min_r;
     s.beam_count = n;
+    if (check_scan(r, &s))
+        return -1;
     return push_scan(r, &s, SCANLOG_PLAIN);
 }
 
@@ -579,9 +633,10 @@ static int parse_comment(reader *r, char *line)
     char *w = next_field(&fs);
     if (w && strcmp(w, "polyc-scans") == 0) {
         char *v = next_field(&fs);
+        excerpt e;
         if (!v || strcmp(v, "1") != 0)
-            return fail(r, "unsupported polyc-scans version '%.16s' (this reader: 1)",
-                        v ? v : "");
+            return fail(r, "unsupported polyc-scans version '%s' (this reader: 1)",
+                        quote(&e, v ? v : ""));
     }
     count_keyword(r->log, "#");
     return 0;
@@ -606,9 +661,10 @@ static int parse_line(reader *r, char *line)
         return parse_robotlaser1(r, &fs);
     if (strcmp(word, "SCAN") == 0)
         return parse_plain(r, &fs);
-    if (!is_keyword(word))
-        return fail(r, "not a log line: starts with '%.24s%s'", word,
-                    strlen(word) > 24 ? "..." : "");
+    if (!is_keyword(word)) {
+        excerpt e;
+        return fail(r, "not a log line: starts with '%s'", quote(&e, word));
+    }
     count_keyword(r->log, word);
     return 0;
 }
@@ -630,8 +686,8 @@ static int finish(reader *r)
             uint64_t *prefix = malloc((NR_BINS + 1) * sizeof *prefix);
             if (h.bin && prefix) {
                 for (uint32_t i = 0; i < log->count; i++) {
-                    if (log->kind_of_scan[i] != SCANLOG_FLASER)
-                        continue;
+                    if (log->kind_of_scan[i] != SCANLOG_FLASER || !log->scans[i].beam_count)
+                        continue;         /* no ranges: the pool may be NULL */
                     const float *a = log->pool + log->offset_of_scan[i];
                     for (uint32_t j = 0; j < log->scans[i].beam_count; j++)
                         nr_add(&h, a[j]);
@@ -662,12 +718,17 @@ int scanlog_read(scanlog *log, FILE *f, const char *name, const scanlog_opts *op
     memset(&r, 0, sizeof r);
     r.log = log;
     r.name = name;
-    r.max_range_m = opts && opts->max_range_m > 0 ? opts->max_range_m : 0;
+    r.max_range_m = opts && opts->max_range_m > (double)SCANLOG_MIN_RANGE_M ? opts->max_range_m : 0;
     while ((got = read_line(&r, f, &len)) == 1) {
         log->lines++;
         size_t pool_len = log->pool_len;
         if (parse_line(&r, r.buf)) {
             log->pool_len = pool_len;
+            if (r.partial) {             /* say why a last line may be cut short */
+                size_t n = strlen(log->error);
+                snprintf(log->error + n, sizeof log->error - n,
+                         " (the file ends inside this line: truncated?)");
+            }
             break;
         }
     }

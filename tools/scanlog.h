@@ -16,12 +16,16 @@
 #define SCANLOG_MAX_ANGLE_RAD    1e3
 #define SCANLOG_MIN_RANGE_M      0.02f  /* Hokuyo error codes are 0..19 mm */
 #define SCANLOG_MAX_KEYWORDS     16
+/* The library's limits on a scan's angles (polyc_add_scan), checked here */
+#define SCANLOG_MAX_START_RAD    100.0f
+#define SCANLOG_MAX_STEP_RAD     6.2832f
 
 enum scanlog_kind { SCANLOG_FLASER = 1, SCANLOG_ROBOTLASER1 = 2, SCANLOG_PLAIN = 3 };
 
 typedef struct scanlog_opts {
-    double max_range_m;        /* > 0: FLASER no-return threshold (no detection);
-                                  other formats: lowers max_range_m to this */
+    double max_range_m;        /* > 0.02: FLASER no-return threshold (no detection);
+                                  other formats: lowers max_range_m to this;
+                                  other values: ignored */
 } scanlog_opts;
 
 /* Line types that were skipped, with their counts (first SCANLOG_MAX_KEYWORDS). */
