@@ -210,6 +210,17 @@ static int32_t add_line(polyc__opt *o, const float *xy, int n, int closed)
     return l;
 }
 
+/* A hand case: points every 1 cm along a straight wall from (-1, 0) to
+ * (1, 0), no polylines yet. */
+static void open_straight_wall(fixture *f, ptlist *p)
+{
+    fx_open_hand(f, 0.0f);
+    p->n = 0;
+    pts_line(p, -1.0f, 0.0f, 1.0f, 0.0f, 0.01f);
+    set_points(f, p->xy, p->n);
+    clear_lines(&f->o);
+}
+
 static void rebuild(polyc__opt *o)
 {
     check_st(polyc__rebuild(o), o->ctx, "rebuild");
@@ -747,11 +758,7 @@ static void test_overlaps_trims_overlapping_end(void **state)
     (void)state;
     static fixture f;
     static ptlist p;
-    fx_open_hand(&f, 0.0f);
-    p.n = 0;
-    pts_line(&p, -1.0f, 0.0f, 1.0f, 0.0f, 0.01f);
-    set_points(&f, p.xy, p.n);
-    clear_lines(&f.o);
+    open_straight_wall(&f, &p);
     /* A ends along B (both vertices of its last segment within 2 cm of B);
      * B's first segment is within 5 cm of A only at its head */
     const float a[6] = {-1.0f, 0.0f, 0.1f, 0.0f, 0.3f, 0.0f};
@@ -1058,11 +1065,7 @@ static void test_zigzag_removes_hairpin(void **state)
     (void)state;
     static fixture f;
     static ptlist p;
-    fx_open_hand(&f, 0.0f);
-    p.n = 0;
-    pts_line(&p, -1.0f, 0.0f, 1.0f, 0.0f, 0.01f);
-    set_points(&f, p.xy, p.n);
-    clear_lines(&f.o);
+    open_straight_wall(&f, &p);
     /* a spike 40 cm out of a straight wall: its tip turns by 177 degrees */
     const float xy[10] = {-1.0f, 0.0f, 0.0f, 0.0f, 0.02f, 0.4f, 0.04f, 0.0f, 1.0f, 0.0f};
     const float after[8] = {-1.0f, 0.0f, 0.0f, 0.0f, 0.04f, 0.0f, 1.0f, 0.0f};
@@ -1154,11 +1157,7 @@ static void test_remove_collinear_vertex(void **state)
     (void)state;
     static fixture f;
     static ptlist p;
-    fx_open_hand(&f, 0.0f);
-    p.n = 0;
-    pts_line(&p, -1.0f, 0.0f, 1.0f, 0.0f, 0.01f);
-    set_points(&f, p.xy, p.n);
-    clear_lines(&f.o);
+    open_straight_wall(&f, &p);
     const float xy[6] = {-1.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f}, after[4] = {-1.0f, 0.0f, 1.0f, 0.0f};
     int32_t l = add_line(&f.o, xy, 3, 0);
     rebuild(&f.o);
