@@ -73,10 +73,14 @@ static int try_corner(polyc__opt *o, int32_t b, int32_t c, int k)
     return 1;
 }
 
-int polyc__op_corners(polyc__opt *o)
+/* Candidates: chains starting at a vertex edited at or after touch stamp
+ * `since` (0: all). */
+int polyc__op_corners(polyc__opt *o, uint32_t since)
 {
     int changed = 0;
     for (int32_t b = 0; b < o->s->v_high; b++) {
+        if (o->v_touch[b] < since)
+            continue;
         for (int k = 1; k <= CHAIN_MAX; k++) { /* (k = 0 would be b itself) */
             if (o->s->v[b].line == POLYC__NONE || o->s->l[o->s->v[b].line].count < CHAIN_MAX + 4)
                 break;

@@ -166,7 +166,7 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
         polyc__op_adjust(&o, ADJUST_ROUNDS, since); /* D moves what is left */
         uint32_t mark = ++o.touch_stamp;
         polyc__op_zigzag(&o);            /* E */
-        polyc__op_corners(&o);           /* corners (not in the paper) */
+        polyc__op_corners(&o, since);    /* corners (not in the paper) */
         polyc__op_remove_vertices(&o, mark); /* G */
         polyc__op_add_vertices(&o, ADD_ROUNDS); /* G, more vertices */
         polyc__op_adjust(&o, ADJUST_ROUNDS, mark);
@@ -174,7 +174,7 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
          * clean them before the model is judged, so the best one is clean */
         for (int round = 0; round < 3; round++) {
             mark = ++o.touch_stamp;
-            if (polyc__op_split(&o) + polyc__op_zigzag(&o) + polyc__op_corners(&o) == 0)
+            if (polyc__op_split(&o) + polyc__op_zigzag(&o) + polyc__op_corners(&o, since) == 0)
                 break;
             polyc__op_adjust(&o, ADJUST_ROUNDS, mark);
         }
@@ -182,12 +182,13 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
         if (o.h.out_of_entries)
             return restore_best(&o, polyc__fail(ctx, POLYC_ERR_NOMEM, "spatial hash full"));
         double bic = polyc__bic(&o);
+        /* any better map is kept; a gain under one BIC unit (no evidence
+         * either way) does not restart the patience: late iterations can
+         * cycle between maps that differ by a vertex and a fraction of it */
+        quiet = bic < best - 1.0 ? 0 : quiet + 1;
         if (bic < best - 1e-9 * fabs(best)) {
             best = bic;
             polyc__flat_from_store(&o.best, o.s);
-            quiet = 0;
-        } else {
-            quiet++;
         }
         polyc_iteration rep;
         memset(&rep, 0, sizeof rep);

@@ -133,7 +133,7 @@ int polyc__op_merge(polyc__opt *o);
 int polyc__op_split(polyc__opt *o);
 int polyc__op_adjust(polyc__opt *o, int max_rounds, uint32_t since);
 int polyc__op_zigzag(polyc__opt *o);
-int polyc__op_corners(polyc__opt *o);
+int polyc__op_corners(polyc__opt *o, uint32_t since);
 int polyc__op_trim_ends(polyc__opt *o);
 void polyc__op_noise(polyc__opt *o, double sigma_m);
 int polyc__op_remove_vertices(polyc__opt *o, uint32_t since);

@@ -576,7 +576,7 @@ static const char *random_step(polyc__opt *o, polyc__rng *r)
     case 11: polyc__op_merge(o); return "merge";
     case 12: polyc__op_split(o); return "split";
     case 13: polyc__op_zigzag(o); return "zigzag";
-    case 14: polyc__op_corners(o); return "corners";
+    case 14: polyc__op_corners(o, 0); return "corners";
     case 15: polyc__op_remove_vertices(o, 0); return "remove_vertices";
     case 16: polyc__op_add_vertices(o, 1); return "add_vertices";
     case 17: polyc__op_adjust(o, 2, irand(r, 2) ? o->touch_stamp : 0); return "adjust";
@@ -1043,7 +1043,7 @@ static void test_bic_checked_operators_never_raise_bic(void **state)
                 switch (op) {
                 case 0: polyc__op_adjust(&f.o, 3, 0); break;
                 case 1: polyc__op_zigzag(&f.o); break;
-                case 2: polyc__op_corners(&f.o); break;
+                case 2: polyc__op_corners(&f.o, 0); break;
                 case 3: polyc__op_remove_vertices(&f.o, 0); break;
                 default: polyc__op_add_vertices(&f.o, 2); break;
                 }
@@ -1267,7 +1267,7 @@ static void test_corner_replaces_spike(void **state)
     int32_t l = add_line(&f.o, xy, 7, 0);
     rebuild(&f.o);
     double before = polyc__bic(&f.o);
-    int changed = polyc__op_corners(&f.o);
+    int changed = polyc__op_corners(&f.o, 0);
     check_books(&f.o, "corner");
     assert_line_near(&f.o, l, after, 5, 1e-6f);
     assert_int_equal(changed, 1);
@@ -1293,7 +1293,7 @@ static void test_corners_leave_clean_map(void **state)
     clear_lines(&f.o);
     int32_t l = add_line(&f.o, xy, 8, 0);
     rebuild(&f.o);
-    int changed = polyc__op_corners(&f.o);
+    int changed = polyc__op_corners(&f.o, 0);
     assert_line_is(&f.o, l, xy, 8);
     assert_int_equal(changed, 0);
     fx_close(&f);
