@@ -252,7 +252,9 @@ POLYC_API polyc_status polyc_grid_info(const polyc_ctx *ctx, double *origin_x_m,
 POLYC_API polyc_status polyc_grid_cell(const polyc_ctx *ctx, uint32_t ix, uint32_t iy,
                                        uint32_t *hits, uint32_t *misses, uint32_t *contour);
 
-/* First error's static message and, for scans, the scan index (or -1). */
+/* The static message of the first error of the last failed call ("" if the
+ * last call succeeded); for a rejected scan it says what was wrong with it,
+ * and the scan is the one that polyc_add_scan was given. */
 POLYC_API const char *polyc_last_error(const polyc_ctx *ctx);
 
 #ifdef __cplusplus
