@@ -1,6 +1,6 @@
 /* points.c - the data points d_i of the BIC (paper eq. 2).
  * Takes: the grid and the scans. Gives: the reflected endpoints that fall in
- * a cell the grid does not judge free (m >= data_min_m), as one weighted point
+ * a cell the grid judges not free, i.e. m >= data_min_m, as one weighted point
  * per block of 2 x 2 grid cells (count, mean, second moments: squared distances to a line
  * stay exact) or, with POLYC_FLAG_EXACT_POINTS, one point per endpoint;
  * sorted by spatial-hash bucket. */
