@@ -156,7 +156,7 @@ static void bin_segment(gtscore_index *index, uint32_t s, uint32_t *cursor, int 
 
 int gtscore_index_build(gtscore_index *index, double cell_m)
 {
-    double min_x = INFINITY, min_y = INFINITY, max_x = -INFINITY, max_y = -INFINITY;
+    double min_x = HUGE_VAL, min_y = HUGE_VAL, max_x = -HUGE_VAL, max_y = -HUGE_VAL;
     double span_x, span_y, cells;
     uint32_t s, *cursor = NULL;
     size_t c, n, total;
@@ -241,14 +241,14 @@ static double cell_distance2(const gtscore_index *index, int64_t x, int64_t y, d
  * limit_m around the point can hold a segment that near. */
 static double box_distance(const gtscore_index *index, double x_m, double y_m, double limit_m)
 {
-    double best2 = INFINITY;
+    double best2 = HUGE_VAL;
     double fx0 = floor((x_m - limit_m - index->origin_x_m) / index->cell_m);
     double fx1 = floor((x_m + limit_m - index->origin_x_m) / index->cell_m);
     double fy0 = floor((y_m - limit_m - index->origin_y_m) / index->cell_m);
     double fy1 = floor((y_m + limit_m - index->origin_y_m) / index->cell_m);
     int64_t x, y, x0, x1, y0, y1;
     if (fx1 < 0.0 || fy1 < 0.0 || fx0 >= (double)index->width || fy0 >= (double)index->height)
-        return INFINITY;
+        return HUGE_VAL;
     x0 = fx0 < 0.0 ? 0 : (int64_t)fx0;
     y0 = fy0 < 0.0 ? 0 : (int64_t)fy0;
     x1 = fx1 >= (double)index->width ? (int64_t)index->width - 1 : (int64_t)fx1;
@@ -267,10 +267,10 @@ static int64_t max64(int64_t a, int64_t b)
 double gtscore_index_distance(const gtscore_index *index, double x_m, double y_m,
                               double limit_m)
 {
-    double best2 = INFINITY, fx, fy;
+    double best2 = HUGE_VAL, fx, fy;
     int64_t cx, cy, w, h, k, k_first, k_last;
     if (!index->cell_start || !isfinite(x_m) || !isfinite(y_m))
-        return INFINITY;
+        return HUGE_VAL;
     if (limit_m <= 2.0 * index->cell_m)
         return box_distance(index, x_m, y_m, limit_m);
     w = (int64_t)index->width;
@@ -278,7 +278,7 @@ double gtscore_index_distance(const gtscore_index *index, double x_m, double y_m
     fx = floor((x_m - index->origin_x_m) / index->cell_m);
     fy = floor((y_m - index->origin_y_m) / index->cell_m);
     if (fabs(fx) > 1e15 || fabs(fy) > 1e15)
-        return INFINITY;
+        return HUGE_VAL;
     cx = (int64_t)fx;
     cy = (int64_t)fy;
     /* rings that intersect the grid: Chebyshev distance to it, and to its
@@ -315,11 +315,11 @@ static double ray_segment(const double *s, double ox, double oy, double dx, doub
     double denom = dx * ey - dy * ex;
     double t, u;
     if (fabs(denom) < 1e-15)
-        return INFINITY; /* parallel, or a point: the ray grazes it */
+        return HUGE_VAL; /* parallel, or a point: the ray grazes it */
     t = (wx * ey - wy * ex) / denom;
     u = (wx * dy - wy * dx) / denom;
     if (t <= 1e-12 || u < -1e-12 || u > 1.0 + 1e-12)
-        return INFINITY;
+        return HUGE_VAL;
     return t;
 }
 
@@ -330,29 +330,29 @@ double gtscore_index_ray(const gtscore_index *index, double x_m, double y_m, dou
     double x_lo = index->origin_x_m, y_lo = index->origin_y_m;
     double x_hi = x_lo + index->cell_m * index->width;
     double y_hi = y_lo + index->cell_m * index->height;
-    double t_in = 0.0, t_out = max_range_m, best = INFINITY;
+    double t_in = 0.0, t_out = max_range_m, best = HUGE_VAL;
     double t_next_x, t_next_y, t_step_x, t_step_y, px, py;
     int64_t cx, cy, step_x, step_y;
 
     if (!index->cell_start || !isfinite(x_m) || !isfinite(y_m) || !(max_range_m > 0.0))
-        return INFINITY;
+        return HUGE_VAL;
     /* clip the ray to the grid box (slabs) */
     if (dx != 0.0) {
         double t0 = (x_lo - x_m) / dx, t1 = (x_hi - x_m) / dx;
         t_in = fmax(t_in, fmin(t0, t1));
         t_out = fmin(t_out, fmax(t0, t1));
     } else if (x_m < x_lo || x_m >= x_hi) {
-        return INFINITY;
+        return HUGE_VAL;
     }
     if (dy != 0.0) {
         double t0 = (y_lo - y_m) / dy, t1 = (y_hi - y_m) / dy;
         t_in = fmax(t_in, fmin(t0, t1));
         t_out = fmin(t_out, fmax(t0, t1));
     } else if (y_m < y_lo || y_m >= y_hi) {
-        return INFINITY;
+        return HUGE_VAL;
     }
     if (t_in > t_out)
-        return INFINITY;
+        return HUGE_VAL;
 
     px = x_m + t_in * dx;
     py = y_m + t_in * dy;

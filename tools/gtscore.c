@@ -254,7 +254,7 @@ static int sample_segment(const gtscore_truth *truth, const float *a, const floa
     for (k = 0; k < n; k++) {
         double t = (double)k / (double)n;
         (*dist)[(*count)++] = gtscore_index_distance(&truth->index, ax + (bx - ax) * t,
-                                                     ay + (by - ay) * t, INFINITY);
+                                                     ay + (by - ay) * t, HUGE_VAL);
     }
     return 0;
 }

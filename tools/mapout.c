@@ -141,8 +141,8 @@ static int endpoint(const polyc_scan *s, uint32_t j, double *x, double *y)
 
 static void make_view(const mapout_map *map, view *v)
 {
-    v->x0 = v->y0 = INFINITY;
-    v->x1 = v->y1 = -INFINITY;
+    v->x0 = v->y0 = HUGE_VAL;
+    v->x1 = v->y1 = -HUGE_VAL;
     for (uint32_t i = 0; i < map->line_count; i++)
         for (uint32_t j = 0; j < map->lines[i].point_count; j++)
             box_add(v, (double)map->lines[i].xy_m[2 * j], (double)map->lines[i].xy_m[2 * j + 1]);

@@ -303,7 +303,7 @@ static double cast_ray(const scansim_scene *scene, double ox, double oy, double 
                        uint32_t scan, int32_t *segment, double *along)
 {
     double dx = cos(angle), dy = sin(angle);
-    double best = INFINITY;
+    double best = HUGE_VAL;
     int32_t best_seg = -1;
     double best_u = 0.0;
     uint32_t w, j, seg = 0;
