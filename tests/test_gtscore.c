@@ -248,7 +248,7 @@ static void test_index_vs_brute_force(void **state)
         double x = 40.0 * scansim_rng_uniform(&rng) - 20.0;
         double y = 30.0 * scansim_rng_uniform(&rng) - 10.0;
         double a = 6.283 * scansim_rng_uniform(&rng);
-        double best_d = INFINITY, best_t = INFINITY, d, t;
+        double best_d = HUGE_VAL, best_t = HUGE_VAL, d, t;
         for (i = 0; i < SEGS; i++) {
             const double *g = &seg[4 * i];
             double ex = g[2] - g[0], ey = g[3] - g[1], wx = x - g[0], wy = y - g[1];
@@ -264,7 +264,7 @@ static void test_index_vs_brute_force(void **state)
                     best_t = tt;
             }
         }
-        d = gtscore_index_distance(&index, x, y, INFINITY);
+        d = gtscore_index_distance(&index, x, y, HUGE_VAL);
         assert_near(d, best_d, 1e-9);
         d = gtscore_index_distance(&index, x, y, 0.2);
         if (best_d <= 0.2)

@@ -175,7 +175,7 @@ static void test_json_stats(void **state)
     memset(&s, 0, sizeof s);
     s.scans = 3;
     s.beams = 5000000000ull;
-    s.bic = NAN;                        /* JSON has no NaN: null */
+    s.bic = (double)NAN;                        /* JSON has no NaN: null */
     s.error_sq_m2 = 0.25;
     m.stats = &s;
     m.times = &t;

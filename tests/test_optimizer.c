@@ -1452,7 +1452,7 @@ static void test_optimize_room(void **state)
         }
         /* each vertex within 1 cm of a corner of the room */
         for (uint32_t k = 0; k < 4; k++) {
-            double x = map[run][2 * k], y = map[run][2 * k + 1];
+            double x = (double)map[run][2 * k], y = (double)map[run][2 * k + 1];
             double cx = x < 0.0 ? ROOM_X0 : ROOM_X1, cy = y < 0.0 ? ROOM_Y0 : ROOM_Y1;
             if (hypot(x - cx, y - cy) > 0.01)
                 fail_msg("vertex (%.4f, %.4f) is %.1f mm from the corner", x, y,
