@@ -67,8 +67,15 @@ unit: $(TEST_BIN) $(BUILD)/polyc
 # valgrind run and the Cortex-M cross build.
 check: deps
 	$(MAKE) test
+	$(MAKE) test-opt
 	$(MAKE) test-valgrind
 	$(MAKE) cross
+
+# The unit suites again under other optimisation settings (-O3, -Os -flto).
+.PHONY: test-opt
+test-opt:
+	$(MAKE) BUILD=build-O3 OPT='-O3 -g' unit
+	$(MAKE) BUILD=build-Os OPT='-Os -flto' unit
 deps:
 	sh tools/install-deps.sh
 
