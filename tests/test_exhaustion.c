@@ -89,6 +89,15 @@ static polyc_status build_scene(polyc_ctx *ctx, const scansim_scene *sc, const c
     return st;
 }
 
+/* The small scene, its configuration (3 iterations) and its limits. */
+static void open_small(scansim_scene *sc, polyc_config *cfg, polyc_limits *lim)
+{
+    assert_int_equal(small_scene(sc), 0);
+    small_config(cfg);
+    cfg->max_iterations = 3;
+    assert_int_equal(polyc_limits_for_scans(cfg, sc->scans, sc->scan_count, lim), POLYC_OK);
+}
+
 /* The small scene in a block of `size` bytes. */
 static polyc_status run_block(const scansim_scene *sc, const polyc_config *cfg,
                               const polyc_limits *lim, size_t size, size_t skew, size_t need)
@@ -121,10 +130,7 @@ static void test_every_block_size(void **state)
     scansim_scene sc;
     polyc_config cfg;
     polyc_limits lim;
-    assert_int_equal(small_scene(&sc), 0);
-    small_config(&cfg);
-    cfg.max_iterations = 3;
-    assert_int_equal(polyc_limits_for_scans(&cfg, sc.scans, sc.scan_count, &lim), POLYC_OK);
+    open_small(&sc, &cfg, &lim);
     size_t need = polyc_memory_size(&cfg, &lim);
     assert_true(need > 4096);
     uint32_t runs = 0, ok = 0;
@@ -164,9 +170,9 @@ static uint32_t *field(polyc_limits *lim, int f)
 }
 
 /* The small scene with `lim`, in a block of exactly the queried size. On a
- * failure the context must still work: after polyc_reset, two of the
- * scene's scans that fit in what is left build a map (or the budget is too
- * small even for them, NOMEM again), and an empty context builds. */
+ * failure the context must still work: after polyc_reset an empty context
+ * builds, and after another reset one of the scene's scans builds a map (or
+ * the budget is too small even for it: NOMEM or LIMIT again). */
 static polyc_status run_limits(const scansim_scene *sc, const polyc_config *cfg,
                                const polyc_limits *lim, const char *what)
 {
@@ -198,10 +204,7 @@ static void test_limits_too_small(void **state)
     scansim_scene sc;
     polyc_config cfg;
     polyc_limits full;
-    assert_int_equal(small_scene(&sc), 0);
-    small_config(&cfg);
-    cfg.max_iterations = 3;
-    assert_int_equal(polyc_limits_for_scans(&cfg, sc.scans, sc.scan_count, &full), POLYC_OK);
+    open_small(&sc, &cfg, &full);
     /* vertices and points as the scene needs at most: all beams */
     full.max_vertices = full.max_beams + 1024;
     full.max_points = full.max_beams;
