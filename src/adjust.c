@@ -56,8 +56,9 @@ static int segs_at(const polyc__opt *o, int32_t v, float x, float y, float *xy)
 }
 
 /* Commits the move of v to (x, y) found by hill_climb from its local
- * evaluation: every point whose cost can change is in the prepared list
- * (those on v's segments are never pruned), so nothing is rescored twice. */
+ * evaluation: every point whose cost can change is in the prepared list or
+ * aggregated on one of v's segments (those on v's segments are never
+ * pruned), so nothing is rescored twice. */
 static void commit_move(polyc__opt *o, int32_t v, float x, float y)
 {
     polyc__vertex *V = o->s->v;
@@ -100,6 +101,15 @@ static void commit_move(polyc__opt *o, int32_t v, float x, float y)
         o->pt_cost[i] = c;
         o->pt_seg[i] = sg;
     }
+    /* the aggregated points: on their segment, whatever the move */
+    for (int j = 0; j < ns; j++)
+        for (int32_t k = 0; k < o->agg_n[j]; k++) {
+            int32_t i = o->agg_pt[j == 0 ? k : o->agg_cap - 1 - k];
+            double c = polyc__cost(&o->pts[i], xy[4 * j], xy[4 * j + 1], xy[4 * j + 2], xy[4 * j + 3]);
+            o->err += c - o->pt_cost[i];
+            o->pt_cost[i] = c;
+            o->pt_seg[i] = id[j];
+        }
     for (int k = 0; k < 3; k++)
         if (nb[k] != POLYC__NONE) {
             o->acost[nb[k]] = polyc__vertex_angle_cost(o, nb[k]);
@@ -120,7 +130,7 @@ int polyc__hill_climb(polyc__opt *o, int32_t v)
     int32_t old[2] = {V[v].prev, V[v].next != POLYC__NONE ? v : POLYC__NONE};
     float xy[8];
     int ns = segs_at(o, v, x, y, xy);
-    polyc__local_prepare(o, old, 2, xy, ns, reach + step);
+    polyc__local_prepare_move(o, old, 2, xy, ns, reach + step, x, y);
     double cur = polyc__local_current(o) + (double)gamma * local_angles(o, v, x, y);
     int moved = 0, last = -1;
     for (int it = 0; it < 64; it++) {

@@ -46,8 +46,10 @@ static polyc__heap_entry heap_pop(polyc__opt *o)
     return top;
 }
 
-/* Change of the BIC if v is removed (see polyc__op_remove for the cases). */
-double polyc__removal_delta(polyc__opt *o, int32_t v)
+/* Change of the BIC if v is removed (see polyc__op_remove for the cases),
+ * exact if it is below `bound`, else some value >= bound: proving that a
+ * removal does not pay needs fewer nearest-segment queries than its value. */
+double polyc__removal_delta_below(polyc__opt *o, int32_t v, double bound)
 {
     const polyc__store *s = o->s;
     const polyc__vertex *V = s->v;
@@ -89,9 +91,11 @@ double polyc__removal_delta(polyc__opt *o, int32_t v)
                 dangle += polyc__turn_cost(o, V[p].x, V[p].y, V[n].x, V[n].y, V[nn].x, V[nn].y);
         }
     }
-    polyc__local_prepare(o, old, n_old, xy, n_new, 0.0f);
-    double derr = polyc__local_eval(o, xy, n_new) - polyc__local_current(o);
-    return (double)o->cfg->alpha * (derr + gamma * dangle) + dk * o->log_n;
+    double alpha = (double)o->cfg->alpha;
+    /* delta < bound  <=>  derr < limit */
+    double limit = isinf(bound) ? bound : (bound - dk * o->log_n) / alpha - gamma * dangle;
+    double derr = polyc__local_delta(o, old, n_old, xy, n_new, limit);
+    return alpha * (derr + gamma * dangle) + dk * o->log_n;
 }
 
 /* Candidates: the vertices edited at or after touch stamp `since` (0: all);
@@ -104,7 +108,7 @@ int polyc__op_remove_vertices(polyc__opt *o, uint32_t since)
     for (int32_t v = 0; v < s->v_high; v++) {
         if (s->v[v].line == POLYC__NONE || o->v_touch[v] < since)
             continue;
-        double d = polyc__removal_delta(o, v);
+        double d = polyc__removal_delta_below(o, v, 0.0);
         if (d < 0.0)
             heap_push(o, d, v);
     }
@@ -113,7 +117,7 @@ int polyc__op_remove_vertices(polyc__opt *o, uint32_t since)
         polyc__heap_entry e = heap_pop(o);
         if (s->v[e.v].line == POLYC__NONE)
             continue;
-        double d = polyc__removal_delta(o, e.v);
+        double d = polyc__removal_delta_below(o, e.v, 0.0);
         if (d >= 0.0)
             continue;
         if (o->heap_n > 0 && d > o->heap[0].delta + 1e-9) {
@@ -128,7 +132,7 @@ int polyc__op_remove_vertices(polyc__opt *o, uint32_t since)
         for (int k = 0; k < 2; k++) {
             if (nb[k] == POLYC__NONE || s->v[nb[k]].line == POLYC__NONE)
                 continue;
-            double dn = polyc__removal_delta(o, nb[k]);
+            double dn = polyc__removal_delta_below(o, nb[k], 0.0);
             if (dn < 0.0)
                 heap_push(o, dn, nb[k]);
         }

@@ -6,6 +6,7 @@
 #include "optimize.h"
 
 #include <math.h>
+#include <string.h>
 #include <stdlib.h>
 
 /* ---- edits ---- */
@@ -346,6 +347,31 @@ static int cmp_float(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+/* True if the positions t[0..n) along a segment of length len leave no
+ * stretch longer than gap (the ends included) without one: every bin of
+ * half the gap holds a position. Spares sorting the many segments that
+ * have none; a segment of more than 1024 bins is left to the sort. */
+static int no_gap_over(const float *t, int32_t n, float len, float gap)
+{
+    uint64_t seen[16];
+    float h = 0.5f * gap;
+    if (!(h > 0.0f) || len / h > 1024.0f)
+        return 0;
+    int32_t nb = (int32_t)ceilf(len / h);
+    if (nb < 1)
+        nb = 1;
+    memset(seen, 0, sizeof seen);
+    for (int32_t k = 0; k < n; k++) {
+        int32_t b = (int32_t)(t[k] / h);
+        b = b < 0 ? 0 : (b >= nb ? nb - 1 : b);
+        seen[b >> 6] |= (uint64_t)1 << (b & 63);
+    }
+    for (int32_t b = 0; b < nb; b++)
+        if (!(seen[b >> 6] >> (b & 63) & 1u))
+            return 0;
+    return 1;
+}
+
 /* A segment with a stretch longer than split_gap_m (or 2.5 beam spacings
  * where the data are sparser than that), plus the span of a weighted point,
  * onto which no data point projects is cut there: the polyline ends on
@@ -389,6 +415,8 @@ int polyc__op_split(polyc__opt *o)
         if (len <= gap_min)
             continue;
         int32_t lo = off[v], hi = off[v + 1];
+        if (no_gap_over(t + lo, hi - lo, len, gap_min))
+            continue;
         qsort(t + lo, (size_t)(hi - lo), sizeof(float), cmp_float);
         float prev = 0.0f, best = 0.0f, g0 = 0.0f;
         for (int32_t k = lo; k <= hi; k++) {
@@ -512,7 +540,8 @@ int polyc__op_zigzag(polyc__opt *o)
         int spike = lu < 0.3f && lw < 0.3f && dot < -0.5f * lu * lw;
         if (!fold && !spike)
             continue;
-        if (polyc__removal_delta(o, v) > (spike ? o->log_n : 0.0))
+        double bound = spike ? o->log_n : 0.0;
+        if (polyc__removal_delta_below(o, v, bound) >= bound)
             continue;
         polyc__apply_remove(o, v);
         changed++;

@@ -53,6 +53,15 @@ typedef struct polyc__opt {
     int32_t *loc_seg;              /* and the segment giving it */
     int32_t loc_n;
     double loc_fixed, loc_fixed_cur; /* pruned points: base and current sums */
+    /* moving one vertex: points sure to stay in the interior of one of its
+     * segments and nearest to it, whatever the move within reach, are
+     * summed as second moments about the segment's fixed end (agg_m: xx,
+     * xy, yy), so that a trial costs O(1) for them: listed in agg_pt, those
+     * of segment 0 from the front (agg_n[0]), of segment 1 from the back */
+    int32_t *agg_pt, agg_cap, agg_n[2];
+    int agg_on;                    /* 0: no aggregation prepared */
+    int agg_moving_b[2];           /* the moving end is the segment's b */
+    double agg_ax[2], agg_ay[2], agg_m[2][3];
 
     /* split scratch: per segment offsets, positions of its points */
     int32_t *split_off;
@@ -114,8 +123,16 @@ void polyc__chg_commit(polyc__opt *o);
 /* local evaluation of replacing `old` segments by candidate geometry */
 void polyc__local_prepare(polyc__opt *o, const int32_t *old, int n_old, const float *seg_xy,
                           int n_new, float reach);
+/* the same for moving the vertex at (mx, my), the shared end of the n_new
+ * (1 or 2) segments, by at most `reach`: with aggregation */
+void polyc__local_prepare_move(polyc__opt *o, const int32_t *old, int n_old, const float *seg_xy,
+                               int n_new, float reach, float mx, float my);
 double polyc__local_eval(const polyc__opt *o, const float *seg_xy, int n_new);
 double polyc__local_current(const polyc__opt *o);
+/* the change of the error replacing `old` by seg_xy: exact below `limit`,
+ * else some value >= limit */
+double polyc__local_delta(polyc__opt *o, const int32_t *old, int n_old, const float *seg_xy,
+                          int n_new, double limit);
 
 /* edits (operators.c): each records its change; call chg_begin/commit around */
 void polyc__op_move(polyc__opt *o, int32_t v, float x, float y);
@@ -137,7 +154,9 @@ int polyc__op_corners(polyc__opt *o, uint32_t since);
 int polyc__op_trim_ends(polyc__opt *o);
 void polyc__op_noise(polyc__opt *o, double sigma_m);
 int polyc__op_remove_vertices(polyc__opt *o, uint32_t since);
-double polyc__removal_delta(polyc__opt *o, int32_t v);
+/* the change of the BIC if v is removed when that is below `bound`, else
+ * some value >= bound (INFINITY: always exact) */
+double polyc__removal_delta_below(polyc__opt *o, int32_t v, double bound);
 int polyc__op_add_vertices(polyc__opt *o, int max_tries);
 int polyc__hill_climb(polyc__opt *o, int32_t v);
 double polyc__turn_cost(const polyc__opt *o, float ax, float ay, float bx, float by, float cx,

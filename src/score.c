@@ -22,11 +22,10 @@ double polyc__cost(const polyc__point *p, float ax, float ay, float bx, float by
         double ex = (double)p->x - (double)bx, ey = (double)p->y - (double)by;
         return (double)p->w * (ex * ex + ey * ey) + trace;
     }
-    double inv = 1.0 / sqrt(l2);
-    double nx = -dy * inv, ny = dx * inv;
-    double d = nx * mx + ny * my;
-    return (double)p->w * d * d +
-           (nx * nx * (double)p->cxx + 2.0 * nx * ny * (double)p->cxy + ny * ny * (double)p->cyy);
+    /* w (n.m)^2 + n'Cn with n = (-dy, dx) / |d|: one division, no root */
+    double cross = dx * my - dy * mx;
+    return ((double)p->w * cross * cross + dy * dy * (double)p->cxx -
+            2.0 * dx * dy * (double)p->cxy + dx * dx * (double)p->cyy) / l2;
 }
 
 double polyc__cost_seg(const polyc__opt *o, const polyc__point *p, int32_t seg)
@@ -41,39 +40,62 @@ static double cap_of(const polyc__opt *o, const polyc__point *p)
     return (double)p->w * (double)o->R2;
 }
 
-double polyc__nearest(const polyc__opt *o, int32_t pi, const int32_t *skip, int n_skip,
-                      int32_t *seg)
+/* Own bucket first, then the eight around it nearest first, each only if
+ * it is nearer than the best cost so far allows: a segment is entered in
+ * every bucket it crosses, so one within distance D of the point crosses a
+ * bucket within D of it, and its cost is at least w D^2. */
+/* The nearest below `start` (NONE and `start` if there is none). */
+static double nearest_below(const polyc__opt *o, int32_t pi, const int32_t *skip, int n_skip,
+                            double start, int32_t *seg)
 {
+    static const int8_t ORDER[9][2] = {{0, 0}, {-1, 0}, {1, 0}, {0, -1}, {0, 1},
+                                       {-1, -1}, {1, -1}, {-1, 1}, {1, 1}};
     const polyc__hash *h = &o->h;
     const polyc__point *p = &o->pts[pi];
-    double best = cap_of(o, p);
+    double best = start, w = (double)p->w;
     int32_t best_seg = POLYC__NONE;
     int32_t b = polyc__bucket_of(h, p->x, p->y);
     int32_t bx = b % h->bx, by = b / h->bx;
-    for (int32_t y = by - 1; y <= by + 1; y++) {
-        if (y < 0 || y >= h->by)
+    /* distances to the bucket's four sides (0 if outside that side) */
+    double fx = ((double)p->x - (double)h->origin_x) - (double)bx * (double)h->bucket_m;
+    double fy = ((double)p->y - (double)h->origin_y) - (double)by * (double)h->bucket_m;
+    double side[2][3];
+    side[0][0] = fx > 0.0 ? fx : 0.0;
+    side[0][1] = 0.0;
+    side[0][2] = (double)h->bucket_m - fx > 0.0 ? (double)h->bucket_m - fx : 0.0;
+    side[1][0] = fy > 0.0 ? fy : 0.0;
+    side[1][1] = 0.0;
+    side[1][2] = (double)h->bucket_m - fy > 0.0 ? (double)h->bucket_m - fy : 0.0;
+    for (int k = 0; k < 9; k++) {
+        int32_t x = bx + ORDER[k][0], y = by + ORDER[k][1];
+        if (x < 0 || x >= h->bx || y < 0 || y >= h->by)
             continue;
-        for (int32_t x = bx - 1; x <= bx + 1; x++) {
-            if (x < 0 || x >= h->bx)
+        double gx = side[0][ORDER[k][0] + 1], gy = side[1][ORDER[k][1] + 1];
+        if (w * (gx * gx + gy * gy) >= best)
+            continue;
+        for (int32_t e = h->seg_head[y * h->bx + x]; e != POLYC__NONE; e = h->entries[e].next) {
+            int32_t sg = h->entries[e].seg;
+            int skipped = 0;
+            for (int j = 0; j < n_skip; j++)
+                skipped |= skip[j] == sg;
+            if (skipped)
                 continue;
-            for (int32_t e = h->seg_head[y * h->bx + x]; e != POLYC__NONE; e = h->entries[e].next) {
-                int32_t sg = h->entries[e].seg;
-                int skipped = 0;
-                for (int k = 0; k < n_skip; k++)
-                    skipped |= skip[k] == sg;
-                if (skipped)
-                    continue;
-                double c = polyc__cost_seg(o, p, sg);
-                if (c < best) {
-                    best = c;
-                    best_seg = sg;
-                }
+            double c = polyc__cost_seg(o, p, sg);
+            if (c < best) {
+                best = c;
+                best_seg = sg;
             }
         }
     }
     if (seg)
         *seg = best_seg;
     return best;
+}
+
+double polyc__nearest(const polyc__opt *o, int32_t pi, const int32_t *skip, int n_skip,
+                      int32_t *seg)
+{
+    return nearest_below(o, pi, skip, n_skip, cap_of(o, &o->pts[pi]), seg);
 }
 
 /* 1 - p(turn | x, y) at v; open ends have no angle. */
@@ -264,13 +286,41 @@ static double point_seg_dist(const polyc__point *p, const float *xy)
     return sqrt(ex * ex + ey * ey);
 }
 
+/* Can a move of the shared end c (by at most rho) take point p out of the
+ * interior of segment a-c, or make the other moving segment beat it? If
+ * not, the returned bound exceeds its cost on a-c for every trial, where
+ * that cost is exactly w (n.(p-a))^2 + n'Cn; if no other segment costs less
+ * than the bound either, the point can join the segment's moments. d_own
+ * and d_other are the distances of p to this segment and to the other
+ * moving one (1e30 if none). Returns 0 if the point may leave. */
+static double stay_bound(const polyc__point *p, double ax, double ay, double cx, double cy,
+                         double rho, double d_own, double d_other)
+{
+    double px = (double)p->x, py = (double)p->y;
+    double ux = cx - ax, uy = cy - ay, pax = px - ax, pay = py - ay;
+    /* projection after the end at a: (p-a).(c-a) > 0 for all |dc| <= rho */
+    if (pax * ux + pay * uy - sqrt(pax * pax + pay * pay) * rho <= 0.0)
+        return 0.0;
+    /* before the end at c: (c-p).(c-a) >= (c0-p).(c0-a) - rho |2c0-p-a| */
+    double cpx = cx - px, cpy = cy - py, sx = cpx + ux, sy = cpy + uy;
+    if (cpx * ux + cpy * uy - rho * sqrt(sx * sx + sy * sy) <= 0.0)
+        return 0.0;
+    /* its cost here is at most w (d + rho)^2 + trace(C), the other's at
+     * least w (d' - rho)^2 */
+    double w = (double)p->w, up = d_own + rho, lo = d_other - rho;
+    double worst = w * up * up + ((double)p->cxx + (double)p->cyy);
+    return lo > 0.0 && worst < w * lo * lo ? worst : 0.0;
+}
+
 /* Collects the points near the `old` segments and the candidate geometry,
  * with their cost when the old segments are gone (loc_base, loc_seg). With
  * reach > 0 the candidates stay within `reach` of seg_xy: a point not on an
  * old segment whose cost is below any cost it could get from them never
- * changes, and is summed once into loc_fixed instead of being listed. */
-void polyc__local_prepare(polyc__opt *o, const int32_t *old, int n_old, const float *seg_xy,
-                          int n_new, float reach)
+ * changes, and is summed once into loc_fixed instead of being listed. With
+ * `move`, the candidates differ by the position of the shared end (mx, my)
+ * only, and the points that stay on one segment are aggregated. */
+static void prepare(polyc__opt *o, const int32_t *old, int n_old, const float *seg_xy, int n_new,
+                    float reach, int move, float mx, float my)
 {
     const polyc__hash *h = &o->h;
     o->epoch++;
@@ -285,6 +335,21 @@ void polyc__local_prepare(polyc__opt *o, const int32_t *old, int n_old, const fl
     o->loc_n = 0;
     o->loc_fixed = 0.0;
     o->loc_fixed_cur = 0.0;
+    o->agg_on = move && n_new <= 2;
+    o->agg_n[0] = o->agg_n[1] = 0;
+    for (int j = 0; j < 2; j++) {
+        o->agg_m[j][0] = o->agg_m[j][1] = o->agg_m[j][2] = 0.0;
+        o->agg_moving_b[j] = 0;
+        o->agg_ax[j] = o->agg_ay[j] = 0.0;
+    }
+    if (o->agg_on)
+        for (int j = 0; j < n_new; j++) {
+            const float *q = seg_xy + 4 * j;
+            int b = q[2] == mx && q[3] == my;
+            o->agg_moving_b[j] = b;
+            o->agg_ax[j] = (double)(b ? q[0] : q[2]);
+            o->agg_ay[j] = (double)(b ? q[1] : q[3]);
+        }
     for (int32_t k = 0; k < o->bucket_n; k++) {
         int32_t b = o->bucket_list[k];
         for (uint32_t i = h->pt_start[b]; i < h->pt_start[b + 1]; i++) {
@@ -293,21 +358,55 @@ void polyc__local_prepare(polyc__opt *o, const int32_t *old, int n_old, const fl
             for (int j = 0; j < n_old; j++)
                 hit |= seg != POLYC__NONE && seg == old[j];
             int32_t base_seg = seg;
-            double base = hit ? polyc__nearest(o, (int32_t)i, old, n_old, &base_seg) : o->pt_cost[i];
-            if (reach > 0.0f && !hit) {
-                const polyc__point *p = &o->pts[i];
+            double base = o->pt_cost[i];
+            const polyc__point *p = &o->pts[i];
+            double d[2] = {1e30, 1e30};
+            if (reach > 0.0f) {
                 double dmin = 1e30;
                 for (int j = 0; j < n_new; j++) {
-                    double d = point_seg_dist(p, seg_xy + 4 * j);
-                    if (d < dmin)
-                        dmin = d;
+                    double dj = point_seg_dist(p, seg_xy + 4 * j);
+                    if (j < 2)
+                        d[j] = dj;
+                    if (dj < dmin)
+                        dmin = dj;
                 }
                 dmin -= (double)reach;
-                if (dmin > 0.0 && base <= (double)p->w * dmin * dmin) {
+                if (!hit && dmin > 0.0 && base <= (double)p->w * dmin * dmin) {
                     o->loc_fixed += base;
                     o->loc_fixed_cur += o->pt_cost[i];
                     continue;
                 }
+            }
+            int j = n_new == 2 && d[1] < d[0];
+            double bound = o->agg_on ? stay_bound(p, o->agg_ax[j], o->agg_ay[j], (double)mx,
+                                                  (double)my, (double)reach, d[j], d[1 - j])
+                                     : 0.0;
+            if (hit) {
+                /* without the old segments: a query within the bound is
+                 * enough to tell that the point stays (most do) */
+                double cap = cap_of(o, p);
+                base = nearest_below(o, (int32_t)i, old, n_old, bound > 0.0 && bound < cap ? bound : cap,
+                                     &base_seg);
+                if (base_seg != POLYC__NONE)
+                    bound = 0.0;
+                else if (bound > 0.0 && bound < cap)
+                    base = cap; /* unknown but irrelevant: the point stays */
+                else
+                    bound = 0.0;
+            } else if (bound >= base) {
+                bound = 0.0;
+            }
+            if (bound > 0.0) {
+                double dx = (double)p->x - o->agg_ax[j], dy = (double)p->y - o->agg_ay[j];
+                double w = (double)p->w;
+                o->agg_m[j][0] += w * dx * dx + (double)p->cxx;
+                o->agg_m[j][1] += w * dx * dy + (double)p->cxy;
+                o->agg_m[j][2] += w * dy * dy + (double)p->cyy;
+                int32_t slot = j == 0 ? o->agg_n[0] : o->agg_cap - 1 - o->agg_n[1];
+                o->agg_pt[slot] = (int32_t)i;
+                o->agg_n[j]++;
+                o->loc_fixed_cur += o->pt_cost[i];
+                continue;
             }
             o->loc_pt[o->loc_n] = (int32_t)i;
             o->loc_base[o->loc_n] = base;
@@ -318,6 +417,18 @@ void polyc__local_prepare(polyc__opt *o, const int32_t *old, int n_old, const fl
     o->bucket_n = 0;
 }
 
+void polyc__local_prepare(polyc__opt *o, const int32_t *old, int n_old, const float *seg_xy,
+                          int n_new, float reach)
+{
+    prepare(o, old, n_old, seg_xy, n_new, reach, 0, 0.0f, 0.0f);
+}
+
+void polyc__local_prepare_move(polyc__opt *o, const int32_t *old, int n_old, const float *seg_xy,
+                               int n_new, float reach, float mx, float my)
+{
+    prepare(o, old, n_old, seg_xy, n_new, reach, 1, mx, my);
+}
+
 double polyc__local_eval(const polyc__opt *o, const float *seg_xy, int n_new)
 {
     seg_pre q[4];
@@ -325,6 +436,16 @@ double polyc__local_eval(const polyc__opt *o, const float *seg_xy, int n_new)
     for (int j = 0; j < n_new; j++)
         seg_prepare(&q[j], seg_xy + 4 * j);
     double sum = o->loc_fixed;
+    if (o->agg_on)
+        for (int j = 0; j < n_new; j++) {
+            if (o->agg_n[j] == 0)
+                continue;
+            /* n'Mn with n the unit normal of the segment from its fixed end */
+            const float *e = seg_xy + 4 * j + (o->agg_moving_b[j] ? 2 : 0);
+            double ux = (double)e[0] - o->agg_ax[j], uy = (double)e[1] - o->agg_ay[j];
+            const double *m = o->agg_m[j];
+            sum += (m[0] * uy * uy - 2.0 * m[1] * ux * uy + m[2] * ux * ux) / (ux * ux + uy * uy);
+        }
     for (int32_t k = 0; k < o->loc_n; k++) {
         const polyc__point *p = &o->pts[o->loc_pt[k]];
         double c = o->loc_base[k];
@@ -344,4 +465,97 @@ double polyc__local_current(const polyc__opt *o)
     for (int32_t k = 0; k < o->loc_n; k++)
         sum += o->pt_cost[o->loc_pt[k]];
     return sum;
+}
+
+/* ---- bounded change of the error (removal candidates) ---- */
+
+/* Max-heap on loc_base (the most a pending point can add) over loc_pt. */
+static void pend_sift(polyc__opt *o, int32_t i, int32_t n)
+{
+    double key = o->loc_base[i];
+    int32_t pt = o->loc_pt[i];
+    for (;;) {
+        int32_t c = 2 * i + 1;
+        if (c >= n)
+            break;
+        if (c + 1 < n && o->loc_base[c + 1] > o->loc_base[c])
+            c++;
+        if (o->loc_base[c] <= key)
+            break;
+        o->loc_base[i] = o->loc_base[c];
+        o->loc_pt[i] = o->loc_pt[c];
+        i = c;
+    }
+    o->loc_base[i] = key;
+    o->loc_pt[i] = pt;
+}
+
+/* The change of the error when the `old` segments are replaced by seg_xy,
+ * exact when it is below `limit`; otherwise some value >= limit (enough to
+ * reject a removal). A point whose nearest segment goes needs a nearest
+ * query, unless a new segment serves it at least as well as now; the rest
+ * can only lose (their new cost is at least their current one), so they are
+ * queried largest possible loss first, and the queries stop as soon as the
+ * sure losses reach the limit. Most vertices worth keeping are settled by
+ * the few points at their corner. */
+double polyc__local_delta(polyc__opt *o, const int32_t *old, int n_old, const float *seg_xy,
+                          int n_new, double limit)
+{
+    const polyc__hash *h = &o->h;
+    seg_pre q[4];
+    POLYC_ASSERT(n_new <= 4);
+    for (int j = 0; j < n_new; j++)
+        seg_prepare(&q[j], seg_xy + 4 * j);
+    o->epoch++;
+    o->bucket_n = 0;
+    for (int k = 0; k < n_old; k++)
+        if (old[k] != POLYC__NONE)
+            mark_segment_region(o, old[k]);
+    for (int k = 0; k < n_new; k++) {
+        const float *s = seg_xy + 4 * k;
+        polyc__segment_buckets(o, s[0], s[1], s[2], s[3], 1, list_bucket);
+    }
+    double sure = 0.0; /* exact part so far; pending points add >= 0 each */
+    int32_t n = 0;
+    for (int32_t k = 0; k < o->bucket_n; k++) {
+        int32_t b = o->bucket_list[k];
+        for (uint32_t i = h->pt_start[b]; i < h->pt_start[b + 1]; i++) {
+            const polyc__point *p = &o->pts[i];
+            double cur = o->pt_cost[i], c = 1e300;
+            for (int j = 0; j < n_new; j++) {
+                double cj = seg_cost(&q[j], p);
+                if (cj < c)
+                    c = cj;
+            }
+            int32_t seg = o->pt_seg[i];
+            int hit = 0;
+            for (int j = 0; j < n_old; j++)
+                hit |= seg != POLYC__NONE && seg == old[j];
+            if (!hit || c <= cur) {
+                /* not hit: its cost without the old segments is cur; hit
+                 * with c <= cur: no other segment beats c (all are >= cur) */
+                sure += (c < cur ? c : cur) - cur;
+                continue;
+            }
+            o->loc_pt[n] = (int32_t)i;
+            o->loc_base[n] = (c < cap_of(o, p) ? c : cap_of(o, p)) - cur;
+            n++;
+        }
+    }
+    o->bucket_n = 0;
+    for (int32_t i = n / 2 - 1; i >= 0; i--)
+        pend_sift(o, i, n);
+    while (n > 0 && sure < limit) {
+        int32_t i = o->loc_pt[0];
+        double most = o->loc_base[0];
+        double base = polyc__nearest(o, i, old, n_old, NULL) - o->pt_cost[i];
+        sure += base < most ? base : most;
+        n--;
+        if (n > 0) {
+            o->loc_base[0] = o->loc_base[n];
+            o->loc_pt[0] = o->loc_pt[n];
+            pend_sift(o, 0, n);
+        }
+    }
+    return sure;
 }

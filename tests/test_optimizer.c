@@ -685,6 +685,63 @@ static void test_books_random_gamma(void **state)
     fx_close(&f);
 }
 
+/* Moving one vertex: the evaluation with the points that stay on one
+ * segment summed as moments equals the point-by-point one for every trial
+ * within reach, on a noisy map (so that many points are near two segments,
+ * an end, or a neighbouring polyline). */
+static void test_move_eval_moments_match(void **state)
+{
+    (void)state;
+    static fixture f;
+    fx_open(&f, 0.0f, 0.002f, 0);
+    polyc__rng r = {57};
+    make_start_map(&f.o, &r);
+    polyc__op_remove_vertices(&f.o, 0); /* long segments: points on them stay */
+    polyc__op_noise(&f.o, 0.01);
+    rebuild(&f.o);
+    const float reach = 0.05f;
+    int aggregated = 0;
+    for (int32_t v = 0; v < f.o.s->v_high; v++) {
+        const polyc__vertex *V = f.o.s->v;
+        if (V[v].line == POLYC__NONE)
+            continue;
+        float x0 = V[v].x, y0 = V[v].y, xy[8];
+        int32_t old[2] = {V[v].prev, V[v].next != POLYC__NONE ? v : POLYC__NONE};
+        int ns = 0;
+        if (V[v].prev != POLYC__NONE) {
+            const float q[4] = {V[V[v].prev].x, V[V[v].prev].y, x0, y0};
+            memcpy(xy + 4 * ns++, q, sizeof q);
+        }
+        if (V[v].next != POLYC__NONE) {
+            const float q[4] = {x0, y0, V[V[v].next].x, V[V[v].next].y};
+            memcpy(xy + 4 * ns++, q, sizeof q);
+        }
+        for (int t = 0; t < 12; t++) {
+            float ang = (float)(6.283185307179586 * urand(&r)), rad = reach * (float)urand(&r);
+            float cx = x0 + rad * cosf(ang), cy = y0 + rad * sinf(ang), trial[8];
+            memcpy(trial, xy, sizeof trial);
+            if (V[v].prev != POLYC__NONE) {
+                trial[2] = cx;
+                trial[3] = cy;
+            }
+            if (V[v].next != POLYC__NONE) {
+                trial[4 * (ns - 1)] = cx;
+                trial[4 * (ns - 1) + 1] = cy;
+            }
+            polyc__local_prepare(&f.o, old, 2, xy, ns, reach);
+            double plain = polyc__local_eval(&f.o, trial, ns), plain_cur = polyc__local_current(&f.o);
+            polyc__local_prepare_move(&f.o, old, 2, xy, ns, reach, x0, y0);
+            aggregated += f.o.agg_n[0] + f.o.agg_n[1];
+            double agg = polyc__local_eval(&f.o, trial, ns), agg_cur = polyc__local_current(&f.o);
+            if (!close_rel(plain, agg, 1e-9) || !close_rel(plain_cur, agg_cur, 1e-9))
+                fail_msg("vertex %d trial %d: plain %.12f / %.12f, moments %.12f / %.12f", v, t, plain,
+                         plain_cur, agg, agg_cur);
+        }
+    }
+    assert_true(aggregated > 0); /* the case is exercised */
+    fx_close(&f);
+}
+
 /* ---- two bugs the random edits found (fixed in b8dcafa), on minimal cases ---- */
 
 /* Merging two heads reverses one polyline: all its segments go out and come
@@ -1161,7 +1218,7 @@ static void test_remove_collinear_vertex(void **state)
     const float xy[6] = {-1.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f}, after[4] = {-1.0f, 0.0f, 1.0f, 0.0f};
     int32_t l = add_line(&f.o, xy, 3, 0);
     rebuild(&f.o);
-    double d = polyc__removal_delta(&f.o, 1);
+    double d = polyc__removal_delta_below(&f.o, 1, INFINITY);
     assert_true(fabs(d + f.o.log_n) < 1e-9); /* no error change, one vertex less */
     assert_int_equal(polyc__op_remove_vertices(&f.o, 0), 1);
     check_books(&f.o, "remove");
@@ -1179,7 +1236,7 @@ static void test_remove_keeps_true_corner(void **state)
     const float xy[6] = {-1.0f, 0.0f, 0.0f, 0.0f, 0.0f, 1.0f};
     int32_t l = add_line(&f.o, xy, 3, 0);
     rebuild(&f.o);
-    assert_true(polyc__removal_delta(&f.o, 1) > 0.0);
+    assert_true(polyc__removal_delta_below(&f.o, 1, INFINITY) > 0.0);
     assert_int_equal(polyc__op_remove_vertices(&f.o, 0), 0);
     assert_line_is(&f.o, l, xy, 3);
     fx_close(&f);
@@ -1236,7 +1293,13 @@ static void test_removal_delta_is_exact(void **state)
             rebuild(&f.o);
             if (f.o.s->v[v].line == POLYC__NONE)
                 continue;
-            double before = polyc__bic(&f.o), d = polyc__removal_delta(&f.o, v);
+            double before = polyc__bic(&f.o), d = polyc__removal_delta_below(&f.o, v, INFINITY);
+            /* bounded: exact below the bound, at least the bound above it */
+            for (int b = 0; b < 3; b++) {
+                double bound = b == 0 ? 0.0 : (b == 1 ? f.o.log_n : d), db = polyc__removal_delta_below(&f.o, v, bound);
+                if (d < bound ? fabs(db - d) > 1e-6 * (1.0 + fabs(before)) : db < bound - 1e-9 * (1.0 + fabs(before)))
+                    fail_msg("vertex %d bound %.6f: exact %.9f, bounded %.9f", v, bound, d, db);
+            }
             polyc__chg_begin(&f.o);
             polyc__op_remove(&f.o, v);
             polyc__chg_commit(&f.o);
@@ -1489,6 +1552,7 @@ int main(void)
         cmocka_unit_test(test_remove_keeps_true_corner),
         cmocka_unit_test(test_add_vertex_at_cut_corner),
         cmocka_unit_test(test_removal_delta_is_exact),
+        cmocka_unit_test(test_move_eval_moments_match),
         cmocka_unit_test(test_corner_replaces_spike),
         cmocka_unit_test(test_corners_leave_clean_map),
         cmocka_unit_test(test_trim_pulls_end_back_to_data),

@@ -495,6 +495,9 @@ static int single_scans(const options *o, const scene *s)
             continue;
         }
         ms_sum += now_ms() - t0;
+        if (getenv("SINGLE_STAGES"))
+            fprintf(stderr, "open+init %.2f add %.2f grid %.2f contour %.2f trace %.2f opt %.2f total %.2f blk %.1fMB\n",
+                    0.0, times[ST_ADD], times[ST_GRID], times[ST_CONTOUR], times[ST_TRACE], times[ST_OPT], now_ms()-t0, p.block_size/1e6);
         for (i = 0; i < count; i++)
             vertices += lines[i].point_count;
         gtscore_index_init(&map);
