@@ -466,6 +466,7 @@ static int single_scans(const options *o, const scene *s)
 {
     scanlog log;
     double parse_ms, f_sum = 0.0, ms_sum = 0.0, sum_sq = 0.0, vertices = 0.0;
+    double stage_sum[ST_COUNT] = {0};
     uint64_t hits = 0;
     unsigned k, done = 0;
     char label[160];
@@ -495,9 +496,8 @@ static int single_scans(const options *o, const scene *s)
             continue;
         }
         ms_sum += now_ms() - t0;
-        if (getenv("SINGLE_STAGES"))
-            fprintf(stderr, "open+init %.2f add %.2f grid %.2f contour %.2f trace %.2f opt %.2f total %.2f blk %.1fMB\n",
-                    0.0, times[ST_ADD], times[ST_GRID], times[ST_CONTOUR], times[ST_TRACE], times[ST_OPT], now_ms()-t0, p.block_size/1e6);
+        for (i = ST_GRID; i <= ST_OPT; i++)
+            stage_sum[i] += times[i];
         for (i = 0; i < count; i++)
             vertices += lines[i].point_count;
         gtscore_index_init(&map);
@@ -514,8 +514,10 @@ static int single_scans(const options *o, const scene *s)
         pipeline_close(&p);
     }
     if (done)
-        printf("%-24s %6u %8.4f %9.1f %9.1f %9.1f\n", label, done, f_sum / done,
-               hits ? 1e3 * sqrt(sum_sq / (double)hits) : 0.0, vertices / done, ms_sum / done);
+        printf("%-24s %6u %8.4f %9.1f %9.1f %9.2f | %6.2f %7.2f %6.2f %8.2f\n", label, done,
+               f_sum / done, hits ? 1e3 * sqrt(sum_sq / (double)hits) : 0.0, vertices / done,
+               ms_sum / done, stage_sum[ST_GRID] / done, stage_sum[ST_CONTOUR] / done,
+               stage_sum[ST_TRACE] / done, stage_sum[ST_OPT] / done);
     fflush(stdout);
     scanlog_free(&log);
     return done ? 0 : -1;
@@ -625,9 +627,10 @@ int main(int argc, char **argv)
         printf("\nsingle scans: a map from one scan; f = share of reflected beams whose ray "
                "meets the map,\nray RMSE = measured minus map range over those beams "
                "(tools/gtscore.h)\n");
-        printf("%-24s %6s %8s %9s %9s %9s\n", "log", "scans", "mean f", "rayRMSE", "verts",
-               "ms/scan");
-        printf("%-24s %6s %8s %9s %9s %9s\n", "", "", "", "mm", "/scan", "");
+        printf("%-24s %6s %8s %9s %9s %9s | %6s %7s %6s %8s\n", "log", "scans", "mean f",
+               "rayRMSE", "verts", "ms/scan", "grid", "contour", "trace", "optimise");
+        printf("%-24s %6s %8s %9s %9s %9s | %6s %7s %6s %8s\n", "", "", "", "mm", "/scan", "",
+               "ms", "ms", "ms", "ms");
         for (i = 0; i < count; i++)
             if (strcmp(list[i].kind, "carmen") == 0 && single_scans(&o, &list[i]) != 0)
                 failed = 1;
