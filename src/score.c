@@ -548,8 +548,9 @@ double polyc__local_delta(polyc__opt *o, const int32_t *old, int n_old, const fl
     while (n > 0 && sure < limit) {
         int32_t i = o->loc_pt[0];
         double most = o->loc_base[0];
-        double base = polyc__nearest(o, i, old, n_old, NULL) - o->pt_cost[i];
-        sure += base < most ? base : most;
+        /* only a segment cheaper than the new one matters: a query within
+         * that cost (usually the point's own bucket) */
+        sure += nearest_below(o, i, old, n_old, most + o->pt_cost[i], NULL) - o->pt_cost[i];
         n--;
         if (n > 0) {
             o->loc_base[0] = o->loc_base[n];
