@@ -686,8 +686,8 @@ static void test_books_random_gamma(void **state)
 }
 
 /* Moving one vertex: the evaluation with the points that stay on one
- * segment summed as moments equals the point-by-point one for every trial
- * within reach, on a noisy map (so that many points are near two segments,
+ * segment summed as moments equals the point-by-point one for every trial within reach, and the
+ * climb's commit keeps the books, on a noisy map (so that many points are near two segments,
  * an end, or a neighbouring polyline). */
 static void test_move_eval_moments_match(void **state)
 {
@@ -737,6 +737,9 @@ static void test_move_eval_moments_match(void **state)
                 fail_msg("vertex %d trial %d: plain %.12f / %.12f, moments %.12f / %.12f", v, t, plain,
                          plain_cur, agg, agg_cur);
         }
+        /* and a climb commits what the moments found */
+        polyc__hill_climb(&f.o, v);
+        check_books(&f.o, "hill climb with moments");
     }
     assert_true(aggregated > 0); /* the case is exercised */
     fx_close(&f);
