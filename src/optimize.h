@@ -124,7 +124,8 @@ void polyc__chg_commit(polyc__opt *o);
 void polyc__local_prepare(polyc__opt *o, const int32_t *old, int n_old, const float *seg_xy,
                           int n_new, float reach);
 /* the same for moving the vertex at (mx, my), the shared end of the n_new
- * (1 or 2) segments, by at most `reach`: with aggregation */
+ * (1 or 2) segments, by at most `reach`: seg_xy are the `old` segments as
+ * they are now; with aggregation */
 void polyc__local_prepare_move(polyc__opt *o, const int32_t *old, int n_old, const float *seg_xy,
                                int n_new, float reach, float mx, float my);
 double polyc__local_eval(const polyc__opt *o, const float *seg_xy, int n_new);

@@ -328,7 +328,9 @@ static void prepare(polyc__opt *o, const int32_t *old, int n_old, const float *s
     for (int k = 0; k < n_old; k++)
         if (old[k] != POLYC__NONE)
             mark_segment_region(o, old[k]);
-    for (int k = 0; k < n_new; k++) {
+    /* moving: the candidates start where the old segments are, and their
+     * moves stay within the buckets' margin */
+    for (int k = 0; k < n_new && !move; k++) {
         const float *q = seg_xy + 4 * k;
         polyc__segment_buckets(o, q[0], q[1], q[2], q[3], 1, list_bucket);
     }
