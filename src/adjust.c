@@ -17,20 +17,49 @@ double polyc__turn_cost(const polyc__opt *o, float ax, float ay, float bx, float
     return 1.0 - (double)polyc__prior_p(&o->prior, bx, by, turn);
 }
 
+
+static float turn_of(float ax, float ay, float bx, float by, float cx, float cy)
+{
+    float ux = bx - ax, uy = by - ay, wx = cx - bx, wy = cy - by;
+    return atan2f(fabsf(ux * wy - uy * wx), ux * wx + uy * wy);
+}
+
+/* The prior at the three vertices whose angles a move of v changes: its
+ * neighbours stay put, v's cell is looked up again when it changes. */
+typedef struct angle_places {
+    polyc__prior_place prev, at, next;
+} angle_places;
+
+static void places_init(const polyc__opt *o, int32_t v, angle_places *pl)
+{
+    const polyc__vertex *V = o->s->v;
+    pl->prev.valid = pl->next.valid = 0;
+    if (V[v].prev != POLYC__NONE)
+        polyc__prior_at(&o->prior, V[V[v].prev].x, V[V[v].prev].y, &pl->prev);
+    if (V[v].next != POLYC__NONE)
+        polyc__prior_at(&o->prior, V[V[v].next].x, V[V[v].next].y, &pl->next);
+    polyc__prior_at(&o->prior, V[v].x, V[v].y, &pl->at);
+}
+
 /* Angle terms of v's neighbourhood with v at (x, y). */
-static double local_angles(const polyc__opt *o, int32_t v, float x, float y)
+static double local_angles(const polyc__opt *o, angle_places *pl, int32_t v, float x, float y)
 {
     if (o->cfg->gamma <= 0.0f)
         return 0.0;
     const polyc__vertex *V = o->s->v;
     int32_t p = V[v].prev, n = V[v].next;
     double sum = 0.0;
-    if (p != POLYC__NONE && n != POLYC__NONE)
-        sum += polyc__turn_cost(o, V[p].x, V[p].y, x, y, V[n].x, V[n].y);
+    if (p != POLYC__NONE && n != POLYC__NONE) {
+        if (!polyc__prior_same_place(&o->prior, &pl->at, x, y))
+            polyc__prior_at(&o->prior, x, y, &pl->at);
+        sum += 1.0 - (double)polyc__prior_p_at(&pl->at, turn_of(V[p].x, V[p].y, x, y, V[n].x, V[n].y));
+    }
     if (p != POLYC__NONE && V[p].prev != POLYC__NONE && V[p].prev != v)
-        sum += polyc__turn_cost(o, V[V[p].prev].x, V[V[p].prev].y, V[p].x, V[p].y, x, y);
+        sum += 1.0 - (double)polyc__prior_p_at(
+                         &pl->prev, turn_of(V[V[p].prev].x, V[V[p].prev].y, V[p].x, V[p].y, x, y));
     if (n != POLYC__NONE && V[n].next != POLYC__NONE && V[n].next != v)
-        sum += polyc__turn_cost(o, x, y, V[n].x, V[n].y, V[V[n].next].x, V[V[n].next].y);
+        sum += 1.0 - (double)polyc__prior_p_at(
+                         &pl->next, turn_of(x, y, V[n].x, V[n].y, V[V[n].next].x, V[V[n].next].y));
     return sum;
 }
 
@@ -131,7 +160,10 @@ int polyc__hill_climb(polyc__opt *o, int32_t v)
     float xy[8];
     int ns = segs_at(o, v, x, y, xy);
     polyc__local_prepare_move(o, old, 2, xy, ns, reach + step, x, y);
-    double cur = polyc__local_current(o) + (double)gamma * local_angles(o, v, x, y);
+    angle_places pl;
+    if (gamma > 0.0f)
+        places_init(o, v, &pl);
+    double cur = polyc__local_current(o) + (double)gamma * local_angles(o, &pl, v, x, y);
     int moved = 0, last = -1;
     for (int it = 0; it < 64; it++) {
         double best = cur;
@@ -146,7 +178,7 @@ int polyc__hill_climb(polyc__opt *o, int32_t v)
             if ((cx - x0) * (cx - x0) + (cy - y0) * (cy - y0) > reach * reach)
                 continue;
             ns = segs_at(o, v, cx, cy, xy);
-            double e = polyc__local_eval(o, xy, ns) + (double)gamma * local_angles(o, v, cx, cy);
+            double e = polyc__local_eval(o, xy, ns) + (double)gamma * local_angles(o, &pl, v, cx, cy);
             if (e < best - 1e-12 * (1.0 + fabs(best))) {
                 best = e;
                 best_d = d;

@@ -416,18 +416,26 @@ polyc_status polyc__prior_build(polyc_ctx *ctx, polyc__prior *p)
 
 /* ---- query (the optimiser's hot loop: no trigonometry, 9 cells x 3 bins) ---- */
 
-float polyc__prior_p(const polyc__prior *p, float x, float y, float turn_rad)
+/* The cell of (x, y), or 0 if there is no evidence within a cell of it
+ * (outside the grid, NaN, no prior): there p is uniform. */
+static int cell_of(const polyc__prior *p, float x, float y, int32_t *cx, int32_t *cy)
 {
-    const float uniform = 1.0f / (float)BINS;
     if (p->w <= 0 || p->h <= 0 || !p->hist)
-        return uniform;
+        return 0;
     float fx = (x - (float)p->origin_x) * p->inv_cell;
     float fy = (y - (float)p->origin_y) * p->inv_cell;
     /* more than a cell outside (or NaN): no neighbour inside either */
     if (!(fx >= -1.0f && fy >= -1.0f && fx < (float)p->w + 1.0f && fy < (float)p->h + 1.0f))
-        return uniform;
-    int32_t cx = (int32_t)floorf(fx), cy = (int32_t)floorf(fy);
+        return 0;
+    *cx = (int32_t)floorf(fx);
+    *cy = (int32_t)floorf(fy);
+    return 1;
+}
 
+/* The kernel around `turn`: bins k-1, k, k+1 and their weights (0 for a
+ * bin outside 0..17, which then repeats k). */
+static void kernel(float turn_rad, int *b, float *kw)
+{
     float u = turn_rad * BINS_PER_RAD;
     if (!(u > 0.0f)) /* also NaN */
         u = 0.0f;
@@ -435,15 +443,84 @@ float polyc__prior_p(const polyc__prior *p, float x, float y, float turn_rad)
         u = (float)(BINS - 1);
     int k = (int)(u + 0.5f);
     float d = u - (float)k;
-    float kl = 0.5f - d, kc = 1.5f - fabsf(d), kr = 0.5f + d;
-    if (k == 0)
-        kl = 0.0f;
-    if (k == BINS - 1)
-        kr = 0.0f;
-    int bl = k > 0 ? k - 1 : k, br = k < BINS - 1 ? k + 1 : k;
+    b[0] = k > 0 ? k - 1 : k;
+    b[1] = k;
+    b[2] = k < BINS - 1 ? k + 1 : k;
+    kw[0] = k == 0 ? 0.0f : 0.5f - d;
+    kw[1] = 1.5f - fabsf(d);
+    kw[2] = k == BINS - 1 ? 0.0f : 0.5f + d;
+}
 
+/* p from the smoothed counts of the kernel's bins (cnt indexed by bin). */
+static float share(const int *b, const float *kw, const uint32_t *cnt, uint32_t n)
+{
+    float num = kw[0] * ((float)cnt[b[0]] + EPS) + kw[1] * ((float)cnt[b[1]] + EPS) +
+                kw[2] * ((float)cnt[b[2]] + EPS);
+    float pr = num / ((kw[0] + kw[1] + kw[2]) * ((float)n + (float)BINS * EPS));
+    return pr < 1.0f ? pr : 1.0f;
+}
+
+/* C_b for every bin and N at cell (cx, cy): 3 x 3 cells, weights 4/2/1. */
+static void smoothed(const polyc__prior *p, int32_t cx, int32_t cy, uint32_t *c, uint32_t *n)
+{
     const uint32_t *tot = totals(p);
-    uint32_t cl = 0, cc = 0, cr = 0, n = 0; /* weighted sums (fit: 16 * 18 * 65535) */
+    for (int b = 0; b < BINS; b++)
+        c[b] = 0;
+    *n = 0;
+    for (int32_t j = -1; j <= 1; j++) {
+        int32_t iy = cy + j;
+        if (iy < 0 || iy >= p->h)
+            continue;
+        for (int32_t i = -1; i <= 1; i++) {
+            int32_t ix = cx + i;
+            if (ix < 0 || ix >= p->w)
+                continue;
+            uint32_t w = (uint32_t)(4 >> ((i != 0) + (j != 0)));
+            size_t cell = (size_t)iy * (size_t)p->w + (size_t)ix;
+            const uint16_t *h = p->hist + cell * BINS;
+            for (int b = 0; b < BINS; b++)
+                c[b] += w * h[b];
+            *n += w * tot[cell];
+        }
+    }
+}
+
+void polyc__prior_at(const polyc__prior *p, float x, float y, polyc__prior_place *at)
+{
+    at->valid = cell_of(p, x, y, &at->cx, &at->cy);
+    if (at->valid)
+        smoothed(p, at->cx, at->cy, at->c, &at->n);
+}
+
+int polyc__prior_same_place(const polyc__prior *p, const polyc__prior_place *at, float x, float y)
+{
+    int32_t cx, cy;
+    int valid = cell_of(p, x, y, &cx, &cy);
+    return valid == at->valid && (!valid || (cx == at->cx && cy == at->cy));
+}
+
+float polyc__prior_p_at(const polyc__prior_place *at, float turn_rad)
+{
+    int b[3];
+    float kw[3];
+    if (!at->valid)
+        return 1.0f / (float)BINS;
+    kernel(turn_rad, b, kw);
+    return share(b, kw, at->c, at->n);
+}
+
+float polyc__prior_p(const polyc__prior *p, float x, float y, float turn_rad)
+{
+    int32_t cx, cy;
+    int b[3];
+    float kw[3];
+    if (!cell_of(p, x, y, &cx, &cy))
+        return 1.0f / (float)BINS;
+    kernel(turn_rad, b, kw);
+    /* only the kernel's bins */
+    const uint32_t *tot = totals(p);
+    uint32_t cnt[BINS], n = 0;
+    cnt[b[0]] = cnt[b[1]] = cnt[b[2]] = 0;
     for (int32_t j = -1; j <= 1; j++) {
         int32_t iy = cy + j;
         if (iy < 0 || iy >= p->h)
@@ -455,14 +532,13 @@ float polyc__prior_p(const polyc__prior *p, float x, float y, float turn_rad)
             uint32_t w = (uint32_t)(4 >> ((i != 0) + (j != 0)));
             size_t c = (size_t)iy * (size_t)p->w + (size_t)ix;
             const uint16_t *h = p->hist + c * BINS;
-            cl += w * h[bl];
-            cc += w * h[k];
-            cr += w * h[br];
+            cnt[b[0]] += w * h[b[0]];
+            if (b[1] != b[0])
+                cnt[b[1]] += w * h[b[1]];
+            if (b[2] != b[1])
+                cnt[b[2]] += w * h[b[2]];
             n += w * tot[c];
         }
     }
-    float s = kl + kc + kr;
-    float num = kl * ((float)cl + EPS) + kc * ((float)cc + EPS) + kr * ((float)cr + EPS);
-    float pr = num / (s * ((float)n + (float)BINS * EPS));
-    return pr < 1.0f ? pr : 1.0f;
+    return share(b, kw, cnt, n);
 }

@@ -157,6 +157,15 @@ size_t polyc__prior_bytes(const polyc_limits *lim);
 polyc_status polyc__prior_build(polyc_ctx *ctx, polyc__prior *p);
 /* p(turn | x, y) in [0, 1]; x, y frame-relative metres; turn in [0, pi]. */
 float polyc__prior_p(const polyc__prior *p, float x, float y, float turn_rad);
+/* The same for many turns at one place: its cell's smoothed counts. */
+typedef struct polyc__prior_place {
+    int valid;                     /* 0: no evidence there, p uniform */
+    int32_t cx, cy;
+    uint32_t n, c[POLYC__ANGLE_BINS];
+} polyc__prior_place;
+void polyc__prior_at(const polyc__prior *p, float x, float y, polyc__prior_place *at);
+int polyc__prior_same_place(const polyc__prior *p, const polyc__prior_place *at, float x, float y);
+float polyc__prior_p_at(const polyc__prior_place *at, float turn_rad);
 
 /* ---- expected beam spacing (spacing.c) ---- */
 typedef struct polyc__spacing {

@@ -135,14 +135,20 @@ static float fy(const fixture *f, double y)
 
 static const float DEG = (float)(PI_D / 180.0);
 
+/* p in (0, 1] everywhere, and the same from polyc__prior_at's counts */
 static void check_all_in_unit_interval(const polyc__prior *p, float x0, float y0, float x1, float y1)
 {
     for (int iy = 0; iy <= 40; iy++)
         for (int ix = 0; ix <= 40; ix++) {
             float x = x0 + (x1 - x0) * (float)ix / 40.0f, y = y0 + (y1 - y0) * (float)iy / 40.0f;
+            polyc__prior_place at;
+            polyc__prior_at(p, x, y, &at);
+            assert_true(polyc__prior_same_place(p, &at, x, y));
             for (int a = -5; a <= 185; a += 1) {
                 float v = polyc__prior_p(p, x, y, (float)a * DEG);
                 assert_true(v > 0.0f && v <= 1.0f);
+                /* the per-place form gives the same value */
+                assert_true(v == polyc__prior_p_at(&at, (float)a * DEG));
             }
         }
 }
