@@ -6,7 +6,7 @@ OPT     ?= -O2 -g
 WARN    = -std=c99 -Wall -Wextra -Wpedantic -Wshadow -Wconversion -Wdouble-promotion \
           -Wstrict-prototypes -Wmissing-prototypes -Wvla
 CFLAGS  ?=
-ALL_CFLAGS = $(WARN) $(OPT) $(CFLAGS) -Iinclude -fPIC -fvisibility=hidden -DPOLYC_BUILD_SHARED
+ALL_CFLAGS = $(WARN) $(OPT) $(CFLAGS) -Iinclude -fPIC -fvisibility=hidden -fno-math-errno -DPOLYC_BUILD_SHARED
 LDLIBS  = -lm
 
 LIB_SRC  = $(wildcard src/*.c)
