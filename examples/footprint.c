@@ -15,7 +15,7 @@ static polyc_config cfg;
 
 static double size(uint32_t scans, uint32_t beams, uint32_t tiles, uint32_t vertices)
 {
-    polyc_limits lim = {scans, beams, tiles * 1024u, vertices};
+    polyc_limits lim = {scans, beams, tiles * 1024u, vertices, 0};
     return (double)polyc_memory_size(&cfg, &lim);
 }
 
