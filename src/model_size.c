@@ -163,7 +163,7 @@ static void segment_stats(polyc__opt *o)
     }
 }
 
-#define ADD_CANDIDATES 8 /* at most; a sixteenth of the vertices, at least 2 */
+#define ADD_CANDIDATES 8
 
 /* Tries a vertex at the farthest point of the worst segments (largest mean
  * squared distance); each is adjusted with its neighbours and kept only if
@@ -176,19 +176,15 @@ int polyc__op_add_vertices(polyc__opt *o, int max_tries)
         segment_stats(o);
         int32_t cand[ADD_CANDIDATES];
         double score[ADD_CANDIDATES];
-        /* a small map has few segments worth a vertex: trying 8 of its 20
-         * each round cost a single scan a third of its time for nothing */
-        int32_t want = s->v_live / 16;
-        want = want < 2 ? 2 : (want > ADD_CANDIDATES ? ADD_CANDIDATES : want);
         int nc = 0;
         for (int32_t v = 0; v < s->v_high; v++) {
             if (s->v[v].line == POLYC__NONE || s->v[v].next == POLYC__NONE || o->seg_w[v] < 4.0f ||
                 o->seg_far[v] == POLYC__NONE)
                 continue;
             double m = (double)(o->seg_sum[v] / o->seg_w[v]);
-            if (nc == want && m <= score[nc - 1])
+            if (nc == ADD_CANDIDATES && m <= score[nc - 1])
                 continue;
-            int k = nc < want ? nc++ : nc - 1;
+            int k = nc < ADD_CANDIDATES ? nc++ : nc - 1;
             while (k > 0 && score[k - 1] < m) {
                 score[k] = score[k - 1];
                 cand[k] = cand[k - 1];
