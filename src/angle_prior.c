@@ -57,7 +57,7 @@
 #include <string.h>
 
 #define BINS POLYC__ANGLE_BINS
-#define BINS_PER_RAD 5.729577951f   /* 18 / pi: 10 degree bins */
+#define BINS_PER_RAD 5.729577951f   /* 18 / pi: 10 degree bins (polyc__prior_at lists all 18) */
 
 #define GAP_M 0.15f                 /* cluster break: fixed part */
 #define GAP_STEPS 3.0f              /* cluster break: beam spacings at range r */
@@ -460,12 +460,14 @@ static float share(const int *b, const float *kw, const uint32_t *cnt, uint32_t 
     return pr < 1.0f ? pr : 1.0f;
 }
 
-/* C_b for every bin and N at cell (cx, cy): 3 x 3 cells, weights 4/2/1. */
-static void smoothed(const polyc__prior *p, int32_t cx, int32_t cy, uint32_t *c, uint32_t *n)
+/* C_b for the nb bins listed (distinct) and N at cell (cx, cy): 3 x 3
+ * cells, weights 4/2/1; cnt is indexed by bin. */
+static void smoothed(const polyc__prior *p, int32_t cx, int32_t cy, const int *bins, int nb,
+                     uint32_t *cnt, uint32_t *n)
 {
     const uint32_t *tot = totals(p);
-    for (int b = 0; b < BINS; b++)
-        c[b] = 0;
+    for (int k = 0; k < nb; k++)
+        cnt[bins[k]] = 0;
     *n = 0;
     for (int32_t j = -1; j <= 1; j++) {
         int32_t iy = cy + j;
@@ -478,8 +480,8 @@ static void smoothed(const polyc__prior *p, int32_t cx, int32_t cy, uint32_t *c,
             uint32_t w = (uint32_t)(4 >> ((i != 0) + (j != 0)));
             size_t cell = (size_t)iy * (size_t)p->w + (size_t)ix;
             const uint16_t *h = p->hist + cell * BINS;
-            for (int b = 0; b < BINS; b++)
-                c[b] += w * h[b];
+            for (int k = 0; k < nb; k++)
+                cnt[bins[k]] += w * h[bins[k]];
             *n += w * tot[cell];
         }
     }
@@ -487,9 +489,10 @@ static void smoothed(const polyc__prior *p, int32_t cx, int32_t cy, uint32_t *c,
 
 void polyc__prior_at(const polyc__prior *p, float x, float y, polyc__prior_place *at)
 {
+    static const int ALL[BINS] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17};
     at->valid = cell_of(p, x, y, &at->cx, &at->cy);
     if (at->valid)
-        smoothed(p, at->cx, at->cy, at->c, &at->n);
+        smoothed(p, at->cx, at->cy, ALL, BINS, at->c, &at->n);
 }
 
 int polyc__prior_same_place(const polyc__prior *p, const polyc__prior_place *at, float x, float y)
@@ -517,28 +520,12 @@ float polyc__prior_p(const polyc__prior *p, float x, float y, float turn_rad)
     if (!cell_of(p, x, y, &cx, &cy))
         return 1.0f / (float)BINS;
     kernel(turn_rad, b, kw);
-    /* only the kernel's bins */
-    const uint32_t *tot = totals(p);
-    uint32_t cnt[BINS], n = 0;
-    cnt[b[0]] = cnt[b[1]] = cnt[b[2]] = 0;
-    for (int32_t j = -1; j <= 1; j++) {
-        int32_t iy = cy + j;
-        if (iy < 0 || iy >= p->h)
-            continue;
-        for (int32_t i = -1; i <= 1; i++) {
-            int32_t ix = cx + i;
-            if (ix < 0 || ix >= p->w)
-                continue;
-            uint32_t w = (uint32_t)(4 >> ((i != 0) + (j != 0)));
-            size_t c = (size_t)iy * (size_t)p->w + (size_t)ix;
-            const uint16_t *h = p->hist + c * BINS;
-            cnt[b[0]] += w * h[b[0]];
-            if (b[1] != b[0])
-                cnt[b[1]] += w * h[b[1]];
-            if (b[2] != b[1])
-                cnt[b[2]] += w * h[b[2]];
-            n += w * tot[c];
-        }
-    }
+    /* only the kernel's (distinct) bins */
+    int distinct[3], nd = 0;
+    for (int k = 0; k < 3; k++)
+        if (k == 0 || b[k] != b[k - 1])
+            distinct[nd++] = b[k];
+    uint32_t cnt[BINS], n;
+    smoothed(p, cx, cy, distinct, nd, cnt, &n);
     return share(b, kw, cnt, n);
 }
