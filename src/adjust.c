@@ -9,19 +9,17 @@
 static const float DIR_X[8] = {1.0f, 0.70710678f, 0.0f, -0.70710678f, -1.0f, -0.70710678f, 0.0f, 0.70710678f};
 static const float DIR_Y[8] = {0.0f, 0.70710678f, 1.0f, 0.70710678f, 0.0f, -0.70710678f, -1.0f, -0.70710678f};
 
-/* 1 - p(turn at b) for the path a -> b -> c */
-double polyc__turn_cost(const polyc__opt *o, float ax, float ay, float bx, float by, float cx, float cy)
-{
-    float ux = bx - ax, uy = by - ay, wx = cx - bx, wy = cy - by;
-    float turn = atan2f(fabsf(ux * wy - uy * wx), ux * wx + uy * wy);
-    return 1.0 - (double)polyc__prior_p(&o->prior, bx, by, turn);
-}
-
-
+/* the turn at b, in [0, pi], of the path a -> b -> c */
 static float turn_of(float ax, float ay, float bx, float by, float cx, float cy)
 {
     float ux = bx - ax, uy = by - ay, wx = cx - bx, wy = cy - by;
     return atan2f(fabsf(ux * wy - uy * wx), ux * wx + uy * wy);
+}
+
+/* 1 - p(turn at b) for the path a -> b -> c */
+double polyc__turn_cost(const polyc__opt *o, float ax, float ay, float bx, float by, float cx, float cy)
+{
+    return 1.0 - (double)polyc__prior_p(&o->prior, bx, by, turn_of(ax, ay, bx, by, cx, cy));
 }
 
 /* The prior at the three vertices whose angles a move of v changes: its

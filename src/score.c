@@ -40,11 +40,11 @@ static double cap_of(const polyc__opt *o, const polyc__point *p)
     return (double)p->w * (double)o->R2;
 }
 
-/* Own bucket first, then the eight around it nearest first, each only if
- * it is nearer than the best cost so far allows: a segment is entered in
- * every bucket it crosses, so one within distance D of the point crosses a
- * bucket within D of it, and its cost is at least w D^2. */
-/* The nearest below `start` (NONE and `start` if there is none). */
+/* The nearest segment costing less than `start` (NONE and `start` if there
+ * is none). Own bucket first, then the eight around it nearest first, each
+ * only if it is nearer than the best cost so far allows: a segment is
+ * entered in every bucket it crosses, so one within distance D of the point
+ * crosses a bucket within D of it, and its cost is at least w D^2. */
 static double nearest_below(const polyc__opt *o, int32_t pi, const int32_t *skip, int n_skip,
                             double start, int32_t *seg)
 {
@@ -539,8 +539,9 @@ double polyc__local_delta(polyc__opt *o, const int32_t *old, int n_old, const fl
                 sure += (c < cur ? c : cur) - cur;
                 continue;
             }
+            double cap = cap_of(o, p);
             o->loc_pt[n] = (int32_t)i;
-            o->loc_base[n] = (c < cap_of(o, p) ? c : cap_of(o, p)) - cur;
+            o->loc_base[n] = (c < cap ? c : cap) - cur;
             n++;
         }
     }
