@@ -58,6 +58,9 @@ typedef enum polyc_status {
                                          grid cell (slower, more memory) */
 #define POLYC_FLAG_NO_GRAZING    0x2u /* count misses all the way to the hit, as
                                          the paper does (see docs/algorithm.md) */
+#define POLYC_FLAG_GRID_TRACE    0x4u /* trace the grid's contour even for a
+                                         single scan (by default one scan's
+                                         initial polylines follow its beam order) */
 
 typedef struct polyc_config {
     /* Grid (paper section III) */

@@ -192,7 +192,9 @@ int polyc__hill_climb(polyc__opt *o, int32_t v)
         last = best_d;
         moved = 1;
     }
-    if (!moved)
+    /* a single scan: no climb may put a segment in front of a return (unless
+     * the vertex already stood so) */
+    if (!moved || (o->rays.on && polyc__vertex_blocks(o, v, x, y) && !polyc__vertex_blocks(o, v, x0, y0)))
         return 0;
     commit_move(o, v, x, y);
     return 1;
@@ -242,7 +244,11 @@ void polyc__op_noise(polyc__opt *o, double sigma_m)
     for (int32_t v = 0; v < s->v_high; v++) {
         if (s->v[v].line == POLYC__NONE)
             continue;
-        s->v[v].x += (float)(sigma_m * polyc__rng_normal(&o->rng));
-        s->v[v].y += (float)(sigma_m * polyc__rng_normal(&o->rng));
+        float x = s->v[v].x + (float)(sigma_m * polyc__rng_normal(&o->rng));
+        float y = s->v[v].y + (float)(sigma_m * polyc__rng_normal(&o->rng));
+        if (polyc__vertex_blocks(o, v, x, y))
+            continue; /* a single scan saw through there */
+        s->v[v].x = x;
+        s->v[v].y = y;
     }
 }

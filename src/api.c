@@ -98,7 +98,8 @@ polyc_status polyc_config_check(const polyc_config *c, const char **why)
     else if (!in(c->overlap_m, 0.0f, 10.0f)) w = "overlap_m must be in [0, 10]";
     else if (!in(c->search_radius_m, 1e-3f, 100.0f)) w = "search_radius_m must be in (0, 100]";
     else if (c->reserved != 0) w = "reserved must be 0";
-    else if (c->flags & ~(POLYC_FLAG_EXACT_POINTS | POLYC_FLAG_NO_GRAZING)) w = "unknown flags";
+    else if (c->flags & ~(POLYC_FLAG_EXACT_POINTS | POLYC_FLAG_NO_GRAZING | POLYC_FLAG_GRID_TRACE))
+        w = "unknown flags";
     if (why)
         *why = w;
     return w ? POLYC_ERR_CONFIG : POLYC_OK;
@@ -210,7 +211,9 @@ size_t polyc_memory_size(const polyc_config *config, const polyc_limits *limits)
     n = polyc__add(n, polyc__grid_budget_bytes(limits));
     n = polyc__add(n, polyc__contour_bytes(limits));
     n = polyc__add(n, polyc__store_bytes(limits));
-    n = polyc__add(n, polyc__contour_bytes(limits)); /* tracing scratch */
+    /* tracing scratch: the contour walk, or a single scan's chains */
+    size_t trace_scratch = polyc__contour_bytes(limits), chains = polyc__chains_bytes(limits);
+    n = polyc__add(n, trace_scratch > chains ? trace_scratch : chains);
     n = polyc__add(n, polyc__flat_bytes(limits));
     n = polyc__add(n, polyc__prior_bytes(limits));
     n = polyc__add(n, 2 * polyc__spacing_bytes(limits)); /* trace and optimiser */
@@ -377,6 +380,12 @@ static polyc_status stage_grid(polyc_ctx *ctx)
     return st;
 }
 
+/* Initial polylines from a single scan's beam order (scan_chains.c) */
+static int one_scan_chains(const polyc_ctx *ctx)
+{
+    return ctx->scan_count == 1 && !(ctx->cfg.flags & POLYC_FLAG_GRID_TRACE);
+}
+
 static polyc_status stage_contour(polyc_ctx *ctx)
 {
     polyc_status st = polyc__contour_build(ctx);
@@ -398,7 +407,7 @@ static void export_result(polyc_ctx *ctx)
 
 static polyc_status stage_trace(polyc_ctx *ctx)
 {
-    polyc_status st = polyc__trace_build(ctx);
+    polyc_status st = one_scan_chains(ctx) ? polyc__chains_build(ctx) : polyc__trace_build(ctx);
     if (st != POLYC_OK)
         return st;
     int32_t vcap = ctx->store.v_cap;
@@ -417,6 +426,14 @@ static polyc_status need_stage(polyc_ctx *ctx, polyc__stage want)
     polyc_status st = POLYC_OK;
     if (ctx->stage < POLYC__STAGE_GRID && want >= POLYC__STAGE_GRID)
         st = run_stage(ctx, POLYC__STAGE_GRID, ctx->scans_mark, stage_grid, POLYC__STAGE_SCANS);
+    if (st == POLYC_OK && ctx->stage < POLYC__STAGE_CONTOUR && want > POLYC__STAGE_CONTOUR &&
+        one_scan_chains(ctx)) {
+        /* the chains do not need it: left empty unless asked for */
+        ctx->contour_count = 0;
+        ctx->contour_mark = ctx->grid_mark;
+        ctx->stats.contour_cells = 0;
+        ctx->stage = POLYC__STAGE_CONTOUR;
+    }
     if (st == POLYC_OK && ctx->stage < POLYC__STAGE_CONTOUR && want >= POLYC__STAGE_CONTOUR)
         st = run_stage(ctx, POLYC__STAGE_CONTOUR, ctx->grid_mark, stage_contour, POLYC__STAGE_GRID);
     if (st == POLYC_OK && ctx->stage < POLYC__STAGE_TRACE && want >= POLYC__STAGE_TRACE)

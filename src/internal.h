@@ -280,6 +280,9 @@ polyc_status polyc__store_from_flat(polyc__store *s, const polyc__flat *f);
 
 /* trace.c */
 polyc_status polyc__trace_build(polyc_ctx *ctx);
+/* scan_chains.c: a single scan's initial polylines from its beam order */
+size_t polyc__chains_bytes(const polyc_limits *lim);
+polyc_status polyc__chains_build(polyc_ctx *ctx);
 
 /* points.c */
 size_t polyc__points_bytes(const polyc_limits *lim);

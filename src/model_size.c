@@ -62,6 +62,8 @@ double polyc__removal_delta_below(polyc__opt *o, int32_t v, double bound)
     int n_new = 0;
     double dk, dangle;
     if (!ln->closed && ln->count == 2) {
+        if (o->rays.on)
+            return INFINITY; /* a single scan's return stays on the map */
         old[n_old++] = p != POLYC__NONE ? p : v;
         dk = -2.0;
         dangle = 0.0;
@@ -79,6 +81,8 @@ double polyc__removal_delta_below(polyc__opt *o, int32_t v, double bound)
         xy[1] = V[p].y;
         xy[2] = V[n].x;
         xy[3] = V[n].y;
+        if (polyc__blocks_beams(&o->rays, xy[0], xy[1], xy[2], xy[3]))
+            return INFINITY; /* a single scan saw through there */
         n_new = 1;
         dk = -1.0;
         dangle = -o->acost[p] - o->acost[v] - o->acost[n];
@@ -202,6 +206,10 @@ int polyc__op_add_vertices(polyc__opt *o, int max_tries)
             int32_t far = o->seg_far[u];
             if (o->pt_seg[far] != u)
                 continue; /* stale after an earlier addition */
+            if (o->rays.on &&
+                (polyc__blocks_beams(&o->rays, s->v[u].x, s->v[u].y, o->pts[far].x, o->pts[far].y) ||
+                 polyc__blocks_beams(&o->rays, o->pts[far].x, o->pts[far].y, s->v[w].x, s->v[w].y)))
+                continue;
             double before = polyc__bic(o);
             float ux = s->v[u].x, uy = s->v[u].y, wx = s->v[w].x, wy = s->v[w].y;
             polyc__chg_begin(o);

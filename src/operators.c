@@ -487,6 +487,8 @@ int polyc__op_trim_ends(polyc__opt *o)
         if (len <= 0.0f)
             continue;
         float u = ((o->pts[i].x - a->x) * dx + (o->pts[i].y - a->y) * dy) / len;
+        if (o->rays.on)
+            u = polyc__ray_position(&o->rays, a->x, a->y, b->x, b->y, o->pts[i].x, o->pts[i].y, u);
         /* store as fraction from the tail side and from the head side */
         if (tail_end && u / len > o->split_t[sg])
             o->split_t[sg] = u / len;
@@ -504,12 +506,26 @@ int polyc__op_trim_ends(polyc__opt *o)
         /* a margin of half a beam spacing keeps the last point's own beam on the map */
         float margin = fmaxf(0.01f, 0.5f * polyc__spacing_at(&o->spacing, bx, by)) / len;
         float keep_tail = o->split_t[v] + margin, keep_head = o->trim_head[v] + margin;
-        if (s->v[w].next == POLYC__NONE && o->split_t[v] >= 0.0f && keep_tail < 1.0f) {
-            polyc__apply_move(o, w, ax + keep_tail * (bx - ax), ay + keep_tail * (by - ay));
+        /* a single scan's ends also grow to its end beams */
+        float most = o->rays.on ? 1.0f + 4.0f * margin : 1.0f;
+        keep_tail = fminf(keep_tail, most);
+        keep_head = fminf(keep_head, most);
+        /* (there, under a millimetre is not worth a move, which would be
+         * climbed again in the next iteration) */
+        if (o->rays.on && fabsf(keep_tail - 1.0f) * len < 1e-3f)
+            keep_tail = 1.0f;
+        if (o->rays.on && fabsf(keep_head - 1.0f) * len < 1e-3f)
+            keep_head = 1.0f;
+        float tx = ax + keep_tail * (bx - ax), ty = ay + keep_tail * (by - ay);
+        float hx = bx + keep_head * (ax - bx), hy = by + keep_head * (ay - by);
+        if (s->v[w].next == POLYC__NONE && o->split_t[v] >= 0.0f && keep_tail != 1.0f &&
+            !(keep_tail > 1.0f && polyc__vertex_blocks(o, w, tx, ty))) {
+            polyc__apply_move(o, w, tx, ty);
             changed++;
         }
-        if (a->prev == POLYC__NONE && o->trim_head[v] >= 0.0f && keep_head < 1.0f) {
-            polyc__apply_move(o, v, bx + keep_head * (ax - bx), by + keep_head * (ay - by));
+        if (a->prev == POLYC__NONE && o->trim_head[v] >= 0.0f && keep_head != 1.0f &&
+            !(keep_head > 1.0f && polyc__vertex_blocks(o, v, hx, hy))) {
+            polyc__apply_move(o, v, hx, hy);
             changed++;
         }
     }

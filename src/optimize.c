@@ -56,6 +56,7 @@ polyc_status polyc__opt_setup(polyc_ctx *ctx, polyc__opt *o)
     o->R2 = o->R * o->R;
     o->rng.state = ctx->cfg.seed;
     int32_t V = o->s->v_cap;
+    polyc__rays_init(&o->rays, ctx);
     polyc_status st = polyc__prior_build(ctx, &o->prior);
     if (st != POLYC_OK)
         return st;
@@ -155,6 +156,8 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
          * could not correct it. Without noise, only what changed since the
          * previous iteration is adjusted and offered for removal again. */
         double noise = it > 0 && sigma >= 0.5 * (double)cfg->step_m ? sigma : 0.0;
+        if (o.rays.on)
+            noise = 0.0; /* single scan: see docs/algorithm.md */
         if (noise > 0.0) {
             polyc__op_noise(&o, noise);
             if ((st = polyc__rebuild(&o)) != POLYC_OK)
@@ -162,22 +165,28 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
         }
         uint32_t since = it == 0 || noise > 0.0 ? 0 : prev_start;
         prev_start = start;
-        polyc__op_overlaps(&o);          /* A */
-        polyc__op_merge(&o);             /* B */
-        polyc__op_split(&o);             /* C */
+        if (!o.rays.on) {
+            /* a single scan's chains already join what its beam order
+             * joins: overlaps, merges and splits are its beams' business */
+            polyc__op_overlaps(&o);      /* A */
+            polyc__op_merge(&o);         /* B */
+            polyc__op_split(&o);         /* C */
+        }
         polyc__op_remove_vertices(&o, since); /* G: fewer vertices first, so that */
         polyc__op_adjust(&o, ADJUST_ROUNDS, since); /* D moves what is left */
         uint32_t mark = ++o.touch_stamp;
         polyc__op_zigzag(&o);            /* E */
         polyc__op_corners(&o, since);    /* corners (not in the paper) */
         polyc__op_remove_vertices(&o, mark); /* G */
-        polyc__op_add_vertices(&o, ADD_ROUNDS); /* G, more vertices */
+        if (!o.rays.on) /* a single scan's chains start with more than enough */
+            polyc__op_add_vertices(&o, ADD_ROUNDS); /* G, more vertices */
         polyc__op_adjust(&o, ADJUST_ROUNDS, mark);
         /* moves and additions can leave segments without data or hairpins:
          * clean them before the model is judged, so the best one is clean */
         for (int round = 0; round < 3; round++) {
             mark = ++o.touch_stamp;
-            if (polyc__op_split(&o) + polyc__op_zigzag(&o) + polyc__op_corners(&o, since) == 0)
+            if ((o.rays.on ? 0 : polyc__op_split(&o)) + polyc__op_zigzag(&o) +
+                    polyc__op_corners(&o, since) == 0)
                 break;
             polyc__op_adjust(&o, ADJUST_ROUNDS, mark);
         }

@@ -11,6 +11,20 @@ typedef struct polyc__heap_entry {
     int32_t pad;
 } polyc__heap_entry;
 
+/* one scan's beams (ray_check.c): a segment may not stand in front of a
+ * return, nor behind one of its own returns, by more than this along the
+ * beam */
+#define POLYC__RAY_TOLERANCE_M 0.10
+typedef struct polyc__rays {
+    int on;                        /* the map comes from a single scan */
+    double x, y, base, step;       /* origin, direction of beam 0, step */
+    const float *range;
+    float min_m, max_m;
+    int32_t count, turn;           /* beams, beams per full turn */
+    double tol_m;
+    double own_m;                  /* a return this near a segment's line is its own */
+} polyc__rays;
+
 typedef struct polyc__opt {
     polyc_ctx *ctx;
     const polyc_config *cfg;
@@ -31,6 +45,7 @@ typedef struct polyc__opt {
     double *acost;                 /* per vertex: 1 - p */
     polyc__prior prior;
     polyc__spacing spacing;        /* expected point spacing: the split scale */
+    polyc__rays rays;              /* single-scan mode: the beams' free space */
 
     polyc__hash h;
     uint8_t *seg_in;               /* per vertex: its segment is in the hash */
@@ -158,6 +173,12 @@ int polyc__op_remove_vertices(polyc__opt *o, uint32_t since);
 /* the change of the BIC if v is removed when that is below `bound`, else
  * some value >= bound (INFINITY: always exact) */
 double polyc__removal_delta_below(polyc__opt *o, int32_t v, double bound);
+/* ray_check.c */
+void polyc__rays_init(polyc__rays *rays, const polyc_ctx *ctx);
+int polyc__blocks_beams(const polyc__rays *rays, float ax, float ay, float bx, float by);
+int polyc__vertex_blocks(const polyc__opt *o, int32_t v, float x, float y);
+float polyc__ray_position(const polyc__rays *rays, float ax, float ay, float bx, float by,
+                          float px, float py, float projection);
 int polyc__op_add_vertices(polyc__opt *o, int max_tries);
 int polyc__hill_climb(polyc__opt *o, int32_t v);
 double polyc__turn_cost(const polyc__opt *o, float ax, float ay, float bx, float by, float cx,

@@ -279,7 +279,9 @@ static int pipeline_run(pipeline *p, const polyc_scan *scans, uint32_t n, double
     if (step(p, polyc_build_grid(p->ctx), "polyc_build_grid"))
         return -1;
     t1 = now_ms(); times[ST_GRID] = t1 - t; t = t1;
-    if (step(p, polyc_extract_contour(p->ctx), "polyc_extract_contour"))
+    /* (a single scan's polylines come from its beam order: polyc_build
+     * skips the contour, and so does this) */
+    if (n > 1 && step(p, polyc_extract_contour(p->ctx), "polyc_extract_contour"))
         return -1;
     t1 = now_ms(); times[ST_CONTOUR] = t1 - t; t = t1;
     if (step(p, polyc_trace(p->ctx), "polyc_trace"))

@@ -55,6 +55,7 @@ static const char usage_text[] =
     "  --alpha A               BIC weight of the error (paper 500)\n"
     "  --gamma G               weight of the angle prior (0: uniform)\n"
     "  --exact-points          keep every endpoint as a data point (slower)\n"
+    "  --grid-trace            one scan: trace the grid's contour, not the beam order\n"
     "  --trace FILE            per iteration: iteration bic best_bic vertices polylines noise_m\n"
     "  --memory-mb N           fail (exit 3) if the library needs more than N MiB\n"
     "  --points, --grid, --vertices\n"
@@ -166,6 +167,8 @@ static int set_flag(options *o, const char *name)
         o->no_optimize = 1;
     else if (strcmp(name, "--exact-points") == 0)
         o->config.flags |= POLYC_FLAG_EXACT_POINTS;
+    else if (strcmp(name, "--grid-trace") == 0)
+        o->config.flags |= POLYC_FLAG_GRID_TRACE;
     else if (strcmp(name, "--points") == 0)
         o->points = 1;
     else if (strcmp(name, "--grid") == 0)

@@ -26,7 +26,8 @@ from array import array
 from typing import NamedTuple, Sequence, Tuple, List
 
 __all__ = ["PolycError", "Scan", "Polyline", "Result", "Context", "build_map",
-           "default_config", "version", "STATUS", "FLAG_EXACT_POINTS", "FLAG_NO_GRAZING"]
+           "default_config", "version", "STATUS", "FLAG_EXACT_POINTS", "FLAG_NO_GRAZING",
+           "FLAG_GRID_TRACE"]
 
 # polyc_status, append-only like the C enum
 STATUS = {0: "POLYC_OK", 1: "POLYC_ERR_NULL", 2: "POLYC_ERR_CONFIG", 3: "POLYC_ERR_NOMEM",
@@ -36,6 +37,7 @@ OK, ERR_NULL, ERR_CONFIG, ERR_NOMEM, ERR_SCAN, ERR_STATE = 0, 1, 2, 3, 4, 5
 ERR_EXTENT, ERR_LIMIT, ERR_RANGE, ERR_STOPPED = 6, 7, 8, 9
 FLAG_EXACT_POINTS = 0x1
 FLAG_NO_GRAZING = 0x2
+FLAG_GRID_TRACE = 0x4
 
 _f32, _f64, _u32, _u64 = ctypes.c_float, ctypes.c_double, ctypes.c_uint32, ctypes.c_uint64
 

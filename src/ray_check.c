@@ -1,0 +1,119 @@
+/* ray_check.c - one scan's beams as constraints on the map (a departure from
+ * the paper, used when the map is built from a single scan).
+ * Takes: the context's one scan. Gives: whether a segment would stand in
+ * front of some beam's return, i.e. where the beam saw through: the BIC only
+ * sees distances to data points, so without this a removal or a merge can
+ * bridge a gap that beams passed through, and those beams then meet the map
+ * metres short of what they measured. */
+#include "optimize.h"
+
+#include <math.h>
+
+#define TWO_PI 6.283185307179586
+
+void polyc__rays_init(polyc__rays *rays, const polyc_ctx *ctx)
+{
+    rays->on = ctx->scan_count == 1 && !(ctx->cfg.flags & POLYC_FLAG_GRID_TRACE);
+    if (!rays->on)
+        return;
+    const polyc__scan *s = &ctx->scans[0];
+    rays->x = s->x_m;
+    rays->y = s->y_m;
+    rays->base = (double)s->theta_rad + (double)s->start_rad;
+    rays->step = (double)s->step_rad;
+    rays->count = (int32_t)s->count;
+    rays->range = &ctx->ranges[s->first];
+    rays->min_m = s->min_m;
+    rays->max_m = s->max_m;
+    /* beams per turn: indices that far apart are the same direction */
+    rays->turn = rays->step != 0.0 ? (int32_t)lround(TWO_PI / fabs(rays->step)) : 0;
+    rays->tol_m = POLYC__RAY_TOLERANCE_M;
+    rays->own_m = (double)ctx->cfg.search_radius_m;
+}
+
+/* Range along beam direction (c, s) from the origin to segment a-b, or
+ * INFINITY if the beam misses it. */
+static double range_to(const polyc__rays *rays, double c, double sn, double ax, double ay,
+                       double bx, double by)
+{
+    double ex = bx - ax, ey = by - ay;
+    double den = c * ey - sn * ex;
+    if (den == 0.0)
+        return INFINITY;
+    double qx = ax - rays->x, qy = ay - rays->y;
+    double t = (qx * ey - qy * ex) / den;  /* along the beam */
+    double u = (qx * sn - qy * c) / den;   /* along the segment */
+    return t > 0.0 && u >= 0.0 && u <= 1.0 ? t : (double)INFINITY;
+}
+
+/* Where the beam through (px, py) crosses the line of segment a-b, in
+ * metres from a along it; `projection` (p's own) if the beam runs nearly
+ * parallel to the segment or crosses it far from p. */
+float polyc__ray_position(const polyc__rays *rays, float ax, float ay, float bx, float by,
+                          float px, float py, float projection)
+{
+    double ex = (double)bx - (double)ax, ey = (double)by - (double)ay, len = sqrt(ex * ex + ey * ey);
+    double cx = (double)px - rays->x, cy = (double)py - rays->y, r = sqrt(cx * cx + cy * cy);
+    if (len <= 0.0 || r <= 0.0)
+        return projection;
+    ex /= len;
+    ey /= len;
+    double den = cx * ey - cy * ex; /* r sin(incidence) */
+    if (fabs(den) < 0.05 * r)
+        return projection;
+    double qx = (double)ax - rays->x, qy = (double)ay - rays->y;
+    double u = (qx * cy - qy * cx) / den;
+    return fabs(u - (double)projection) <= 0.5 ? (float)u : projection;
+}
+
+/* Whether vertex v at (x, y) makes one of its segments block a beam. */
+int polyc__vertex_blocks(const polyc__opt *o, int32_t v, float x, float y)
+{
+    if (!o->rays.on)
+        return 0;
+    const polyc__vertex *V = o->s->v;
+    int32_t p = V[v].prev, n = V[v].next;
+    return (p != POLYC__NONE && polyc__blocks_beams(&o->rays, V[p].x, V[p].y, x, y)) ||
+           (n != POLYC__NONE && polyc__blocks_beams(&o->rays, x, y, V[n].x, V[n].y));
+}
+
+int polyc__blocks_beams(const polyc__rays *rays, float ax, float ay, float bx, float by)
+{
+    if (!rays->on || rays->step == 0.0)
+        return 0;
+    double ta = atan2((double)ay - rays->y, (double)ax - rays->x);
+    double tb = atan2((double)by - rays->y, (double)bx - rays->x);
+    /* beam index space: the segment covers [ia, ib] the short way round */
+    double ia = remainder(ta - rays->base, TWO_PI) / rays->step;
+    double span = remainder(tb - ta, TWO_PI) / rays->step;
+    double lo = span < 0.0 ? ia + span : ia, hi = span < 0.0 ? ia : ia + span;
+    for (double k = ceil(lo); k <= hi; k += 1.0) {
+        int32_t i = (int32_t)k;
+        if (rays->turn > 0 && (i < 0 || i >= rays->count)) {
+            i %= rays->turn; /* the same direction one turn away */
+            if (i < 0)
+                i += rays->turn;
+        }
+        if (i < 0 || i >= rays->count)
+            continue;
+        float r = rays->range[i];
+        if (!(r >= rays->min_m && r < rays->max_m))
+            continue; /* no return: it proves nothing about a wall */
+        double a = rays->base + (double)i * rays->step;
+        double c = cos(a), sn = sin(a);
+        double t = range_to(rays, c, sn, ax, ay, bx, by);
+        if (t < (double)r - rays->tol_m)
+            return 1;
+        if (isfinite(t) && t > (double)r + rays->tol_m) {
+            /* the return is in front of the segment: a misfit if it is
+             * near enough to be the segment's own point (within the
+             * search radius of its line) */
+            double px = rays->x + (double)r * c - (double)ax, py = rays->y + (double)r * sn - (double)ay;
+            double ex = (double)bx - (double)ax, ey = (double)by - (double)ay;
+            double cr = px * ey - py * ex;
+            if (cr * cr < rays->own_m * rays->own_m * (ex * ex + ey * ey))
+                return 1;
+        }
+    }
+    return 0;
+}

@@ -1,0 +1,305 @@
+/* scan_chains.c - initial polylines of a single scan from its beam order
+ * (a departure from the paper, which traces the grid's contour).
+ * Takes: the context's one scan. Gives: polylines in the store, one per
+ * chain of neighbouring endpoints, simplified to within a grid cell.
+ *
+ * Why: one scan leaves sparse contour cells (a beam spacing apart at range,
+ * wider at grazing angles), and the grid trace cannot tell such a gap from a
+ * depth jump by distance alone; the beam order can. Two consecutive
+ * endpoints belong to one surface unless the second lies farther than a
+ * surface seen at LAMBDA or more to the beams would put it (the adaptive
+ * breakpoint rule of Borges and Aldon, 2004). */
+#include "internal.h"
+
+#include <math.h>
+
+#define LAMBDA_RAD 0.1745f   /* 10 degrees: flatter surfaces count as jumps */
+#define GRAZING_REACH 4.0f  /* ... times farther if the chain goes straight on */
+#define COS2_TURN 0.9698f    /* cos^2 of 10 degrees: "straight on" */
+#define MAX_SKIP_NEAR 2      /* a chain bridges one beam without return, */
+#define MAX_SKIP 8           /* or seven going straight on (grazing walls) */
+
+typedef struct chains {
+    polyc_ctx *ctx;
+    float *xy;                 /* every beam's endpoint; NaN without a hit */
+    uint8_t *keep;             /* per beam: a vertex of the simplified chain */
+    float ox, oy;              /* the scan's origin */
+    float step;                /* |angle step| */
+    float tol;                 /* simplification tolerance */
+} chains;
+
+size_t polyc__chains_bytes(const polyc_limits *lim)
+{
+    return polyc__add(polyc__bytes((size_t)lim->max_beams + 1, 2 * sizeof(float)),
+                      polyc__bytes((size_t)lim->max_beams + 1, 1));
+}
+
+static int is_hit(const polyc__scan *s, float r)
+{
+    return r == r && r >= s->min_m && r < s->max_m;
+}
+
+static float seg_dist2(const float *p, const float *a, const float *b)
+{
+    float dx = b[0] - a[0], dy = b[1] - a[1], l2 = dx * dx + dy * dy;
+    float t = l2 > 0.0f ? ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2 : 0.0f;
+    t = t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
+    float ex = a[0] + t * dx - p[0], ey = a[1] + t * dy - p[1];
+    return ex * ex + ey * ey;
+}
+
+static int has_point(const chains *c, int32_t i)
+{
+    return c->xy[2 * i] == c->xy[2 * i];
+}
+
+/* Douglas-Peucker over the hits of beams [a, b], both hits: marks vertices
+ * in c->keep. Without a stack (fixed memory): each pass splits every span
+ * whose farthest point is beyond the tolerance, until none is. */
+static void simplify(chains *c, int32_t a, int32_t b)
+{
+    for (int32_t i = a; i <= b; i++)
+        c->keep[i] = 0;
+    c->keep[a] = c->keep[b] = 1;
+    float tol2 = c->tol * c->tol;
+    int split = 1;
+    while (split) {
+        split = 0;
+        int32_t i = a;
+        while (i < b) {
+            int32_t j = i + 1, far = -1;
+            float worst = tol2;
+            while (!c->keep[j])
+                j++;
+            for (int32_t k = i + 1; k < j; k++) {
+                if (!has_point(c, k))
+                    continue;
+                float d = seg_dist2(&c->xy[2 * k], &c->xy[2 * i], &c->xy[2 * j]);
+                if (d > worst) {
+                    worst = d;
+                    far = k;
+                }
+            }
+            if (far >= 0) {
+                c->keep[far] = 1;
+                split = 1;
+            }
+            i = j;
+        }
+    }
+}
+
+static float dist2(const chains *c, int32_t i, int32_t j)
+{
+    float dx = c->xy[2 * j] - c->xy[2 * i], dy = c->xy[2 * j + 1] - c->xy[2 * i + 1];
+    return dx * dx + dy * dy;
+}
+
+/* a -> b -> c goes straight on (turns less than 10 degrees) */
+static int straight(const chains *c, int32_t a, int32_t b, int32_t d)
+{
+    float ux = c->xy[2 * b] - c->xy[2 * a], uy = c->xy[2 * b + 1] - c->xy[2 * a + 1];
+    float wx = c->xy[2 * d] - c->xy[2 * b], wy = c->xy[2 * d + 1] - c->xy[2 * b + 1];
+    float dot = ux * wx + uy * wy;
+    return dot > 0.0f && dot * dot >= COS2_TURN * (ux * ux + uy * uy) * (wx * wx + wy * wy);
+}
+
+static polyc_status append(chains *c, int32_t line, float x, float y)
+{
+    if (polyc__vertex_append(&c->ctx->store, line, x, y) == POLYC__NONE)
+        return polyc__fail(c->ctx, POLYC_ERR_NOMEM, "too many vertices for limits.max_vertices");
+    return POLYC_OK;
+}
+
+/* Half a beam spacing at the endpoint of beam i, at least half a cell. */
+static float half_spacing(const chains *c, int32_t i)
+{
+    float dx = c->xy[2 * i] - c->ox, dy = c->xy[2 * i + 1] - c->oy;
+    return fmaxf(0.5f * c->ctx->cfg.cell_m, 0.5f * sqrtf(dx * dx + dy * dy) * c->step);
+}
+
+/* A line fitted to the hits of beams [i, j]: centroid and unit direction
+ * (total least squares: the direction of the larger eigenvector). */
+typedef struct fitted {
+    float cx, cy, dx, dy;
+} fitted;
+
+static void fit(const chains *c, int32_t i, int32_t j, fitted *f)
+{
+    float sx = 0.0f, sy = 0.0f, n = 0.0f;
+    for (int32_t k = i; k <= j; k++)
+        if (has_point(c, k)) {
+            sx += c->xy[2 * k];
+            sy += c->xy[2 * k + 1];
+            n += 1.0f;
+        }
+    f->cx = sx / n;
+    f->cy = sy / n;
+    float xx = 0.0f, xy = 0.0f, yy = 0.0f;
+    for (int32_t k = i; k <= j; k++)
+        if (has_point(c, k)) {
+            float ex = c->xy[2 * k] - f->cx, ey = c->xy[2 * k + 1] - f->cy;
+            xx += ex * ex;
+            xy += ex * ey;
+            yy += ey * ey;
+        }
+    float a = 0.5f * atan2f(2.0f * xy, xx - yy);
+    f->dx = cosf(a);
+    f->dy = sinf(a);
+}
+
+static void project(const fitted *f, const float *p, float *x, float *y)
+{
+    float t = (p[0] - f->cx) * f->dx + (p[1] - f->cy) * f->dy;
+    *x = f->cx + t * f->dx;
+    *y = f->cy + t * f->dy;
+}
+
+/* Where the two fitted lines meet; 0 if they are within 10 degrees of
+ * parallel. */
+static int meet(const fitted *f, const fitted *g, float *x, float *y)
+{
+    float den = f->dx * g->dy - f->dy * g->dx;
+    if (fabsf(den) < 0.17f)
+        return 0;
+    float t = ((g->cx - f->cx) * g->dy - (g->cy - f->cy) * g->dx) / den;
+    *x = f->cx + t * f->dx;
+    *y = f->cy + t * f->dy;
+    return 1;
+}
+
+/* (x, y) moved outwards from (ix, iy) by half a beam spacing at beam i */
+static void extend(const chains *c, int32_t i, float ix, float iy, float *x, float *y)
+{
+    float dx = *x - ix, dy = *y - iy, len = sqrtf(dx * dx + dy * dy);
+    if (len <= 0.0f)
+        return;
+    float m = half_spacing(c, i) / len;
+    *x += dx * m;
+    *y += dy * m;
+}
+
+/* The chain of beams [a, b] (both hits) as a polyline: Douglas-Peucker
+ * picks the vertices, a line is fitted to the hits between each two of
+ * them, and each inner vertex goes where its two lines meet (near its hit;
+ * else onto the lines), each end onto its line. The ends reach half a beam
+ * spacing past the end hits, so that the end beams meet the map; a lone hit
+ * becomes a segment across its beam, one beam spacing long. */
+static polyc_status emit(chains *c, int32_t a, int32_t b)
+{
+    polyc__store *s = &c->ctx->store;
+    int32_t line = polyc__line_new(s);
+    if (line == POLYC__NONE)
+        return polyc__fail(c->ctx, POLYC_ERR_NOMEM, "too many polylines for limits.max_vertices");
+    if (a == b) {
+        float x = c->xy[2 * a], y = c->xy[2 * a + 1], dx = x - c->ox, dy = y - c->oy;
+        float len = sqrtf(dx * dx + dy * dy);
+        float h = half_spacing(c, a) / (len > 0.0f ? len : 1.0f);
+        polyc_status st = append(c, line, x + dy * h, y - dx * h);
+        return st != POLYC_OK ? st : append(c, line, x - dy * h, y + dx * h);
+    }
+    simplify(c, a, b);
+    fitted before, after;
+    int32_t i = a, j = a + 1;
+    while (!c->keep[j])
+        j++;
+    fit(c, i, j, &after);
+    float x, y, ex, ey;
+    project(&after, &c->xy[2 * a], &x, &y);
+    project(&after, &c->xy[2 * j], &ex, &ey);
+    extend(c, a, ex, ey, &x, &y);
+    polyc_status st = append(c, line, x, y);
+    while (st == POLYC_OK && j < b) {
+        /* inner vertex j between spans [i, j] and [j, k] */
+        int32_t k = j + 1;
+        while (!c->keep[k])
+            k++;
+        before = after;
+        fit(c, j, k, &after);
+        const float *p = &c->xy[2 * j];
+        float far = 2.0f * c->tol;
+        if (!meet(&before, &after, &x, &y) ||
+            (x - p[0]) * (x - p[0]) + (y - p[1]) * (y - p[1]) > far * far) {
+            float x1, y1, x2, y2;
+            project(&before, p, &x1, &y1);
+            project(&after, p, &x2, &y2);
+            x = 0.5f * (x1 + x2);
+            y = 0.5f * (y1 + y2);
+        }
+        st = append(c, line, x, y);
+        i = j;
+        j = k;
+    }
+    if (st != POLYC_OK)
+        return st;
+    project(&after, &c->xy[2 * b], &x, &y);
+    project(&after, &c->xy[2 * i], &ex, &ey);
+    extend(c, b, ex, ey, &x, &y);
+    return append(c, line, x, y);
+}
+
+polyc_status polyc__chains_build(polyc_ctx *ctx)
+{
+    polyc_status st = polyc__store_init(ctx, &ctx->store, polyc__max_vertices(&ctx->lim));
+    if (st != POLYC_OK || ctx->scan_count == 0)
+        return st;
+    size_t after_store = ctx->arena.used; /* scratch released at the end */
+    const polyc__scan *s = &ctx->scans[0];
+    int32_t n = (int32_t)s->count;
+    chains c;
+    c.ctx = ctx;
+    c.xy = polyc__alloc(&ctx->arena, (size_t)n + 1, 2 * sizeof(float));
+    c.keep = polyc__alloc(&ctx->arena, (size_t)n + 1, 1);
+    if (!c.xy || !c.keep)
+        return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the scan's chains");
+    c.ox = s->x_m;
+    c.oy = s->y_m;
+    c.step = fabsf(s->step_rad);
+    c.tol = ctx->cfg.cell_m;
+    const float *r = &ctx->ranges[s->first];
+    for (int32_t i = 0; i < n; i++) {
+        float a = s->theta_rad + s->start_rad + (float)i * s->step_rad;
+        c.xy[2 * i] = c.xy[2 * i + 1] = NAN;
+        if (is_hit(s, r[i])) {
+            c.xy[2 * i] = c.ox + r[i] * cosf(a);
+            c.xy[2 * i + 1] = c.oy + r[i] * sinf(a);
+        }
+    }
+    /* chains: runs of hits where each is linked to the previous one */
+    int32_t first = -1, last = -1, prev = -1;
+    for (int32_t i = 0; i <= n; i++) {
+        int hit = i < n && has_point(&c, i);
+        int linked = 0;
+        if (hit && last >= 0 && i - last <= MAX_SKIP) {
+            float dphi = c.step;   /* each missing beam widens the reach by a step */
+            float reach = (float)(i - last) * r[last] * sinf(dphi) / sinf(fmaxf(LAMBDA_RAD - dphi, 0.01f)) +
+                          2.0f * ctx->cfg.cell_m;
+            float dx = c.xy[2 * i] - c.xy[2 * last], dy = c.xy[2 * i + 1] - c.xy[2 * last + 1];
+            float d2 = dx * dx + dy * dy;
+            linked = i - last <= MAX_SKIP_NEAR && d2 <= reach * reach;
+            if (!linked && d2 <= GRAZING_REACH * GRAZING_REACH * reach * reach) {
+                /* a wall seen at a grazing angle: three points in a line,
+                 * the chain's last two or the two with the next hit */
+                int32_t next = i + 1;
+                while (next < n && next - i <= MAX_SKIP && !has_point(&c, next))
+                    next++;
+                linked = (prev >= 0 && straight(&c, prev, last, i)) ||
+                         (next < n && next - i <= MAX_SKIP && straight(&c, last, i, next) &&
+                          dist2(&c, i, next) <= GRAZING_REACH * GRAZING_REACH * reach * reach);
+            }
+        }
+        if (first >= 0 && (i == n || (hit && !linked) || i - last > MAX_SKIP)) {
+            if ((st = emit(&c, first, last)) != POLYC_OK)
+                return st;
+            first = -1;
+        }
+        if (hit) {
+            if (first < 0)
+                first = i;
+            prev = first == i ? -1 : last;
+            last = i;
+        }
+    }
+    ctx->arena.used = after_store;
+    return POLYC_OK;
+}

@@ -1,0 +1,269 @@
+/* test_single_scan.c - maps from one scan: initial polylines from the beam
+ * order (src/scan_chains.c) and the beams as constraints on the optimiser
+ * (src/ray_check.c). Scenes come from tools/scansim, scored along the beams
+ * by tools/gtscore (f and ray RMSE, as shared/data/README.md defines them).
+ */
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gtscore.h"
+#include "optimize.h"
+#include "polyc.h"
+#include "scansim.h"
+
+#define PI 3.14159265358979
+
+typedef struct one_map {
+    scansim_scene scene;
+    void *block;
+    polyc_ctx *ctx;
+    polyc_stats stats;
+    gtscore_scan_score score;
+    double worst_short_m;      /* largest (map range - measured range) < 0 ... */
+    double worst_long_m;       /* ... and > 0, over the hits */
+} one_map;
+
+/* A 6 m x 4 m room with a 40 cm box in it, seen once from (1, 2). */
+static void room_with_box(scansim_scene *sc)
+{
+    scansim_scene_init(sc, "room", 5u);
+    assert_int_equal(scansim_add_box(sc, 0.0, 0.0, 6.0, 4.0), 0);
+    assert_int_equal(scansim_add_box(sc, 2.6, 1.4, 3.0, 1.8), 0);
+    assert_int_equal(scansim_add_pose(sc, 1.0, 2.0, 0.1), 0);
+    scansim_transform(sc, 0.4, 3.0, -1.0);
+}
+
+/* A 1.6 m wide corridor, 30 m long, seen once from near one end along it. */
+static void corridor(scansim_scene *sc)
+{
+    scansim_scene_init(sc, "corridor", 9u);
+    const double left[4] = {-1.0, 1.6, 29.0, 1.6}, right[4] = {-1.0, 0.0, 29.0, 0.0};
+    assert_int_equal(scansim_add_wall(sc, left, 2, 0), 0);
+    assert_int_equal(scansim_add_wall(sc, right, 2, 0), 0);
+    sc->laser.max_range_m = 20.0f;
+    assert_int_equal(scansim_add_pose(sc, 0.0, 0.8, 0.0), 0);
+}
+
+static void build(one_map *m, const polyc_config *config)
+{
+    polyc_limits lim;
+    assert_int_equal(scansim_run(&m->scene), 0);
+    assert_int_equal(m->scene.scan_count, 1);
+    const polyc_scan *scan = &m->scene.scans[0];
+    assert_int_equal(polyc_limits_for_scans(config, scan, 1, &lim), POLYC_OK);
+    size_t size = polyc_memory_size(config, &lim);
+    assert_true(size > 0);
+    m->block = malloc(size);
+    assert_non_null(m->block);
+    assert_int_equal(polyc_init(m->block, size, config, &lim, &m->ctx), POLYC_OK);
+    assert_int_equal(polyc_add_scan(m->ctx, scan), POLYC_OK);
+    polyc_status st = polyc_build(m->ctx, NULL, NULL);
+    if (st != POLYC_OK)
+        fail_msg("polyc_build: %s (%s)", polyc_status_str(st), polyc_last_error(m->ctx));
+    assert_int_equal(polyc_get_stats(m->ctx, &m->stats), POLYC_OK);
+
+    /* score along the beams */
+    uint32_t n = polyc_polyline_count(m->ctx);
+    polyc_polyline *lines = calloc(n ? n : 1u, sizeof *lines);
+    assert_non_null(lines);
+    for (uint32_t i = 0; i < n; i++)
+        assert_int_equal(polyc_get_polyline(m->ctx, i, &lines[i]), POLYC_OK);
+    gtscore_index map;
+    gtscore_index_init(&map);
+    assert_int_equal(gtscore_index_add_polylines(&map, lines, n), 0);
+    assert_int_equal(gtscore_index_build(&map, 0.1), 0);
+    memset(&m->score, 0, sizeof m->score);
+    gtscore_score_scan(&map, scan, &m->score);
+    m->worst_short_m = m->worst_long_m = 0.0;
+    for (uint32_t i = 0; i < scan->beam_count; i++) {
+        if (!gtscore_beam_reflected(scan, i))
+            continue;
+        double a = scan->pose_theta_rad + (double)scan->start_angle_rad +
+                   (double)i * (double)scan->angle_step_rad;
+        double r = gtscore_index_ray(&map, scan->pose_x_m, scan->pose_y_m, a,
+                                     (double)scan->max_range_m);
+        if (!isfinite(r))
+            continue;
+        double e = r - (double)scan->range_m[i];
+        if (e < m->worst_short_m)
+            m->worst_short_m = e;
+        if (e > m->worst_long_m)
+            m->worst_long_m = e;
+    }
+    gtscore_index_free(&map);
+    free(lines);
+    print_message("%s: %u polylines, %u vertices (initial %u/%u), f %.4f, ray RMSE %.1f mm, "
+                  "worst %.0f / +%.0f mm\n",
+                  m->scene.name, m->stats.polylines, m->stats.vertices,
+                  m->stats.initial_polylines, m->stats.initial_vertices, m->score.f,
+                  1e3 * m->score.ray_rmse_m, 1e3 * m->worst_short_m, 1e3 * m->worst_long_m);
+}
+
+static void done(one_map *m)
+{
+    free(m->block);
+    scansim_scene_free(&m->scene);
+}
+
+/* Initial polylines: every return is on the map, within the range noise
+ * along its beam, and the box is not joined to the wall behind it (such a
+ * segment would stop the beams that pass beside the box). The contour is
+ * not computed for them. */
+static void test_chains_follow_the_beams(void **state)
+{
+    (void)state;
+    one_map m;
+    memset(&m, 0, sizeof m);
+    room_with_box(&m.scene);
+    polyc_config c;
+    polyc_config_default(&c);
+    c.max_iterations = 0;
+    build(&m, &c);
+    assert_true(m.score.f >= 0.99);
+    assert_true(m.score.ray_rmse_m <= 0.02);
+    assert_true(m.worst_short_m > -0.05);
+    assert_int_equal(m.stats.contour_cells, 0);
+    assert_true(m.stats.polylines >= 2); /* the box apart from the room */
+    done(&m);
+}
+
+/* A wall seen at grazing angles is one chain, not a string of single hits. */
+static void test_grazing_wall_is_one_chain(void **state)
+{
+    (void)state;
+    one_map m;
+    memset(&m, 0, sizeof m);
+    corridor(&m.scene);
+    polyc_config c;
+    polyc_config_default(&c);
+    c.max_iterations = 0;
+    build(&m, &c);
+    assert_int_equal(m.stats.polylines, 2);
+    assert_true(m.score.f >= 0.99);
+    done(&m);
+}
+
+/* The optimised map of one scan: compact, and still true along the beams:
+ * no segment in front of a return, f and ray RMSE at the project's targets
+ * (f >= 0.95, RMSE <= 4 cm). */
+static void check_optimised(void (*scene)(scansim_scene *))
+{
+    one_map m;
+    memset(&m, 0, sizeof m);
+    scene(&m.scene);
+    polyc_config c;
+    polyc_config_default(&c);
+    build(&m, &c);
+    assert_true(m.stats.iterations > 0);
+    assert_true(m.stats.vertices < m.stats.initial_vertices);
+    assert_true(m.score.f >= 0.95);
+    assert_true(m.score.ray_rmse_m <= 0.04);
+    assert_true(m.worst_short_m > -POLYC__RAY_TOLERANCE_M - 0.03);
+    done(&m);
+}
+
+static void test_optimised_room(void **state)
+{
+    (void)state;
+    check_optimised(room_with_box);
+}
+
+static void test_optimised_corridor(void **state)
+{
+    (void)state;
+    check_optimised(corridor);
+}
+
+/* POLYC_FLAG_GRID_TRACE keeps the paper's contour trace for one scan. */
+static void test_grid_trace_flag(void **state)
+{
+    (void)state;
+    one_map m;
+    memset(&m, 0, sizeof m);
+    room_with_box(&m.scene);
+    polyc_config c;
+    polyc_config_default(&c);
+    c.max_iterations = 0;
+    c.flags |= POLYC_FLAG_GRID_TRACE;
+    build(&m, &c);
+    assert_true(m.stats.contour_cells > 0);
+    /* and the contour is there on request in the default mode too */
+    assert_int_equal(polyc_extract_contour(m.ctx), POLYC_OK);
+    done(&m);
+
+    memset(&m, 0, sizeof m);
+    room_with_box(&m.scene);
+    c.flags = 0;
+    build(&m, &c);
+    assert_int_equal(polyc_extract_contour(m.ctx), POLYC_OK);
+    assert_int_equal(polyc_get_stats(m.ctx, &m.stats), POLYC_OK);
+    assert_true(m.stats.contour_cells > 0);
+    done(&m);
+}
+
+/* polyc__blocks_beams on hand cases: a scan whose every return is at 2 m. */
+static void test_blocks_beams(void **state)
+{
+    (void)state;
+    float range[360];
+    for (int i = 0; i < 360; i++)
+        range[i] = 2.0f;
+    range[10] = 50.0f; /* no return (>= max) */
+    polyc__rays r;
+    memset(&r, 0, sizeof r);
+    r.on = 1;
+    r.base = 0.0;
+    r.step = 2.0 * PI / 360.0;
+    r.count = 360;
+    r.turn = 360;
+    r.range = range;
+    r.min_m = 0.1f;
+    r.max_m = 30.0f;
+    r.tol_m = POLYC__RAY_TOLERANCE_M;
+    r.own_m = 0.15;
+    /* in front of the returns: blocks */
+    assert_true(polyc__blocks_beams(&r, 1.0f, -0.2f, 1.0f, 0.2f));
+    /* on them, or within the tolerance: fine */
+    assert_false(polyc__blocks_beams(&r, 2.0f, -0.2f, 2.0f, 0.2f));
+    assert_false(polyc__blocks_beams(&r, 1.95f, -0.2f, 1.95f, 0.2f));
+    /* behind its own returns by more than the tolerance: a misfit */
+    assert_true(polyc__blocks_beams(&r, 2.13f, -0.2f, 2.13f, 0.2f));
+    /* far behind: some other returns' business */
+    assert_false(polyc__blocks_beams(&r, 3.0f, -0.2f, 3.0f, 0.2f));
+    /* across the seam of the turn (beams 359 and 0) and at 180 degrees */
+    assert_true(polyc__blocks_beams(&r, 1.0f, 0.05f, 1.0f, -0.05f));
+    assert_true(polyc__blocks_beams(&r, -1.0f, 0.1f, -1.0f, -0.1f));
+    /* only the no-return beam crosses it: nothing proven */
+    float a = (float)(10.0 * r.step);
+    assert_false(polyc__blocks_beams(&r, cosf(a) - 0.01f * sinf(a), sinf(a) + 0.01f * cosf(a),
+                                     cosf(a) + 0.01f * sinf(a), sinf(a) - 0.01f * cosf(a)));
+    /* a 180-degree scan sees nothing behind it */
+    r.base = -0.5 * PI;
+    r.count = 181;
+    r.step = PI / 180.0;
+    assert_false(polyc__blocks_beams(&r, -1.0f, 0.1f, -1.0f, -0.1f));
+    assert_true(polyc__blocks_beams(&r, 1.0f, -0.2f, 1.0f, 0.2f));
+    r.on = 0;
+    assert_false(polyc__blocks_beams(&r, 1.0f, -0.2f, 1.0f, 0.2f));
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_blocks_beams),
+        cmocka_unit_test(test_chains_follow_the_beams),
+        cmocka_unit_test(test_grazing_wall_is_one_chain),
+        cmocka_unit_test(test_optimised_room),
+        cmocka_unit_test(test_optimised_corridor),
+        cmocka_unit_test(test_grid_trace_flag),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
