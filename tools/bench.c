@@ -468,6 +468,7 @@ static int single_scans(const options *o, const scene *s)
 {
     scanlog log;
     double parse_ms, f_sum = 0.0, ms_sum = 0.0, sum_sq = 0.0, vertices = 0.0;
+    uint64_t beams = 0;
     double stage_sum[ST_COUNT] = {0};
     uint64_t hits = 0;
     unsigned k, done = 0;
@@ -509,6 +510,7 @@ static int single_scans(const options *o, const scene *s)
             gtscore_score_scan(&map, scan, &acc);
         gtscore_index_free(&map);
         f_sum += acc.f;
+        beams += scan->beam_count;
         sum_sq += acc.sum_sq_m2;
         hits += acc.hits;
         done++;
@@ -516,9 +518,9 @@ static int single_scans(const options *o, const scene *s)
         pipeline_close(&p);
     }
     if (done)
-        printf("%-24s %6u %8.4f %9.1f %9.1f %9.2f | %6.2f %7.2f %6.2f %8.2f\n", label, done,
-               f_sum / done, hits ? 1e3 * sqrt(sum_sq / (double)hits) : 0.0, vertices / done,
-               ms_sum / done, stage_sum[ST_GRID] / done, stage_sum[ST_CONTOUR] / done,
+        printf("%-24s %6u %8.4f %9.1f %9.1f %9.1f %9.2f | %6.2f %7.2f %6.2f %8.2f\n", label,
+               done, f_sum / done, hits ? 1e3 * sqrt(sum_sq / (double)hits) : 0.0,
+               vertices / done, beams ? 180.0 * vertices / (double)beams : 0.0, ms_sum / done, stage_sum[ST_GRID] / done, stage_sum[ST_CONTOUR] / done,
                stage_sum[ST_TRACE] / done, stage_sum[ST_OPT] / done);
     fflush(stdout);
     scanlog_free(&log);
@@ -629,10 +631,10 @@ int main(int argc, char **argv)
         printf("\nsingle scans: a map from one scan; f = share of reflected beams whose ray "
                "meets the map,\nray RMSE = measured minus map range over those beams "
                "(tools/gtscore.h)\n");
-        printf("%-24s %6s %8s %9s %9s %9s | %6s %7s %6s %8s\n", "log", "scans", "mean f",
-               "rayRMSE", "verts", "ms/scan", "grid", "contour", "trace", "optimise");
-        printf("%-24s %6s %8s %9s %9s %9s | %6s %7s %6s %8s\n", "", "", "", "mm", "/scan", "",
-               "ms", "ms", "ms", "ms");
+        printf("%-24s %6s %8s %9s %9s %9s %9s | %6s %7s %6s %8s\n", "log", "scans", "mean f",
+               "rayRMSE", "verts", "verts", "ms/scan", "grid", "contour", "trace", "optimise");
+        printf("%-24s %6s %8s %9s %9s %9s %9s | %6s %7s %6s %8s\n", "", "", "", "mm", "/scan",
+               "/180 b.", "", "ms", "ms", "ms", "ms");
         for (i = 0; i < count; i++)
             if (strcmp(list[i].kind, "carmen") == 0 && single_scans(&o, &list[i]) != 0)
                 failed = 1;
