@@ -107,6 +107,21 @@ static void build(one_map *m, const polyc_config *config)
                   1e3 * m->score.ray_rmse_m, 1e3 * m->worst_short_m, 1e3 * m->worst_long_m);
 }
 
+/* Simulates `scene` into m and builds its map: defaults, with `iterations`
+ * (UINT32_MAX: the default) and `flags`. */
+static void scene_map(one_map *m, void (*scene)(scansim_scene *), uint32_t iterations,
+                      uint32_t flags)
+{
+    memset(m, 0, sizeof *m);
+    scene(&m->scene);
+    polyc_config c;
+    polyc_config_default(&c);
+    if (iterations != UINT32_MAX)
+        c.max_iterations = iterations;
+    c.flags = flags;
+    build(m, &c);
+}
+
 static void done(one_map *m)
 {
     free(m->block);
@@ -121,12 +136,7 @@ static void test_chains_follow_the_beams(void **state)
 {
     (void)state;
     one_map m;
-    memset(&m, 0, sizeof m);
-    room_with_box(&m.scene);
-    polyc_config c;
-    polyc_config_default(&c);
-    c.max_iterations = 0;
-    build(&m, &c);
+    scene_map(&m, room_with_box, 0, 0);
     assert_true(m.score.f >= 0.99);
     assert_true(m.score.ray_rmse_m <= 0.02);
     assert_true(m.worst_short_m > -0.05);
@@ -140,12 +150,7 @@ static void test_grazing_wall_is_one_chain(void **state)
 {
     (void)state;
     one_map m;
-    memset(&m, 0, sizeof m);
-    corridor(&m.scene);
-    polyc_config c;
-    polyc_config_default(&c);
-    c.max_iterations = 0;
-    build(&m, &c);
+    scene_map(&m, corridor, 0, 0);
     assert_int_equal(m.stats.polylines, 2);
     assert_true(m.score.f >= 0.99);
     done(&m);
@@ -157,11 +162,7 @@ static void test_grazing_wall_is_one_chain(void **state)
 static void check_optimised(void (*scene)(scansim_scene *))
 {
     one_map m;
-    memset(&m, 0, sizeof m);
-    scene(&m.scene);
-    polyc_config c;
-    polyc_config_default(&c);
-    build(&m, &c);
+    scene_map(&m, scene, UINT32_MAX, 0);
     assert_true(m.stats.iterations > 0);
     assert_true(m.stats.vertices < m.stats.initial_vertices);
     assert_true(m.score.f >= 0.95);
@@ -187,22 +188,14 @@ static void test_grid_trace_flag(void **state)
 {
     (void)state;
     one_map m;
-    memset(&m, 0, sizeof m);
-    room_with_box(&m.scene);
-    polyc_config c;
-    polyc_config_default(&c);
-    c.max_iterations = 0;
-    c.flags |= POLYC_FLAG_GRID_TRACE;
-    build(&m, &c);
+    scene_map(&m, room_with_box, 0, POLYC_FLAG_GRID_TRACE);
     assert_true(m.stats.contour_cells > 0);
     /* and the contour is there on request in the default mode too */
     assert_int_equal(polyc_extract_contour(m.ctx), POLYC_OK);
     done(&m);
 
-    memset(&m, 0, sizeof m);
-    room_with_box(&m.scene);
-    c.flags = 0;
-    build(&m, &c);
+    scene_map(&m, room_with_box, 0, 0);
+    assert_int_equal(m.stats.contour_cells, 0);
     assert_int_equal(polyc_extract_contour(m.ctx), POLYC_OK);
     assert_int_equal(polyc_get_stats(m.ctx, &m.stats), POLYC_OK);
     assert_true(m.stats.contour_cells > 0);
