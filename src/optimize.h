@@ -173,7 +173,10 @@ int polyc__op_remove_vertices(polyc__opt *o, uint32_t since);
 /* the change of the BIC if v is removed when that is below `bound`, else
  * some value >= bound (INFINITY: always exact) */
 double polyc__removal_delta_below(polyc__opt *o, int32_t v, double bound);
-/* ray_check.c */
+/* ray_check.c: single-scan mode (rays.on) only, else every answer is 0.
+ * blocks_beams: segment a-b stands in front of a return, or behind one of
+ * its own, by more than the tolerance; vertex_blocks: v at (x, y) makes one
+ * of its segments do so */
 void polyc__rays_init(polyc__rays *rays, const polyc_ctx *ctx);
 int polyc__blocks_beams(const polyc__rays *rays, float ax, float ay, float bx, float by);
 int polyc__vertex_blocks(const polyc__opt *o, int32_t v, float x, float y);

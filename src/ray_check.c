@@ -1,10 +1,12 @@
 /* ray_check.c - one scan's beams as constraints on the map (a departure from
  * the paper, used when the map is built from a single scan).
  * Takes: the context's one scan. Gives: whether a segment would stand in
- * front of some beam's return, i.e. where the beam saw through: the BIC only
- * sees distances to data points, so without this a removal or a merge can
+ * front of some beam's return (where the beam saw through), or behind one
+ * of its own returns, by more than the tolerance along the beam. The BIC
+ * only sees distances to data points: without this a removal or a merge can
  * bridge a gap that beams passed through, and those beams then meet the map
- * metres short of what they measured. */
+ * metres short of what they measured; and on a wall seen at a grazing angle
+ * a centimetre across the wall is decimetres along the beam. */
 #include "optimize.h"
 
 #include <math.h>
@@ -26,7 +28,8 @@ void polyc__rays_init(polyc__rays *rays, const polyc_ctx *ctx)
     rays->min_m = s->min_m;
     rays->max_m = s->max_m;
     /* beams per turn: indices that far apart are the same direction */
-    rays->turn = rays->step != 0.0 ? (int32_t)lround(TWO_PI / fabs(rays->step)) : 0;
+    double per_turn = rays->step != 0.0 ? TWO_PI / fabs(rays->step) : 0.0;
+    rays->turn = per_turn < 1e9 ? (int32_t)lround(per_turn) : 0;
     rays->tol_m = POLYC__RAY_TOLERANCE_M;
     rays->own_m = (double)ctx->cfg.search_radius_m;
 }
@@ -77,6 +80,31 @@ int polyc__vertex_blocks(const polyc__opt *o, int32_t v, float x, float y)
            (n != POLYC__NONE && polyc__blocks_beams(&o->rays, x, y, V[n].x, V[n].y));
 }
 
+/* Beam i against segment a-b: 1 if the segment stands in front of its
+ * return, or behind it while the return is near enough to be its own. */
+static int beam_blocked(const polyc__rays *rays, int32_t i, float ax, float ay, float bx, float by)
+{
+    float r = rays->range[i];
+    if (!(r >= rays->min_m && r < rays->max_m))
+        return 0; /* no return: it proves nothing about a wall */
+    double a = rays->base + (double)i * rays->step;
+    double c = cos(a), sn = sin(a);
+    double t = range_to(rays, c, sn, ax, ay, bx, by);
+    if (t < (double)r - rays->tol_m)
+        return 1;
+    if (isfinite(t) && t > (double)r + rays->tol_m) {
+        /* the return is in front of the segment: a misfit if it is near
+         * enough to be the segment's own point (within the search radius
+         * of its line) */
+        double px = rays->x + (double)r * c - (double)ax, py = rays->y + (double)r * sn - (double)ay;
+        double ex = (double)bx - (double)ax, ey = (double)by - (double)ay;
+        double cr = px * ey - py * ex;
+        if (cr * cr < rays->own_m * rays->own_m * (ex * ex + ey * ey))
+            return 1;
+    }
+    return 0;
+}
+
 int polyc__blocks_beams(const polyc__rays *rays, float ax, float ay, float bx, float by)
 {
     if (!rays->on || rays->step == 0.0)
@@ -87,33 +115,15 @@ int polyc__blocks_beams(const polyc__rays *rays, float ax, float ay, float bx, f
     double ia = remainder(ta - rays->base, TWO_PI) / rays->step;
     double span = remainder(tb - ta, TWO_PI) / rays->step;
     double lo = span < 0.0 ? ia + span : ia, hi = span < 0.0 ? ia : ia + span;
-    for (double k = ceil(lo); k <= hi; k += 1.0) {
-        int32_t i = (int32_t)k;
-        if (rays->turn > 0 && (i < 0 || i >= rays->count)) {
-            i %= rays->turn; /* the same direction one turn away */
-            if (i < 0)
-                i += rays->turn;
-        }
-        if (i < 0 || i >= rays->count)
-            continue;
-        float r = rays->range[i];
-        if (!(r >= rays->min_m && r < rays->max_m))
-            continue; /* no return: it proves nothing about a wall */
-        double a = rays->base + (double)i * rays->step;
-        double c = cos(a), sn = sin(a);
-        double t = range_to(rays, c, sn, ax, ay, bx, by);
-        if (t < (double)r - rays->tol_m)
-            return 1;
-        if (isfinite(t) && t > (double)r + rays->tol_m) {
-            /* the return is in front of the segment: a misfit if it is
-             * near enough to be the segment's own point (within the
-             * search radius of its line) */
-            double px = rays->x + (double)r * c - (double)ax, py = rays->y + (double)r * sn - (double)ay;
-            double ex = (double)bx - (double)ax, ey = (double)by - (double)ay;
-            double cr = px * ey - py * ex;
-            if (cr * cr < rays->own_m * rays->own_m * (ex * ex + ey * ey))
+    /* lo, hi lie in [-turn, turn]: beam i is index i, i - turn or i + turn
+     * (bounded by the beam count, however fine the step) */
+    int32_t offsets[3] = {0, rays->turn, -rays->turn};
+    for (int k = 0; k < (rays->turn > 0 ? 3 : 1); k++) {
+        double from = fmax(ceil(lo), (double)offsets[k]);
+        double to = fmin(hi, (double)offsets[k] + (double)rays->count - 1.0);
+        for (double q = from; q <= to; q += 1.0)
+            if (beam_blocked(rays, (int32_t)q - offsets[k], ax, ay, bx, by))
                 return 1;
-        }
     }
     return 0;
 }
