@@ -127,6 +127,16 @@ static int32_t live_lines(const polyc__store *s)
 
 /* After a failure mid-search the store holds the best map so far (at worst
  * the traced one), which polyc_optimize then publishes with the status. */
+/* Whether any vertex was edited since the stamp `start`: every edit goes
+ * through polyc__chg_dirty or a committed move, and both stamp v_touch. */
+static int edited_since(const polyc__opt *o, uint32_t start)
+{
+    for (int32_t v = 0; v < o->s->v_high; v++)
+        if (o->v_touch[v] >= start)
+            return 1;
+    return 0;
+}
+
 static polyc_status restore_best(polyc__opt *o, polyc_status st)
 {
     if (polyc__store_from_flat(o->s, &o->best) != POLYC_OK)
@@ -218,6 +228,13 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
             break;
         }
         if (quiet >= cfg->patience)
+            break;
+        /* Without noise now or later, an iteration is a function of the map
+         * and of what the previous one edited: one that edited nothing is
+         * followed by copies of itself, so the patience would run out on
+         * the same best map. */
+        int noisy_later = !o.rays.on && sigma >= 0.5 * (double)cfg->step_m;
+        if (!noisy_later && !edited_since(&o, start))
             break;
     }
     ctx->stats.iterations = it < cfg->max_iterations ? it + (result == POLYC_OK) : it;

@@ -115,6 +115,13 @@ int polyc__hash_insert(polyc__opt *o, int32_t seg);
 void polyc__hash_remove(polyc__opt *o, int32_t seg);
 void polyc__hash_clear(polyc__opt *o);
 int32_t polyc__bucket_of(const polyc__hash *h, float x, float y);
+/* the column and row of the bucket holding (x, y), clamped to the hash */
+static inline void polyc__bucket_xy(const polyc__hash *h, float x, float y, int32_t *ix, int32_t *iy)
+{
+    float fx = (x - h->origin_x) * h->inv_bucket, fy = (y - h->origin_y) * h->inv_bucket;
+    *ix = fx < 0.0f ? 0 : (fx >= (float)h->bx ? h->bx - 1 : (int32_t)fx);
+    *iy = fy < 0.0f ? 0 : (fy >= (float)h->by ? h->by - 1 : (int32_t)fy);
+}
 /* calls fn for every bucket within one bucket of the segment a-b */
 typedef void (*polyc__bucket_fn)(polyc__opt *o, int32_t bucket);
 void polyc__segment_buckets(polyc__opt *o, float ax, float ay, float bx, float by, int dilate,

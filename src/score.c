@@ -54,8 +54,8 @@ static double nearest_below(const polyc__opt *o, int32_t pi, const int32_t *skip
     const polyc__point *p = &o->pts[pi];
     double best = start, w = (double)p->w;
     int32_t best_seg = POLYC__NONE;
-    int32_t b = polyc__bucket_of(h, p->x, p->y);
-    int32_t bx = b % h->bx, by = b / h->bx;
+    int32_t bx, by;
+    polyc__bucket_xy(h, p->x, p->y, &bx, &by);
     /* distances to the bucket's four sides (0 if outside that side) */
     double fx = ((double)p->x - (double)h->origin_x) - (double)bx * (double)h->bucket_m;
     double fy = ((double)p->y - (double)h->origin_y) - (double)by * (double)h->bucket_m;
@@ -66,12 +66,20 @@ static double nearest_below(const polyc__opt *o, int32_t pi, const int32_t *skip
     side[1][0] = fy > 0.0 ? fy : 0.0;
     side[1][1] = 0.0;
     side[1][2] = (double)h->bucket_m - fy > 0.0 ? (double)h->bucket_m - fy : 0.0;
+    double near = side[0][0];
+    for (int k = 1; k < 4; k++) {
+        double g = side[k >> 1][k & 1 ? 2 : 0];
+        near = g < near ? g : near;
+    }
     for (int k = 0; k < 9; k++) {
+        /* the own bucket done: no neighbour is nearer than its nearest side */
+        if (k == 1 && w * near * near >= best)
+            break;
+        double sx = side[0][ORDER[k][0] + 1], sy = side[1][ORDER[k][1] + 1];
+        if (w * (sx * sx + sy * sy) >= best)
+            continue;
         int32_t x = bx + ORDER[k][0], y = by + ORDER[k][1];
         if (x < 0 || x >= h->bx || y < 0 || y >= h->by)
-            continue;
-        double gx = side[0][ORDER[k][0] + 1], gy = side[1][ORDER[k][1] + 1];
-        if (w * (gx * gx + gy * gy) >= best)
             continue;
         for (int32_t e = h->seg_head[y * h->bx + x]; e != POLYC__NONE; e = h->entries[e].next) {
             int32_t sg = h->entries[e].seg;

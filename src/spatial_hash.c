@@ -78,9 +78,8 @@ static int32_t clampi(int32_t v, int32_t hi)
 
 int32_t polyc__bucket_of(const polyc__hash *h, float x, float y)
 {
-    float fx = (x - h->origin_x) * h->inv_bucket, fy = (y - h->origin_y) * h->inv_bucket;
-    int32_t ix = fx < 0.0f ? 0 : (fx >= (float)h->bx ? h->bx - 1 : (int32_t)fx);
-    int32_t iy = fy < 0.0f ? 0 : (fy >= (float)h->by ? h->by - 1 : (int32_t)fy);
+    int32_t ix, iy;
+    polyc__bucket_xy(h, x, y, &ix, &iy);
     return iy * h->bx + ix;
 }
 
