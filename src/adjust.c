@@ -13,7 +13,7 @@ static const float DIR_Y[8] = {0.0f, 0.70710678f, 1.0f, 0.70710678f, 0.0f, -0.70
 static float turn_of(float ax, float ay, float bx, float by, float cx, float cy)
 {
     float ux = bx - ax, uy = by - ay, wx = cx - bx, wy = cy - by;
-    return atan2f(fabsf(ux * wy - uy * wx), ux * wx + uy * wy);
+    return polyc__turn_rad(ux * wy - uy * wx, ux * wx + uy * wy);
 }
 
 /* 1 - p(turn at b) for the path a -> b -> c */

@@ -242,7 +242,7 @@ static void emit(prior_pass *q, const fit_line *l)
     if (q->have_last && q->last.b == l->a) {
         float dot = q->last.dx * l->dx + q->last.dy * l->dy;
         float cr = q->last.dx * l->dy - q->last.dy * l->dx;
-        float turn = atan2f(fabsf(cr), dot);
+        float turn = polyc__turn_rad(cr, dot);
         int bin = (int)(turn * BINS_PER_RAD + 0.5f);
         if (bin > BINS - 1)
             bin = BINS - 1;

@@ -239,6 +239,25 @@ static inline int polyc__cell_index(int32_t ix, int32_t iy)
 {
     return ((iy & (POLYC__TILE_SIDE - 1)) << POLYC__TILE_SHIFT) | (ix & (POLYC__TILE_SIDE - 1));
 }
+/* The angle between two directions in [0, pi] from their cross and dot
+ * products, as atan2f(|cross|, dot) to within 2e-6 rad. Ours, not libm's:
+ * it is about three times faster where the optimiser prices every trial
+ * move's turns, and plain float arithmetic gives the same result with every
+ * libm (the build does not contract it into fused multiply-adds). */
+static inline float polyc__turn_rad(float cross, float dot)
+{
+    float ax = dot < 0.0f ? -dot : dot, ay = cross < 0.0f ? -cross : cross;
+    float hi = ax > ay ? ax : ay, lo = ax > ay ? ay : ax;
+    if (!(hi > 0.0f))
+        return 0.0f; /* a zero-length side; NaN, too, counts as straight */
+    float t = lo / hi, t2 = t * t;
+    float r = t * (0.99997726f +
+                   t2 * (-0.33262347f + t2 * (0.19354346f + t2 * (-0.11643287f +
+                                                                 t2 * (0.05265332f + t2 * -0.01172120f)))));
+    if (ay > ax)
+        r = 1.57079633f - r;
+    return dot < 0.0f ? 3.14159265f - r : r;
+}
 /* m > threshold, evaluated without division: hits > t * (hits + misses) */
 int polyc__cell_occupied(const polyc__tile *t, int idx, float threshold);
 /* beam geometry shared by the grid and contour passes */
