@@ -480,8 +480,12 @@ static void smoothed(const polyc__prior *p, int32_t cx, int32_t cy, const int *b
             uint32_t w = (uint32_t)(4 >> ((i != 0) + (j != 0)));
             size_t cell = (size_t)iy * (size_t)p->w + (size_t)ix;
             const uint16_t *h = p->hist + cell * BINS;
-            for (int k = 0; k < nb; k++)
-                cnt[bins[k]] += w * h[bins[k]];
+            if (nb == BINS) /* all bins, in order: a loop the compiler vectorises */
+                for (int b = 0; b < BINS; b++)
+                    cnt[b] += w * h[b];
+            else
+                for (int k = 0; k < nb; k++)
+                    cnt[bins[k]] += w * h[bins[k]];
             *n += w * tot[cell];
         }
     }
