@@ -27,6 +27,7 @@ size_t polyc__optimizer_bytes(const polyc_config *cfg, const polyc_limits *lim)
     n = polyc__add(n, polyc__bytes(P, sizeof(double)));           /* loc_base */
     n = polyc__add(n, polyc__bytes(P, sizeof(int32_t)));          /* loc_seg */
     n = polyc__add(n, polyc__bytes(P, sizeof(int32_t)));          /* agg_pt */
+    n = polyc__add(n, polyc__bytes(POLYC__CAND_MAX, sizeof(int32_t) + 4 * sizeof(float))); /* cand */
     n = polyc__add(n, polyc__bytes(P + V, sizeof(float)));        /* split_t */
     n = polyc__add(n, polyc__bytes(V, sizeof(float)));            /* trim_head */
     n = polyc__add(n, polyc__bytes(V + 1, sizeof(int32_t)));      /* split_off */
@@ -74,6 +75,8 @@ polyc_status polyc__opt_setup(polyc_ctx *ctx, polyc__opt *o)
     ALLOC(o->loc_base, P);
     ALLOC(o->loc_seg, P);
     ALLOC(o->agg_pt, P);
+    ALLOC(o->cand_seg, POLYC__CAND_MAX);
+    ALLOC(o->cand_box, 4 * POLYC__CAND_MAX);
     o->agg_cap = P;
     ALLOC(o->split_t, P > V ? P : V);
     ALLOC(o->trim_head, V);

@@ -74,6 +74,11 @@ typedef struct polyc__opt {
      * xy, yy), so that a trial costs O(1) for them: listed in agg_pt, those
      * of segment 0 from the front (agg_n[0]), of segment 1 from the back */
     int32_t *agg_pt, agg_cap, agg_n[2];
+    /* the segments (other than the old ones) near the prepared region, for
+     * the points whose own segment goes: cand_n < 0 not gathered yet,
+     * POLYC__CAND_MAX + 1 too many (then the hash is queried) */
+    int32_t *cand_seg, cand_n;
+    float *cand_box;               /* per candidate: min x, min y, max x, max y */
     int agg_on;                    /* 0: no aggregation prepared */
     int agg_moving_b[2];           /* the moving end is the segment's b */
     double agg_ax[2], agg_ay[2], agg_m[2][3];
@@ -99,6 +104,8 @@ typedef struct polyc__opt {
     polyc__flat best;
     double noise_m;
 } polyc__opt;
+
+#define POLYC__CAND_MAX 48
 
 /* optimize.c: carves the state from the arena after the trace, scores it */
 polyc_status polyc__opt_setup(polyc_ctx *ctx, polyc__opt *o);

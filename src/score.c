@@ -320,6 +320,76 @@ static double stay_bound(const polyc__point *p, double ax, double ay, double cx,
     return lo > 0.0 && worst < w * lo * lo ? worst : 0.0;
 }
 
+#define QUERIES_BEFORE_GATHER 3
+
+/* The segments other than `old` in the buckets within one of the first
+ * region_n listed ones: every segment a nearest query from a point of those
+ * buckets could meet (it looks at the 3 x 3 buckets around the point). */
+static void gather_candidates(polyc__opt *o, const int32_t *old, int n_old, int32_t region_n)
+{
+    const polyc__hash *h = &o->h;
+    /* a new epoch: the region's bucket marks are not needed any more, and
+     * seg_dead (compared with the epoch of a change, which starts a new one)
+     * marks the segments met */
+    uint32_t stamp = ++o->epoch;
+    o->cand_n = 0;
+    for (int j = 0; j < n_old; j++)
+        if (old[j] != POLYC__NONE)
+            o->seg_dead[old[j]] = stamp;
+    for (int32_t k = 0; k < region_n; k++) {
+        int32_t b = o->bucket_list[k], bx = b % h->bx, by = b / h->bx;
+        for (int32_t y = by - 1; y <= by + 1; y++)
+            for (int32_t x = bx - 1; x <= bx + 1; x++) {
+                if (x < 0 || y < 0 || x >= h->bx || y >= h->by || o->bucket_mark[y * h->bx + x] == stamp)
+                    continue;
+                o->bucket_mark[y * h->bx + x] = stamp;
+                for (int32_t e = h->seg_head[y * h->bx + x]; e != POLYC__NONE; e = h->entries[e].next) {
+                    int32_t sg = h->entries[e].seg;
+                    if (o->seg_dead[sg] == stamp)
+                        continue;
+                    o->seg_dead[sg] = stamp;
+                    if (o->cand_n == POLYC__CAND_MAX) {
+                        o->cand_n = POLYC__CAND_MAX + 1;
+                        return;
+                    }
+                    const polyc__vertex *a = &o->s->v[sg], *c = &o->s->v[a->next];
+                    float *box = o->cand_box + 4 * o->cand_n;
+                    box[0] = fminf(a->x, c->x);
+                    box[1] = fminf(a->y, c->y);
+                    box[2] = fmaxf(a->x, c->x);
+                    box[3] = fmaxf(a->y, c->y);
+                    o->cand_seg[o->cand_n++] = sg;
+                }
+            }
+    }
+}
+
+/* nearest_below over the gathered candidates: the same segments it would
+ * look at, and a box test instead of the bucket walk. */
+static double nearest_candidate(const polyc__opt *o, int32_t pi, double start, int32_t *seg)
+{
+    const polyc__point *p = &o->pts[pi];
+    double best = start, w = (double)p->w;
+    int32_t best_seg = POLYC__NONE;
+    for (int32_t k = 0; k < o->cand_n; k++) {
+        const float *box = o->cand_box + 4 * k;
+        /* distance to the box, in float: only a bound (rounded down a little) */
+        float gx = box[0] - p->x > p->x - box[2] ? box[0] - p->x : p->x - box[2];
+        float gy = box[1] - p->y > p->y - box[3] ? box[1] - p->y : p->y - box[3];
+        gx = gx > 0.0f ? gx : 0.0f;
+        gy = gy > 0.0f ? gy : 0.0f;
+        if (w * (double)(0.999f * (gx * gx + gy * gy)) >= best)
+            continue;
+        double c = polyc__cost_seg(o, p, o->cand_seg[k]);
+        if (c < best) {
+            best = c;
+            best_seg = o->cand_seg[k];
+        }
+    }
+    *seg = best_seg;
+    return best;
+}
+
 /* Collects the points near the `old` segments and the candidate geometry,
  * with their cost when the old segments are gone (loc_base, loc_seg). With
  * reach > 0 the candidates stay within `reach` of seg_xy: a point not on an
@@ -342,6 +412,8 @@ static void prepare(polyc__opt *o, const int32_t *old, int n_old, const float *s
         const float *q = seg_xy + 4 * k;
         polyc__segment_buckets(o, q[0], q[1], q[2], q[3], 1, list_bucket);
     }
+    int32_t region_n = o->bucket_n, queries = 0;
+    o->cand_n = -1;
     o->loc_n = 0;
     o->loc_fixed = 0.0;
     o->loc_fixed_cur = 0.0;
@@ -394,9 +466,14 @@ static void prepare(polyc__opt *o, const int32_t *old, int n_old, const float *s
             if (hit) {
                 /* without the old segments: a query within the bound is
                  * enough to tell that the point stays (most do) */
-                double cap = cap_of(o, p);
-                base = nearest_below(o, (int32_t)i, old, n_old, bound > 0.0 && bound < cap ? bound : cap,
-                                     &base_seg);
+                double cap = cap_of(o, p), start = bound > 0.0 && bound < cap ? bound : cap;
+                /* the first queries walk the hash; from the QUERIES_BEFORE_GATHER-th on
+                 * the region's candidates pay for gathering them */
+                if (o->cand_n < 0 && ++queries >= QUERIES_BEFORE_GATHER)
+                    gather_candidates(o, old, n_old, region_n);
+                base = o->cand_n >= 0 && o->cand_n <= POLYC__CAND_MAX
+                           ? nearest_candidate(o, (int32_t)i, start, &base_seg)
+                           : nearest_below(o, (int32_t)i, old, n_old, start, &base_seg);
                 if (base_seg != POLYC__NONE)
                     bound = 0.0;
                 else if (bound > 0.0 && bound < cap)
