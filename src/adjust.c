@@ -170,7 +170,8 @@ int polyc__hill_climb(polyc__opt *o, int32_t v)
          * it without trying the other seven */
         for (int k = 0; k < 9; k++) {
             int d = k == 0 ? last : k - 1;
-            if (d < 0 || (k > 0 && d == last))
+            /* nor back where the last step came from: it cost more */
+            if (d < 0 || (k > 0 && (d == last || (last >= 0 && d == (last + 4) % 8))))
                 continue;
             float cx = x + step * DIR_X[d], cy = y + step * DIR_Y[d];
             if ((cx - x0) * (cx - x0) + (cy - y0) * (cy - y0) > reach * reach)
