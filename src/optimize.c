@@ -128,8 +128,6 @@ static int32_t live_lines(const polyc__store *s)
     return s->l_live;
 }
 
-/* After a failure mid-search the store holds the best map so far (at worst
- * the traced one), which polyc_optimize then publishes with the status. */
 /* Whether any vertex was edited since the stamp `start`: every edit goes
  * through polyc__chg_dirty or a committed move, and both stamp v_touch. */
 static int edited_since(const polyc__opt *o, uint32_t start)
@@ -140,6 +138,8 @@ static int edited_since(const polyc__opt *o, uint32_t start)
     return 0;
 }
 
+/* After a failure mid-search the store holds the best map so far (at worst
+ * the traced one), which polyc_optimize then publishes with the status. */
 static polyc_status restore_best(polyc__opt *o, polyc_status st)
 {
     if (polyc__store_from_flat(o->s, &o->best) != POLYC_OK)

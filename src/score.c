@@ -373,12 +373,14 @@ static double nearest_candidate(const polyc__opt *o, int32_t pi, double start, i
     int32_t best_seg = POLYC__NONE;
     for (int32_t k = 0; k < o->cand_n; k++) {
         const float *box = o->cand_box + 4 * k;
-        /* distance to the box, in float: only a bound (rounded down a little) */
-        float gx = box[0] - p->x > p->x - box[2] ? box[0] - p->x : p->x - box[2];
-        float gy = box[1] - p->y > p->y - box[3] ? box[1] - p->y : p->y - box[3];
-        gx = gx > 0.0f ? gx : 0.0f;
-        gy = gy > 0.0f ? gy : 0.0f;
-        if (w * (double)(0.999f * (gx * gx + gy * gy)) >= best)
+        /* distance to the box, a lower bound of the segment's: differences
+         * of floats are exact in double, so the bound is never too high */
+        double px = (double)p->x, py = (double)p->y;
+        double gx = (double)box[0] - px > px - (double)box[2] ? (double)box[0] - px : px - (double)box[2];
+        double gy = (double)box[1] - py > py - (double)box[3] ? (double)box[1] - py : py - (double)box[3];
+        gx = gx > 0.0 ? gx : 0.0;
+        gy = gy > 0.0 ? gy : 0.0;
+        if (0.999 * w * (gx * gx + gy * gy) >= best)
             continue;
         double c = polyc__cost_seg(o, p, o->cand_seg[k]);
         if (c < best) {
