@@ -80,9 +80,21 @@ static size_t cell_cap(const polyc_limits *lim)
 
 #define CELL_BYTES (BINS * sizeof(uint16_t) + sizeof(uint32_t))
 
+/* The split-and-merge visits each endpoint several times: a scan of up to
+ * this many beams has its endpoints computed once, into a scratch block that
+ * is released after learning (a longer scan computes them on every visit,
+ * with the same result). */
+#define CACHE_BEAMS 1081u
+
+static uint32_t cache_beams(const polyc_limits *lim)
+{
+    return lim->max_beams < CACHE_BEAMS ? lim->max_beams : CACHE_BEAMS;
+}
+
 size_t polyc__prior_bytes(const polyc_limits *lim)
 {
-    return polyc__bytes(cell_cap(lim), CELL_BYTES);
+    return polyc__add(polyc__bytes(cell_cap(lim), CELL_BYTES),
+                      polyc__bytes(cache_beams(lim), 3 * sizeof(float)));
 }
 
 /* per-cell totals, stored after the counters */
@@ -106,6 +118,9 @@ typedef struct prior_pass {
     const polyc_ctx *ctx;
     const polyc__scan *s;
     float ox, oy;                  /* prior origin (frame metres) */
+    float *cache;                  /* x, y, range per beam of the scan, or NULL */
+    uint32_t cache_cap;
+    int cached;                    /* the cache holds this scan */
     fit_line last, pend;           /* last emitted line, line pending a merge */
     int have_last, have_pend;
 } prior_pass;
@@ -118,6 +133,13 @@ static int is_hit(const polyc__scan *s, float r)
 /* endpoint of beam i of the scan (frame metres), the beam angle as grid.c has it */
 static void endpoint(const prior_pass *q, uint32_t i, float *x, float *y, float *r)
 {
+    if (q->cached) {
+        const float *c = q->cache + 3 * (size_t)i;
+        *x = c[0];
+        *y = c[1];
+        *r = c[2];
+        return;
+    }
     const polyc__scan *s = q->s;
     float rr = q->ctx->ranges[s->first + i];
     float a = s->theta_rad + s->start_rad + (float)i * s->step_rad;
@@ -339,6 +361,12 @@ static void learn_scan(prior_pass *q)
     uint32_t start = 0;
     int open = 0;
     float px = 0.0f, py = 0.0f, pr = 0.0f;
+    q->cached = 0;
+    if (q->cache && s->count <= q->cache_cap) {
+        for (uint32_t i = 0; i < s->count; i++)
+            endpoint(q, i, &q->cache[3 * i], &q->cache[3 * i + 1], &q->cache[3 * i + 2]);
+        q->cached = 1;
+    }
     for (uint32_t i = 0; i < s->count; i++) {
         if (!is_hit(s, rr[i])) {
             if (open)
@@ -399,10 +427,14 @@ polyc_status polyc__prior_build(polyc_ctx *ctx, polyc__prior *p)
     q.ctx = ctx;
     q.ox = (float)p->origin_x;
     q.oy = (float)p->origin_y;
+    size_t mark = ctx->arena.used;
+    q.cache_cap = cache_beams(&ctx->lim);
+    q.cache = polyc__alloc(&ctx->arena, q.cache_cap, 3 * sizeof(float));
     for (uint32_t si = 0; si < ctx->scan_count; si++) {
         q.s = &ctx->scans[si];
         learn_scan(&q);
     }
+    ctx->arena.used = mark;
 
     uint32_t *tot = totals(p);
     for (size_t c = 0; c < cells; c++) {

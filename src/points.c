@@ -17,7 +17,7 @@ typedef struct endpoint {
 static int endpoint_of(const polyc_ctx *ctx, const polyc__scan *s, uint32_t i, endpoint *e)
 {
     polyc__beam b;
-    if (!polyc__beam_get(ctx, s, i, &b) || !b.hit)
+    if (!polyc__beam_path(ctx, s, i, &b) || !b.hit)
         return 0;
     float fx = floorf(b.ex), fy = floorf(b.ey);
     e->ix = (int32_t)fx;

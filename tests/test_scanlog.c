@@ -143,6 +143,41 @@ static void test_flaser_fields(void **state)
     scanlog_free(&log);
 }
 
+/* Numbers the parser reads without strtod must be the very doubles strtod
+ * gives: fixed cases at the fast path's edges, then pseudo-random decimals. */
+static void expect_pose_x(const char *number)
+{
+    char text[160];
+    snprintf(text, sizeof text, "FLASER 3 1 2 3 %s 0 0 0 0 0 0 h 0\n", number);
+    scanlog log;
+    if (parse(&log, text) != 0)
+        fail_msg("'%s': %s", number, log.error);
+    double want = strtod(number, NULL);
+    if (memcmp(&log.scans[0].pose_x_m, &want, sizeof want) != 0)
+        fail_msg("'%s' read as %.17g, strtod gives %.17g", number, log.scans[0].pose_x_m, want);
+    scanlog_free(&log);
+}
+
+static void test_numbers_as_strtod(void **state)
+{
+    (void)state;
+    static const char *const fixed[] = {
+        "0", "-0", "5.", ".5", "-.5", "0.1", "-17.3073", "00000.1250", "81.83",
+        "123456.789012345", "123456.7890123456", "900719.9254740993", "0.000000000000001",
+        "0.0000000000000001", "1.0000000000000000", "99999.99999999999", "1e3", "+2.5",
+        "-0.000", "3.141592653589793"};
+    for (size_t i = 0; i < sizeof fixed / sizeof fixed[0]; i++)
+        expect_pose_x(fixed[i]);
+    uint64_t state64 = 12345;
+    for (int i = 0; i < 2000; i++) {
+        state64 = state64 * 6364136223846793005ull + 1442695040888963407ull;
+        double v = (double)(state64 >> 11) / 9007199254740992.0 * 2000.0 - 1000.0;
+        char number[64];
+        snprintf(number, sizeof number, "%.*f", (int)(state64 >> 60) % 14, v);
+        expect_pose_x(number);
+    }
+}
+
 static void test_noreturn_sick(void **state)
 {
     (void)state;
@@ -484,6 +519,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_flaser_angles),
         cmocka_unit_test(test_flaser_fields),
+        cmocka_unit_test(test_numbers_as_strtod),
         cmocka_unit_test(test_noreturn_sick),
         cmocka_unit_test(test_noreturn_two_codes),
         cmocka_unit_test(test_noreturn_none),

@@ -298,6 +298,39 @@ static uint64_t count_fields(const char *p)
     return n;
 }
 
+/* Plain decimals ([-]digits[.digits], at most 15 significant digits, as
+ * laser logs write ranges) without strtod: the digits make an integer below
+ * 2^53 and 10^k is exact, so one division gives the correctly rounded value,
+ * the same double strtod returns. Anything else returns 0 for strtod. */
+static int plain_decimal(const char *s, size_t len, double *out)
+{
+    static const double pow10[] = {1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7,
+                                   1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15};
+    size_t i = s[0] == '-';
+    uint64_t m = 0;
+    int digits = 0, frac = -1;
+    for (; i < len; i++) {
+        char c = s[i];
+        if (c >= '0' && c <= '9') {
+            m = m * 10u + (uint64_t)(c - '0');
+            if (m != 0 && ++digits > 15)
+                return 0;
+            if (frac >= 0)
+                frac++;
+        } else if (c == '.' && frac < 0) {
+            frac = 0;
+        } else {
+            return 0;
+        }
+    }
+    /* at least one digit, and a digit on one side of the point */
+    if (len == (size_t)(s[0] == '-') + (frac >= 0) || frac > 15)
+        return 0;
+    double v = (double)m / pow10[frac > 0 ? frac : 0];
+    *out = s[0] == '-' ? -v : v;
+    return 1;
+}
+
 /* A number with nothing after it; NaN and inf are numbers here (callers
  * decide). Fails on missing, non-numeric or over-long fields. */
 static int take_double(reader *r, fields *fs, const char *what, double *out)
@@ -307,6 +340,8 @@ static int take_double(reader *r, fields *fs, const char *what, double *out)
         return fail(r, "missing %s (field %u)", what, fs->index + 1);
     size_t len = strlen(s);
     char *end = NULL;
+    if (len <= MAX_NUMBER_CHARS && plain_decimal(s, len, out))
+        return 0;
     if (len <= MAX_NUMBER_CHARS)
         *out = strtod(s, &end);
     if (len > MAX_NUMBER_CHARS || end != s + len) {
