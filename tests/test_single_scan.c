@@ -52,6 +52,21 @@ static void corridor(scansim_scene *sc)
     assert_int_equal(scansim_add_pose(sc, 0.0, 0.8, 0.0), 0);
 }
 
+/* Thin posts (2 cm, 6 cm apart) 60 cm in front of a 0.5-degree scanner, a
+ * wall 5 m behind them: at that range a grid cell spans almost three beams,
+ * and most beams pass between the posts to the wall. */
+static void posts(scansim_scene *sc)
+{
+    scansim_scene_init(sc, "posts", 11u);
+    sc->laser.beam_count = 361u;
+    sc->laser.angle_step_rad = (float)(PI / 360.0);
+    const double wall[4] = {-6.0, 5.6, 6.0, 5.6};
+    assert_int_equal(scansim_add_wall(sc, wall, 2, 0), 0);
+    for (int k = 0; k < 8; k++)
+        assert_int_equal(scansim_add_box(sc, -0.25 + 0.06 * k, 0.6, -0.23 + 0.06 * k, 0.62), 0);
+    assert_int_equal(scansim_add_pose(sc, 0.0, 0.0, PI / 2.0), 0);
+}
+
 static void build(one_map *m, const polyc_config *config)
 {
     polyc_limits lim;
@@ -142,6 +157,25 @@ static void test_chains_follow_the_beams(void **state)
     assert_true(m.worst_short_m > -0.05);
     assert_int_equal(m.stats.contour_cells, 0);
     assert_true(m.stats.polylines >= 2); /* the box apart from the room */
+    done(&m);
+}
+
+/* Near returns do not stop the beams beside them: a chain's end, or a lone
+ * return's segment, reaches half a beam spacing past its return, never a
+ * neighbouring beam (it reached half a cell: at 60 cm, over two beams). */
+static void test_near_returns_leave_gaps(void **state)
+{
+    (void)state;
+    one_map m;
+    scene_map(&m, posts, 0, 0);
+    assert_true(m.score.f >= 0.99);
+    assert_true(m.worst_short_m > -0.05);
+    assert_true(m.score.ray_rmse_m <= 0.02);
+    done(&m);
+    scene_map(&m, posts, UINT32_MAX, 0);
+    assert_true(m.score.f >= 0.95);
+    assert_true(m.worst_short_m > -POLYC__RAY_TOLERANCE_M - 0.03);
+    assert_true(m.score.ray_rmse_m <= 0.04);
     done(&m);
 }
 
@@ -254,6 +288,7 @@ int main(void)
         cmocka_unit_test(test_blocks_beams),
         cmocka_unit_test(test_chains_follow_the_beams),
         cmocka_unit_test(test_grazing_wall_is_one_chain),
+        cmocka_unit_test(test_near_returns_leave_gaps),
         cmocka_unit_test(test_optimised_room),
         cmocka_unit_test(test_optimised_corridor),
         cmocka_unit_test(test_grid_trace_flag),
