@@ -69,6 +69,8 @@ double polyc__removal_delta_below(polyc__opt *o, int32_t v, double bound)
         dangle = 0.0;
     } else if (p == POLYC__NONE || n == POLYC__NONE) {
         int32_t nb = p == POLYC__NONE ? n : p;
+        if (o->rays.on && polyc__holds_returns(&o->rays, V[v].x, V[v].y, V[nb].x, V[nb].y))
+            return INFINITY; /* a single scan's end return stays on the map */
         old[n_old++] = p == POLYC__NONE ? v : p;
         dk = -1.0;
         dangle = -o->acost[nb]; /* the neighbour becomes an end: no angle */

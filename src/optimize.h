@@ -190,10 +190,12 @@ double polyc__removal_delta_below(polyc__opt *o, int32_t v, double bound);
 /* ray_check.c: single-scan mode (rays.on) only, else every answer is 0.
  * blocks_beams: segment a-b stands in front of a return, or behind one of
  * its own, by more than the tolerance; vertex_blocks: v at (x, y) makes one
- * of its segments do so */
+ * of its segments do so; holds_returns: some beam meets a-b within the
+ * tolerance of its return (the map would lose that return without it) */
 void polyc__rays_init(polyc__rays *rays, const polyc_ctx *ctx);
 int polyc__blocks_beams(const polyc__rays *rays, float ax, float ay, float bx, float by);
 int polyc__vertex_blocks(const polyc__opt *o, int32_t v, float x, float y);
+int polyc__holds_returns(const polyc__rays *rays, float ax, float ay, float bx, float by);
 float polyc__ray_position(const polyc__rays *rays, float ax, float ay, float bx, float by,
                           float px, float py, float projection);
 int polyc__op_add_vertices(polyc__opt *o, int max_tries);

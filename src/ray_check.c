@@ -105,7 +105,36 @@ static int beam_blocked(const polyc__rays *rays, int32_t i, float ax, float ay, 
     return 0;
 }
 
-int polyc__blocks_beams(const polyc__rays *rays, float ax, float ay, float bx, float by)
+/* Beam i meets segment a-b within the tolerance of its return, at no more
+ * than HOLD_RANGE_M and at least HOLD_SIN (15 degrees) to the segment: a
+ * return the segment holds. Farther or flatter beams are poor witnesses:
+ * measured on 10 scans of each real log, holding those too raised acapulco's
+ * ray RMSE from 115 to 188 mm and freiburg-campus's from 45 to 243 mm (ends
+ * kept decimetres off along beams 25-40 m long), for 10-15 % more vertices. */
+#define HOLD_RANGE_M 10.0f
+#define HOLD_SIN 0.26
+
+static int beam_own(const polyc__rays *rays, int32_t i, float ax, float ay, float bx, float by)
+{
+    float r = rays->range[i];
+    if (!(r >= rays->min_m && r < rays->max_m) || r > HOLD_RANGE_M)
+        return 0;
+    double a = rays->base + (double)i * rays->step;
+    double c = cos(a), sn = sin(a);
+    double t = range_to(rays, c, sn, ax, ay, bx, by);
+    if (!(fabs(t - (double)r) <= rays->tol_m))
+        return 0;
+    double ex = (double)bx - (double)ax, ey = (double)by - (double)ay;
+    double cr = c * ey - sn * ex; /* |segment| sin(incidence) */
+    return cr * cr >= HOLD_SIN * HOLD_SIN * (ex * ex + ey * ey);
+}
+
+typedef int (*beam_test)(const polyc__rays *rays, int32_t i, float ax, float ay, float bx,
+                         float by);
+
+/* Whether `test` holds for some beam whose direction crosses segment a-b. */
+static int any_beam(const polyc__rays *rays, float ax, float ay, float bx, float by,
+                    beam_test test)
 {
     if (!rays->on || rays->step == 0.0)
         return 0;
@@ -122,8 +151,18 @@ int polyc__blocks_beams(const polyc__rays *rays, float ax, float ay, float bx, f
         double from = fmax(ceil(lo), (double)offsets[k]);
         double to = fmin(hi, (double)offsets[k] + (double)rays->count - 1.0);
         for (double q = from; q <= to; q += 1.0)
-            if (beam_blocked(rays, (int32_t)q - offsets[k], ax, ay, bx, by))
+            if (test(rays, (int32_t)q - offsets[k], ax, ay, bx, by))
                 return 1;
     }
     return 0;
+}
+
+int polyc__blocks_beams(const polyc__rays *rays, float ax, float ay, float bx, float by)
+{
+    return any_beam(rays, ax, ay, bx, by, beam_blocked);
+}
+
+int polyc__holds_returns(const polyc__rays *rays, float ax, float ay, float bx, float by)
+{
+    return any_beam(rays, ax, ay, bx, by, beam_own);
 }

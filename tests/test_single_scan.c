@@ -282,10 +282,53 @@ static void test_blocks_beams(void **state)
     assert_false(polyc__blocks_beams(&r, 1.0f, -0.2f, 1.0f, 0.2f));
 }
 
+/* Which segments hold a return (an end segment that does may not go). */
+static void test_holds_returns(void **state)
+{
+    (void)state;
+    float range[360];
+    for (int i = 0; i < 360; i++)
+        range[i] = 2.0f;
+    range[5] = 50.0f;  /* no return */
+    range[90] = 12.0f; /* beyond the range where a return is held */
+    polyc__rays r;
+    memset(&r, 0, sizeof r);
+    r.on = 1;
+    r.step = 2.0 * PI / 360.0;
+    r.count = 360;
+    r.turn = 360;
+    r.range = range;
+    r.min_m = 0.1f;
+    r.max_m = 30.0f;
+    r.tol_m = POLYC__RAY_TOLERANCE_M;
+    r.own_m = 0.15;
+    /* across the beams at their returns, or within the tolerance */
+    assert_true(polyc__holds_returns(&r, 2.0f, -0.05f, 2.0f, 0.05f));
+    assert_true(polyc__holds_returns(&r, 2.08f, -0.05f, 2.08f, 0.05f));
+    /* in front of them or behind them: not theirs */
+    assert_false(polyc__holds_returns(&r, 1.5f, -0.05f, 1.5f, 0.05f));
+    assert_false(polyc__holds_returns(&r, 2.5f, -0.05f, 2.5f, 0.05f));
+    /* along a beam (grazing): no witness */
+    assert_false(polyc__holds_returns(&r, 1.95f, 0.0f, 2.05f, 0.0001f));
+    /* a no-return beam, and a return beyond 10 m, hold nothing */
+    float a = (float)(5.0 * r.step), e = (float)(90.0 * r.step);
+    assert_false(polyc__holds_returns(&r, 2.0f * cosf(a) - 0.005f * sinf(a),
+                                      2.0f * sinf(a) + 0.005f * cosf(a),
+                                      2.0f * cosf(a) + 0.005f * sinf(a),
+                                      2.0f * sinf(a) - 0.005f * cosf(a)));
+    assert_false(polyc__holds_returns(&r, 12.0f * cosf(e) - 0.05f * sinf(e),
+                                      12.0f * sinf(e) + 0.05f * cosf(e),
+                                      12.0f * cosf(e) + 0.05f * sinf(e),
+                                      12.0f * sinf(e) - 0.05f * cosf(e)));
+    r.on = 0;
+    assert_false(polyc__holds_returns(&r, 2.0f, -0.05f, 2.0f, 0.05f));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_blocks_beams),
+        cmocka_unit_test(test_holds_returns),
         cmocka_unit_test(test_chains_follow_the_beams),
         cmocka_unit_test(test_grazing_wall_is_one_chain),
         cmocka_unit_test(test_near_returns_leave_gaps),
