@@ -221,6 +221,61 @@ static void test_single_scan(void **state)
     gtscore_index_free(&map);
 }
 
+/* The line-fit floor: endpoints on a wall seen from one side, offset by a
+ * known line (1 cm at one end, 3 cm at the other), give that line's RMS
+ * over the stretches they cover; endpoints on the wall give 0; a wall seen
+ * by too few endpoints gives none. */
+static void test_line_floor(void **state)
+{
+    (void)state;
+    gtscore_truth t;
+    truth_from_text(&t, "ideal 2\nwall open 0 2 4 2\n");
+    /* a sensor at (2, 0) looking up; beam i ends on y = 2 - off(x) */
+    enum { N = 181 };
+    float range[N];
+    polyc_scan scan;
+    memset(&scan, 0, sizeof scan);
+    scan.pose_x_m = 2.0;
+    scan.start_angle_rad = (float)(0.25 * 3.14159265358979);
+    scan.angle_step_rad = (float)(0.5 * 3.14159265358979 / (N - 1));
+    scan.min_range_m = 0.02f;
+    scan.max_range_m = 8.0f;
+    scan.beam_count = N;
+    scan.range_m = range;
+    for (int pass = 0; pass < 2; pass++) {
+        for (int i = 0; i < N; i++) {
+            double a = (double)scan.start_angle_rad + i * (double)scan.angle_step_rad;
+            /* off(x) = a0 + a1 x: solve (2 - off(x)) = r sin a, x = 2 + r cos a */
+            double a0 = pass ? 0.01 : 0.0, a1 = pass ? 0.005 : 0.0;
+            double r = (2.0 - a0 - a1 * 2.0) / (sin(a) + a1 * cos(a));
+            range[i] = (float)r;
+        }
+        double floor_m = -2.0;
+        assert_int_equal(gtscore_line_floor(&t, &scan, 1, &floor_m), 0);
+        if (pass == 0) {
+            assert_near(floor_m, 0.0, 1e-6);
+            continue;
+        }
+        /* the beams cover x in [0, 4] (45 to 135 degrees): the RMS of
+         * 0.01 + 0.005 x over 2 cm stretches of [0, 4] */
+        double sum = 0.0;
+        int n = 0;
+        for (int b = 0; b < 200; b++) {
+            double x = (b + 0.5) * 0.02, e = 0.01 + 0.005 * x;
+            sum += e * e;
+            n++;
+        }
+        /* beams 1 degree apart leave some 2 cm stretches without an
+         * endpoint near the ends: a few percent either way */
+        assert_near(floor_m, sqrt(sum / n), 0.001);
+    }
+    scan.beam_count = 10; /* 10 endpoints: too few for a fit */
+    double none = 0.0;
+    assert_int_equal(gtscore_line_floor(&t, &scan, 1, &none), 0);
+    assert_true(none < 0.0);
+    gtscore_truth_free(&t);
+}
+
 /* The grid index against brute force on random segments, points (some far
  * outside the grid) and rays. */
 static void test_index_vs_brute_force(void **state)
@@ -319,6 +374,7 @@ int main(void)
         cmocka_unit_test(test_percentile_and_far),
         cmocka_unit_test(test_single_scan),
         cmocka_unit_test(test_index_vs_brute_force),
+        cmocka_unit_test(test_line_floor),
         cmocka_unit_test(test_reader_errors),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

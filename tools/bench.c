@@ -48,7 +48,9 @@ static const char usage_text[] =
     "grid, contour, trace, optimise, output = JSON to /dev/null); block and used\n"
     "= the context's memory block and its high-water mark; rss = peak resident\n"
     "size of the process so far. Accuracy (shared/data/README.md): sim scenes\n"
-    "precision RMS / p95 in mm, completeness, vertices / ideal; real logs the\n"
+    "precision RMS / p95 in mm, the line-fit floor (the precision straight lines\n"
+    "fitted to each seen wall side's endpoints would score, tools/gtfloor.c),\n"
+    "completeness, vertices / ideal; real logs the\n"
     "share of scan endpoints within 5 cm of the map (end5).\n"
     "Exit: 0 ok; 1 a scene failed (its row says why); 2 usage error, or\n"
     "DATA_DIR missing: 'bench: data directory DIR not found (pass DATA=path)'.\n";
@@ -337,20 +339,21 @@ static void print_header(const options *o)
            polyc_version() / 100u % 100u, polyc_version() % 100u, o->runs,
            o->runs == 1 ? "" : "s", o->data);
     printf("%-24s %6s %8s | %7s %6s %7s %7s %7s %8s %6s %8s | %7s %7s %7s | %6s %7s %6s "
-           "%5s | %6s %6s %6s %6s\n",
+           "%5s | %6s %6s %6s %6s %6s\n",
            "scene", "scans", "beams", "parse", "add", "grid", "contour", "trace", "optimise",
            "output", "total", "blockMB", "usedMB", "rssMB", "lines", "verts", "ideal", "x",
-           "rms", "p95", "compl", "end5");
+           "rms", "p95", "floor", "compl", "end5");
     printf("%-24s %6s %8s | %7s %6s %7s %7s %7s %8s %6s %8s | %7s %7s %7s | %6s %7s %6s "
-           "%5s | %6s %6s %6s %6s\n",
+           "%5s | %6s %6s %6s %6s %6s\n",
            "", "", "", "ms", "ms", "ms", "ms", "ms", "ms", "ms", "ms", "", "", "", "", "", "",
-           "", "mm", "mm", "", "");
+           "", "mm", "mm", "mm", "", "");
 }
 
 typedef struct row_accuracy {
     int has_truth;
     gtscore_map_score score;
     double end5;               /* < 0: not computed */
+    double floor_m;            /* line-fit floor (sim scenes), < 0: none */
     uint32_t lines, vertices;
 } row_accuracy;
 
@@ -360,6 +363,7 @@ static void accuracy(const scene *s, const scanlog *log, const polyc_polyline *l
     uint32_t i;
     memset(acc, 0, sizeof *acc);
     acc->end5 = -1.0;
+    acc->floor_m = -1.0;
     acc->lines = count;
     for (i = 0; i < count; i++)
         acc->vertices += lines[i].point_count;
@@ -367,9 +371,11 @@ static void accuracy(const scene *s, const scanlog *log, const polyc_polyline *l
         gtscore_truth truth;
         char err[512];
         if (gtscore_truth_load(&truth, s->gt_path, err, sizeof err) == 0 &&
-            gtscore_score_map(&truth, lines, count, &acc->score) == 0)
+            gtscore_score_map(&truth, lines, count, &acc->score) == 0) {
             acc->has_truth = 1;
-        else
+            if (gtscore_line_floor(&truth, log->scans, log->count, &acc->floor_m) != 0)
+                acc->floor_m = -1.0;
+        } else
             fprintf(stderr, "bench: %s: no score: %s\n", s->name, err);
         gtscore_truth_free(&truth);
     } else {
@@ -447,14 +453,18 @@ static int bench_scene(const options *o, const scene *s)
            med[ST_GRID], med[ST_CONTOUR], med[ST_TRACE], med[ST_OPT], med[ST_OUT],
            med[ST_TOTAL], mb(stats.memory_size_bytes), mb(stats.memory_used_bytes),
            peak_rss_mb(), acc.lines, acc.vertices);
-    if (acc.has_truth)
-        printf("%6u %5.2f | %6.1f %6.1f %6.4f %6s\n", acc.score.ideal, acc.score.vertex_ratio,
-               1e3 * acc.score.precision_rms_m, 1e3 * acc.score.precision_p95_m,
-               acc.score.completeness, "-");
-    else if (acc.end5 >= 0.0)
-        printf("%6s %5s | %6s %6s %6s %6.4f\n", "-", "-", "-", "-", "-", acc.end5);
-    else
-        printf("%6s %5s | %6s %6s %6s %6s\n", "-", "-", "-", "-", "-", "-");
+    if (acc.has_truth) {
+        char floor_mm[16] = "-";
+        if (acc.floor_m >= 0.0)
+            snprintf(floor_mm, sizeof floor_mm, "%.1f", 1e3 * acc.floor_m);
+        printf("%6u %5.2f | %6.1f %6.1f %6s %6.4f %6s\n", acc.score.ideal,
+               acc.score.vertex_ratio, 1e3 * acc.score.precision_rms_m,
+               1e3 * acc.score.precision_p95_m, floor_mm, acc.score.completeness, "-");
+    } else if (acc.end5 >= 0.0) {
+        printf("%6s %5s | %6s %6s %6s %6s %6.4f\n", "-", "-", "-", "-", "-", "-", acc.end5);
+    } else {
+        printf("%6s %5s | %6s %6s %6s %6s %6s\n", "-", "-", "-", "-", "-", "-", "-");
+    }
     fflush(stdout);
     free(lines);
     pipeline_close(&p);

@@ -146,6 +146,14 @@ void gtscore_endpoints_within(const gtscore_index *map, const polyc_scan *scans,
                               uint32_t scan_count, double d_m, uint64_t *within,
                               uint64_t *total);
 
+/* The line-fit floor of a simulated scene (tools/gtfloor.c): the precision
+ * RMS that straight lines fitted by least squares to each seen side of
+ * each true wall segment would score, given these scans; *floor_m < 0 if no
+ * side holds enough endpoints (the circles' 720-gons: 1 cm to 6 cm sides).
+ * Returns -1 when out of memory. */
+int gtscore_line_floor(const gtscore_truth *truth, const polyc_scan *scans, uint32_t scan_count,
+                       double *floor_m);
+
 /* True if the beam is reflected (see the definition above). */
 int gtscore_beam_reflected(const polyc_scan *scan, uint32_t beam);
 
