@@ -237,25 +237,32 @@ static void test_grid_trace_flag(void **state)
 }
 
 /* polyc__blocks_beams on hand cases: a scan whose every return is at 2 m. */
+/* A full turn of 360 beams from the origin, every return at 2 m but for
+ * what the caller changes in `range`. */
+static void full_turn(polyc__rays *r, float *range)
+{
+    for (int i = 0; i < 360; i++)
+        range[i] = 2.0f;
+    memset(r, 0, sizeof *r);
+    r->on = 1;
+    r->base = 0.0;
+    r->step = 2.0 * PI / 360.0;
+    r->count = 360;
+    r->turn = 360;
+    r->range = range;
+    r->min_m = 0.1f;
+    r->max_m = 30.0f;
+    r->tol_m = POLYC__RAY_TOLERANCE_M;
+    r->own_m = 0.15;
+}
+
 static void test_blocks_beams(void **state)
 {
     (void)state;
     float range[360];
-    for (int i = 0; i < 360; i++)
-        range[i] = 2.0f;
-    range[10] = 50.0f; /* no return (>= max) */
     polyc__rays r;
-    memset(&r, 0, sizeof r);
-    r.on = 1;
-    r.base = 0.0;
-    r.step = 2.0 * PI / 360.0;
-    r.count = 360;
-    r.turn = 360;
-    r.range = range;
-    r.min_m = 0.1f;
-    r.max_m = 30.0f;
-    r.tol_m = POLYC__RAY_TOLERANCE_M;
-    r.own_m = 0.15;
+    full_turn(&r, range);
+    range[10] = 50.0f; /* no return (>= max) */
     /* in front of the returns: blocks */
     assert_true(polyc__blocks_beams(&r, 1.0f, -0.2f, 1.0f, 0.2f));
     /* on them, or within the tolerance: fine */
@@ -287,21 +294,10 @@ static void test_holds_returns(void **state)
 {
     (void)state;
     float range[360];
-    for (int i = 0; i < 360; i++)
-        range[i] = 2.0f;
+    polyc__rays r;
+    full_turn(&r, range);
     range[5] = 50.0f;  /* no return */
     range[90] = 12.0f; /* beyond the range where a return is held */
-    polyc__rays r;
-    memset(&r, 0, sizeof r);
-    r.on = 1;
-    r.step = 2.0 * PI / 360.0;
-    r.count = 360;
-    r.turn = 360;
-    r.range = range;
-    r.min_m = 0.1f;
-    r.max_m = 30.0f;
-    r.tol_m = POLYC__RAY_TOLERANCE_M;
-    r.own_m = 0.15;
     /* across the beams at their returns, or within the tolerance */
     assert_true(polyc__holds_returns(&r, 2.0f, -0.05f, 2.0f, 0.05f));
     assert_true(polyc__holds_returns(&r, 2.08f, -0.05f, 2.08f, 0.05f));
