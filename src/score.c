@@ -22,10 +22,15 @@ double polyc__cost(const polyc__point *p, float ax, float ay, float bx, float by
         double ex = (double)p->x - (double)bx, ey = (double)p->y - (double)by;
         return (double)p->w * (ex * ex + ey * ey) + trace;
     }
-    /* w (n.m)^2 + n'Cn with n = (-dy, dx) / |d|: one division, no root */
+    /* w (n.m)^2 + n'Cn with n = (-dy, dx) / |d|: one division, no root.
+     * C, central moments summed in float, can be a rounding error short of
+     * positive semi-definite (cxy^2 > cxx cyy): n'Cn then dips below 0 for
+     * a point whose endpoints lie on a line, and a map's error could be
+     * -1e-12 (found by fuzz_library). A sum of squares is never negative. */
     double cross = dx * my - dy * mx;
-    return ((double)p->w * cross * cross + dy * dy * (double)p->cxx -
-            2.0 * dx * dy * (double)p->cxy + dx * dx * (double)p->cyy) / l2;
+    double c = ((double)p->w * cross * cross + dy * dy * (double)p->cxx -
+                2.0 * dx * dy * (double)p->cxy + dx * dx * (double)p->cyy) / l2;
+    return c > 0.0 ? c : 0.0;
 }
 
 double polyc__cost_seg(const polyc__opt *o, const polyc__point *p, int32_t seg)
@@ -279,8 +284,10 @@ static double seg_cost(const seg_pre *q, const polyc__point *p)
         return (double)p->w * (ex * ex + ey * ey) + ((double)p->cxx + (double)p->cyy);
     }
     double d = q->nx * mx + q->ny * my;
-    return (double)p->w * d * d + (q->nx * q->nx * (double)p->cxx +
-                                   2.0 * q->nx * q->ny * (double)p->cxy + q->ny * q->ny * (double)p->cyy);
+    double c = (double)p->w * d * d + (q->nx * q->nx * (double)p->cxx +
+                                       2.0 * q->nx * q->ny * (double)p->cxy +
+                                       q->ny * q->ny * (double)p->cyy);
+    return c > 0.0 ? c : 0.0; /* as polyc__cost */
 }
 
 static double point_seg_dist(const polyc__point *p, const float *xy)
