@@ -153,19 +153,11 @@ polyc_status polyc__rebuild(polyc__opt *o)
 
 /* ---- recording a change ---- */
 
-static void list_bucket(polyc__opt *o, int32_t b)
-{
-    if (o->bucket_mark[b] == o->epoch)
-        return;
-    o->bucket_mark[b] = o->epoch;
-    o->bucket_list[o->bucket_n++] = b;
-}
-
 static void mark_segment_region(polyc__opt *o, int32_t seg)
 {
     const polyc__vertex *a = &o->s->v[seg];
     const polyc__vertex *b = &o->s->v[a->next];
-    polyc__segment_buckets(o, a->x, a->y, b->x, b->y, 1, list_bucket);
+    polyc__segment_region(o, a->x, a->y, b->x, b->y);
 }
 
 void polyc__chg_begin(polyc__opt *o)
@@ -419,7 +411,7 @@ static void prepare(polyc__opt *o, const int32_t *old, int n_old, const float *s
      * moves stay within the buckets' margin */
     for (int k = 0; k < n_new && !move; k++) {
         const float *q = seg_xy + 4 * k;
-        polyc__segment_buckets(o, q[0], q[1], q[2], q[3], 1, list_bucket);
+        polyc__segment_region(o, q[0], q[1], q[2], q[3]);
     }
     int32_t region_n = o->bucket_n, queries = 0;
     o->cand_n = -1;
@@ -609,7 +601,7 @@ double polyc__local_delta(polyc__opt *o, const int32_t *old, int n_old, const fl
             mark_segment_region(o, old[k]);
     for (int k = 0; k < n_new; k++) {
         const float *s = seg_xy + 4 * k;
-        polyc__segment_buckets(o, s[0], s[1], s[2], s[3], 1, list_bucket);
+        polyc__segment_region(o, s[0], s[1], s[2], s[3]);
     }
     double sure = 0.0; /* exact part so far; pending points add >= 0 each */
     int32_t n = 0;

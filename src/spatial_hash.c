@@ -5,6 +5,7 @@
  * wide as the search radius, every segment within reach of a point passes
  * through the 3 x 3 buckets around it. */
 #include "optimize.h"
+#include "walk.h"
 
 #include <math.h>
 #include <string.h>
@@ -83,31 +84,6 @@ int32_t polyc__bucket_of(const polyc__hash *h, float x, float y)
     return iy * h->bx + ix;
 }
 
-typedef struct walk_ctx {
-    polyc__opt *o;
-    polyc__bucket_fn fn;
-    int dilate;
-} walk_ctx;
-
-static int visit_bucket(void *u, int32_t ix, int32_t iy, float t_enter, int last)
-{
-    (void)t_enter;
-    (void)last;
-    walk_ctx *w = u;
-    const polyc__hash *h = &w->o->h;
-    if (!w->dilate) {
-        w->fn(w->o, clampi(iy, h->by - 1) * h->bx + clampi(ix, h->bx - 1));
-        return 0;
-    }
-    for (int32_t dy = -1; dy <= 1; dy++)
-        for (int32_t dx = -1; dx <= 1; dx++) {
-            int32_t x = ix + dx, y = iy + dy;
-            if (x >= 0 && y >= 0 && x < h->bx && y < h->by)
-                w->fn(w->o, y * h->bx + x);
-        }
-    return 0;
-}
-
 /* Clips segment (ax, ay)-(bx, by), in bucket units, to [0, w] x [0, h]
  * (Liang-Barsky); 0 if nothing is left. Parts outside the area are farther
  * than its margin from every data point, so they matter to no query. */
@@ -138,22 +114,90 @@ static int clip(float *ax, float *ay, float *bx, float *by, float w, float h)
     return 1;
 }
 
+/* The segment's path in bucket units, clipped to the hash; 0 if it misses. */
+static int bucket_path(const polyc__hash *h, float ax, float ay, float bx, float by, polyc__beam *b)
+{
+    float wx = (float)h->bx - 0.001f, wy = (float)h->by - 0.001f;
+    b->sx = (ax - h->origin_x) * h->inv_bucket;
+    b->sy = (ay - h->origin_y) * h->inv_bucket;
+    b->ex = (bx - h->origin_x) * h->inv_bucket;
+    b->ey = (by - h->origin_y) * h->inv_bucket;
+    if (!clip(&b->sx, &b->sy, &b->ex, &b->ey, wx, wy))
+        return 0;
+    b->hit = 1;
+    b->miss_end = 1.0f;
+    return 1;
+}
+
+/* The walk of polyc__traverse, inline: the buckets the path crosses, in
+ * order, the end bucket last. */
+typedef struct path_walk {
+    polyc__walk w;
+    int done;
+} path_walk;
+
+static int path_next(path_walk *p, int32_t *ix, int32_t *iy)
+{
+    if (p->done)
+        return 0;
+    if (p->w.n <= 0) {
+        *ix = p->w.ex;
+        *iy = p->w.ey;
+        p->done = 1;
+        return 1;
+    }
+    *ix = p->w.ix;
+    *iy = p->w.iy;
+    polyc__walk_step(&p->w);
+    return 1;
+}
+
 void polyc__segment_buckets(polyc__opt *o, float ax, float ay, float bx, float by, int dilate,
                             polyc__bucket_fn fn)
 {
     const polyc__hash *h = &o->h;
-    float wx = (float)h->bx - 0.001f, wy = (float)h->by - 0.001f;
     polyc__beam b;
-    b.sx = (ax - h->origin_x) * h->inv_bucket;
-    b.sy = (ay - h->origin_y) * h->inv_bucket;
-    b.ex = (bx - h->origin_x) * h->inv_bucket;
-    b.ey = (by - h->origin_y) * h->inv_bucket;
-    if (!clip(&b.sx, &b.sy, &b.ex, &b.ey, wx, wy))
+    if (!bucket_path(h, ax, ay, bx, by, &b))
         return;
-    b.hit = 1;
-    b.miss_end = 1.0f;
-    walk_ctx w = {o, fn, dilate};
-    polyc__traverse(&b, visit_bucket, &w);
+    path_walk p = {.done = 0};
+    polyc__walk_start(&p.w, &b);
+    int32_t ix, iy;
+    while (path_next(&p, &ix, &iy)) {
+        if (!dilate) {
+            fn(o, clampi(iy, h->by - 1) * h->bx + clampi(ix, h->bx - 1));
+            continue;
+        }
+        for (int32_t dy = -1; dy <= 1; dy++)
+            for (int32_t dx = -1; dx <= 1; dx++) {
+                int32_t x = ix + dx, y = iy + dy;
+                if (x >= 0 && y >= 0 && x < h->bx && y < h->by)
+                    fn(o, y * h->bx + x);
+            }
+    }
+}
+
+void polyc__segment_region(polyc__opt *o, float ax, float ay, float bx, float by)
+{
+    const polyc__hash *h = &o->h;
+    polyc__beam b;
+    if (!bucket_path(h, ax, ay, bx, by, &b))
+        return;
+    path_walk p = {.done = 0};
+    polyc__walk_start(&p.w, &b);
+    const uint32_t epoch = o->epoch;
+    int32_t ix, iy;
+    while (path_next(&p, &ix, &iy))
+        for (int32_t y = iy - 1; y <= iy + 1; y++) {
+            if (y < 0 || y >= h->by)
+                continue;
+            for (int32_t x = ix - 1; x <= ix + 1; x++) {
+                int32_t k = y * h->bx + x;
+                if (x < 0 || x >= h->bx || o->bucket_mark[k] == epoch)
+                    continue;
+                o->bucket_mark[k] = epoch;
+                o->bucket_list[o->bucket_n++] = k;
+            }
+        }
 }
 
 /* The bucket callbacks get the segment id through o->cur_seg. */
