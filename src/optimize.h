@@ -18,6 +18,7 @@ typedef struct polyc__heap_entry {
 typedef struct polyc__rays {
     int on;                        /* the map comes from a single scan */
     double x, y, base, step;       /* origin, direction of beam 0, step */
+    double step_cos, step_sin;     /* cos and sin of step */
     const float *range;
     float min_m, max_m;
     int32_t count, turn;           /* beams, beams per full turn */

@@ -23,6 +23,8 @@ void polyc__rays_init(polyc__rays *rays, const polyc_ctx *ctx)
     rays->y = s->y_m;
     rays->base = (double)s->theta_rad + (double)s->start_rad;
     rays->step = (double)s->step_rad;
+    rays->step_cos = cos(rays->step);
+    rays->step_sin = sin(rays->step);
     rays->count = (int32_t)s->count;
     rays->range = &ctx->ranges[s->first];
     rays->min_m = s->min_m;
@@ -82,13 +84,12 @@ int polyc__vertex_blocks(const polyc__opt *o, int32_t v, float x, float y)
 
 /* Beam i against segment a-b: 1 if the segment stands in front of its
  * return, or behind it while the return is near enough to be its own. */
-static int beam_blocked(const polyc__rays *rays, int32_t i, float ax, float ay, float bx, float by)
+static int beam_blocked(const polyc__rays *rays, int32_t i, double c, double sn, float ax,
+                        float ay, float bx, float by)
 {
     float r = rays->range[i];
     if (!(r >= rays->min_m && r < rays->max_m))
         return 0; /* no return: it proves nothing about a wall */
-    double a = rays->base + (double)i * rays->step;
-    double c = cos(a), sn = sin(a);
     double t = range_to(rays, c, sn, ax, ay, bx, by);
     if (t < (double)r - rays->tol_m)
         return 1;
@@ -114,13 +115,12 @@ static int beam_blocked(const polyc__rays *rays, int32_t i, float ax, float ay, 
 #define HOLD_RANGE_M 10.0f
 #define HOLD_SIN 0.26
 
-static int beam_own(const polyc__rays *rays, int32_t i, float ax, float ay, float bx, float by)
+static int beam_own(const polyc__rays *rays, int32_t i, double c, double sn, float ax, float ay,
+                    float bx, float by)
 {
     float r = rays->range[i];
     if (!(r >= rays->min_m && r < rays->max_m) || r > HOLD_RANGE_M)
         return 0;
-    double a = rays->base + (double)i * rays->step;
-    double c = cos(a), sn = sin(a);
     double t = range_to(rays, c, sn, ax, ay, bx, by);
     if (!(fabs(t - (double)r) <= rays->tol_m))
         return 0;
@@ -129,10 +129,13 @@ static int beam_own(const polyc__rays *rays, int32_t i, float ax, float ay, floa
     return cr * cr >= HOLD_SIN * HOLD_SIN * (ex * ex + ey * ey);
 }
 
-typedef int (*beam_test)(const polyc__rays *rays, int32_t i, float ax, float ay, float bx,
-                         float by);
+/* A test of beam i, whose direction is (c, sn), against segment a-b. */
+typedef int (*beam_test)(const polyc__rays *rays, int32_t i, double c, double sn, float ax,
+                         float ay, float bx, float by);
 
-/* Whether `test` holds for some beam whose direction crosses segment a-b. */
+/* Whether `test` holds for some beam whose direction crosses segment a-b.
+ * The directions of a run of beams come from rotating the first by the
+ * step: one cosine and sine per run, not per beam. */
 static int any_beam(const polyc__rays *rays, float ax, float ay, float bx, float by,
                     beam_test test)
 {
@@ -150,9 +153,17 @@ static int any_beam(const polyc__rays *rays, float ax, float ay, float bx, float
     for (int k = 0; k < (rays->turn > 0 ? 3 : 1); k++) {
         double from = fmax(ceil(lo), (double)offsets[k]);
         double to = fmin(hi, (double)offsets[k] + (double)rays->count - 1.0);
-        for (double q = from; q <= to; q += 1.0)
-            if (test(rays, (int32_t)q - offsets[k], ax, ay, bx, by))
+        if (!(from <= to))
+            continue;
+        double a = rays->base + (from - (double)offsets[k]) * rays->step;
+        double c = cos(a), sn = sin(a);
+        for (double q = from; q <= to; q += 1.0) {
+            if (test(rays, (int32_t)q - offsets[k], c, sn, ax, ay, bx, by))
                 return 1;
+            double next_c = c * rays->step_cos - sn * rays->step_sin;
+            sn = sn * rays->step_cos + c * rays->step_sin;
+            c = next_c;
+        }
     }
     return 0;
 }

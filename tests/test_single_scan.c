@@ -247,6 +247,8 @@ static void full_turn(polyc__rays *r, float *range)
     r->on = 1;
     r->base = 0.0;
     r->step = 2.0 * PI / 360.0;
+    r->step_cos = cos(r->step);
+    r->step_sin = sin(r->step);
     r->count = 360;
     r->turn = 360;
     r->range = range;
@@ -283,6 +285,8 @@ static void test_blocks_beams(void **state)
     r.base = -0.5 * PI;
     r.count = 181;
     r.step = PI / 180.0;
+    r.step_cos = cos(r.step);
+    r.step_sin = sin(r.step);
     assert_false(polyc__blocks_beams(&r, -1.0f, 0.1f, -1.0f, -0.1f));
     assert_true(polyc__blocks_beams(&r, 1.0f, -0.2f, 1.0f, 0.2f));
     r.on = 0;
