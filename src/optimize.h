@@ -130,10 +130,9 @@ static inline void polyc__bucket_xy(const polyc__hash *h, float x, float y, int3
     *ix = fx < 0.0f ? 0 : (fx >= (float)h->bx ? h->bx - 1 : (int32_t)fx);
     *iy = fy < 0.0f ? 0 : (fy >= (float)h->by ? h->by - 1 : (int32_t)fy);
 }
-/* calls fn for every bucket the segment a-b crosses (dilate: and every
- * bucket next to one) */
+/* calls fn for every bucket the segment a-b crosses */
 typedef void (*polyc__bucket_fn)(polyc__opt *o, int32_t bucket);
-void polyc__segment_buckets(polyc__opt *o, float ax, float ay, float bx, float by, int dilate,
+void polyc__segment_buckets(polyc__opt *o, float ax, float ay, float bx, float by,
                             polyc__bucket_fn fn);
 /* lists in o->bucket_list, once per epoch (o->bucket_mark), every bucket
  * within one bucket of the segment a-b: those whose points it can reach */

@@ -114,27 +114,30 @@ static int clip(float *ax, float *ay, float *bx, float *by, float w, float h)
     return 1;
 }
 
-/* The segment's path in bucket units, clipped to the hash; 0 if it misses. */
-static int bucket_path(const polyc__hash *h, float ax, float ay, float bx, float by, polyc__beam *b)
-{
-    float wx = (float)h->bx - 0.001f, wy = (float)h->by - 0.001f;
-    b->sx = (ax - h->origin_x) * h->inv_bucket;
-    b->sy = (ay - h->origin_y) * h->inv_bucket;
-    b->ex = (bx - h->origin_x) * h->inv_bucket;
-    b->ey = (by - h->origin_y) * h->inv_bucket;
-    if (!clip(&b->sx, &b->sy, &b->ex, &b->ey, wx, wy))
-        return 0;
-    b->hit = 1;
-    b->miss_end = 1.0f;
-    return 1;
-}
-
-/* The walk of polyc__traverse, inline: the buckets the path crosses, in
- * order, the end bucket last. */
+/* The walk of polyc__traverse, inline, over the buckets the segment's path
+ * crosses (clipped to the hash), in order, the end bucket last. */
 typedef struct path_walk {
     polyc__walk w;
     int done;
 } path_walk;
+
+/* 0 if the path misses the hash. */
+static int path_begin(const polyc__hash *h, float ax, float ay, float bx, float by, path_walk *p)
+{
+    float wx = (float)h->bx - 0.001f, wy = (float)h->by - 0.001f;
+    polyc__beam b;
+    b.sx = (ax - h->origin_x) * h->inv_bucket;
+    b.sy = (ay - h->origin_y) * h->inv_bucket;
+    b.ex = (bx - h->origin_x) * h->inv_bucket;
+    b.ey = (by - h->origin_y) * h->inv_bucket;
+    if (!clip(&b.sx, &b.sy, &b.ex, &b.ey, wx, wy))
+        return 0;
+    b.hit = 1;
+    b.miss_end = 1.0f;
+    polyc__walk_start(&p->w, &b);
+    p->done = 0;
+    return 1;
+}
 
 static int path_next(path_walk *p, int32_t *ix, int32_t *iy)
 {
@@ -152,40 +155,26 @@ static int path_next(path_walk *p, int32_t *ix, int32_t *iy)
     return 1;
 }
 
-void polyc__segment_buckets(polyc__opt *o, float ax, float ay, float bx, float by, int dilate,
+void polyc__segment_buckets(polyc__opt *o, float ax, float ay, float bx, float by,
                             polyc__bucket_fn fn)
 {
     const polyc__hash *h = &o->h;
-    polyc__beam b;
-    if (!bucket_path(h, ax, ay, bx, by, &b))
-        return;
-    path_walk p = {.done = 0};
-    polyc__walk_start(&p.w, &b);
+    path_walk p;
     int32_t ix, iy;
-    while (path_next(&p, &ix, &iy)) {
-        if (!dilate) {
-            fn(o, clampi(iy, h->by - 1) * h->bx + clampi(ix, h->bx - 1));
-            continue;
-        }
-        for (int32_t dy = -1; dy <= 1; dy++)
-            for (int32_t dx = -1; dx <= 1; dx++) {
-                int32_t x = ix + dx, y = iy + dy;
-                if (x >= 0 && y >= 0 && x < h->bx && y < h->by)
-                    fn(o, y * h->bx + x);
-            }
-    }
+    if (!path_begin(h, ax, ay, bx, by, &p))
+        return;
+    while (path_next(&p, &ix, &iy))
+        fn(o, clampi(iy, h->by - 1) * h->bx + clampi(ix, h->bx - 1));
 }
 
 void polyc__segment_region(polyc__opt *o, float ax, float ay, float bx, float by)
 {
     const polyc__hash *h = &o->h;
-    polyc__beam b;
-    if (!bucket_path(h, ax, ay, bx, by, &b))
-        return;
-    path_walk p = {.done = 0};
-    polyc__walk_start(&p.w, &b);
     const uint32_t epoch = o->epoch;
+    path_walk p;
     int32_t ix, iy;
+    if (!path_begin(h, ax, ay, bx, by, &p))
+        return;
     while (path_next(&p, &ix, &iy))
         for (int32_t y = iy - 1; y <= iy + 1; y++) {
             if (y < 0 || y >= h->by)
@@ -238,7 +227,7 @@ int polyc__hash_insert(polyc__opt *o, int32_t seg)
     const polyc__vertex *a = &o->s->v[seg];
     const polyc__vertex *b = &o->s->v[a->next];
     o->cur_seg = seg;
-    polyc__segment_buckets(o, a->x, a->y, b->x, b->y, 0, insert_in_bucket);
+    polyc__segment_buckets(o, a->x, a->y, b->x, b->y, insert_in_bucket);
     o->seg_in[seg] = 1;
     return !o->h.out_of_entries;
 }
@@ -248,6 +237,6 @@ void polyc__hash_remove(polyc__opt *o, int32_t seg)
     const polyc__vertex *a = &o->s->v[seg];
     const polyc__vertex *b = &o->s->v[a->next];
     o->cur_seg = seg;
-    polyc__segment_buckets(o, a->x, a->y, b->x, b->y, 0, remove_from_bucket);
+    polyc__segment_buckets(o, a->x, a->y, b->x, b->y, remove_from_bucket);
     o->seg_in[seg] = 0;
 }

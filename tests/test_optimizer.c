@@ -354,7 +354,7 @@ static void check_store(const polyc__opt *o, const char *where)
                  s->v_live, s->l_live);
 }
 
-/* buckets visited by polyc__segment_buckets (undilated), with multiplicity */
+/* buckets visited by polyc__segment_buckets, with multiplicity */
 #define MAX_WALK 4096
 static int32_t g_walk[MAX_WALK];
 static int g_walk_n;
@@ -401,7 +401,7 @@ static void check_hash(polyc__opt *o, const char *where)
             fail_msg("%s: live segment %d not marked in the hash", where, v);
         const polyc__vertex *a = &o->s->v[v], *c = &o->s->v[a->next];
         g_walk_n = 0;
-        polyc__segment_buckets(o, a->x, a->y, c->x, c->y, 0, collect_bucket);
+        polyc__segment_buckets(o, a->x, a->y, c->x, c->y, collect_bucket);
         expect += g_walk_n;
         for (int k = 0; k < g_walk_n; k++) {
             int visits = 0;
