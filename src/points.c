@@ -132,7 +132,7 @@ static polyc_status collect_cells(polyc__opt *o, polyc__point *tmp, int32_t cap,
         int32_t tx = (d % g->tiles_x) << POLYC__TILE_SHIFT, ty = (d / g->tiles_x) << POLYC__TILE_SHIFT;
         uint32_t k = t->mark_base;
         for (int r = 0; r < POLYC__TILE_SIDE; r++)
-            for (int c = 0; c < POLYC__TILE_SIDE; c++) {
+            for (int c = 0; t->mark[r] != 0 && c < POLYC__TILE_SIDE; c++) { /* most rows: none */
                 if (!((t->mark[r] >> c) & 1u))
                     continue;
                 polyc__point *p = &tmp[k++];
