@@ -337,12 +337,15 @@ static void gather_candidates(polyc__opt *o, const int32_t *old, int n_old, int3
             o->seg_dead[old[j]] = stamp;
     for (int32_t k = 0; k < region_n; k++) {
         int32_t b = o->bucket_list[k], bx = b % h->bx, by = b / h->bx;
-        for (int32_t y = by - 1; y <= by + 1; y++)
-            for (int32_t x = bx - 1; x <= bx + 1; x++) {
-                if (x < 0 || y < 0 || x >= h->bx || y >= h->by || o->bucket_mark[y * h->bx + x] == stamp)
+        int32_t x0 = bx > 0 ? bx - 1 : 0, x1 = bx + 1 < h->bx ? bx + 1 : h->bx - 1;
+        int32_t y0 = by > 0 ? by - 1 : 0, y1 = by + 1 < h->by ? by + 1 : h->by - 1;
+        for (int32_t y = y0; y <= y1; y++)
+            for (int32_t x = x0; x <= x1; x++) {
+                int32_t nb = y * h->bx + x;
+                if (o->bucket_mark[nb] == stamp)
                     continue;
-                o->bucket_mark[y * h->bx + x] = stamp;
-                for (int32_t e = h->seg_head[y * h->bx + x]; e != POLYC__NONE; e = h->entries[e].next) {
+                o->bucket_mark[nb] = stamp;
+                for (int32_t e = h->seg_head[nb]; e != POLYC__NONE; e = h->entries[e].next) {
                     int32_t sg = h->entries[e].seg;
                     if (o->seg_dead[sg] == stamp)
                         continue;
