@@ -234,6 +234,17 @@ static void count_beam(const count_pass *p, const polyc__beam *b)
     if (w.n > 0 && (!polyc__walk_enter(&w, g->width, g->height) || !(t = tile_get(p, w.ix, w.iy))))
         return;
     while (w.n > 0) {
+        if (t == p->spill) {
+            /* nothing is counted here: only the walk to the tile's edge */
+            int left;
+            do
+                left = polyc__walk_step(&w);
+            while (!left && w.n > 0);
+            if (left && w.n > 0 &&
+                (!polyc__walk_enter(&w, g->width, g->height) || !(t = tile_get(p, w.ix, w.iy))))
+                return;
+            continue;
+        }
         if (w.t < miss_end)
             count_inc(&t->misses[w.idx], &t->hits[w.idx]);
         if (polyc__walk_step(&w) && w.n > 0 &&
