@@ -586,7 +586,10 @@ static int make_map(const options *o, run *r, double t_start, mapout_times *t)
             return library_fail("grid", st, ctx, size);
         double t2 = now_ms();
         t->grid_ms = t2 - t1;
-        if ((st = polyc_extract_contour(ctx)) != POLYC_OK)
+        /* one scan's polylines come from its beam order (polyc_build skips
+         * the contour too): it is needed only to trace it or to draw it */
+        int want_contour = r->log.count != 1 || o->grid || (cfg.flags & POLYC_FLAG_GRID_TRACE);
+        if (want_contour && (st = polyc_extract_contour(ctx)) != POLYC_OK)
             return library_fail("contour", st, ctx, size);
         double t3 = now_ms();
         t->contour_ms = t3 - t2;
