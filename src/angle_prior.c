@@ -396,7 +396,44 @@ static void learn_scan(prior_pass *q)
         cluster(q, start, s->count - 1);
 }
 
-polyc_status polyc__prior_build(polyc_ctx *ctx, polyc__prior *p)
+size_t polyc__prior_smooth_bytes(const polyc__prior *p)
+{
+    return polyc__bytes((size_t)p->w * (size_t)p->h, (BINS + 1) * sizeof(uint32_t));
+}
+
+/* Scatters each cell with evidence into the 3 x 3 cells around it, with the
+ * weights smoothed() gathers them with: the same sums of integers. */
+void polyc__prior_smooth(polyc__prior *p, uint32_t *room)
+{
+    const uint32_t *tot = totals(p);
+    size_t cells = (size_t)p->w * (size_t)p->h;
+    memset(room, 0, cells * (BINS + 1) * sizeof(uint32_t));
+    for (int32_t cy = 0; cy < p->h; cy++)
+        for (int32_t cx = 0; cx < p->w; cx++) {
+            size_t c = (size_t)cy * (size_t)p->w + (size_t)cx;
+            if (tot[c] == 0)
+                continue; /* all its bins are 0 too */
+            const uint16_t *h = p->hist + c * BINS;
+            for (int32_t j = -1; j <= 1; j++) {
+                int32_t iy = cy + j;
+                if (iy < 0 || iy >= p->h)
+                    continue;
+                for (int32_t i = -1; i <= 1; i++) {
+                    int32_t ix = cx + i;
+                    if (ix < 0 || ix >= p->w)
+                        continue;
+                    uint32_t w = (uint32_t)(4 >> ((i != 0) + (j != 0)));
+                    uint32_t *t = room + ((size_t)iy * (size_t)p->w + (size_t)ix) * (BINS + 1);
+                    for (int b = 0; b < BINS; b++)
+                        t[b] += w * h[b];
+                    t[BINS] += w * tot[c];
+                }
+            }
+        }
+    p->smooth = room;
+}
+
+polyc_status polyc__prior_build(polyc_ctx *ctx, polyc__prior *p, size_t spare)
 {
     const polyc__grid *g = &ctx->grid;
     memset(p, 0, sizeof *p);
@@ -442,6 +479,16 @@ polyc_status polyc__prior_build(polyc_ctx *ctx, polyc__prior *p)
         for (int b = 0; b < BINS; b++)
             n += p->hist[c * BINS + (size_t)b];
         tot[c] = n;
+    }
+    /* the table only where the block has room beyond the budget: the
+     * library's footprint stays what polyc_memory_size says */
+    size_t table = polyc__prior_smooth_bytes(p);
+    size_t free_bytes = ctx->arena.size - ctx->arena.used;
+    if (table > 0 && free_bytes >= spare && free_bytes - spare >= table) {
+        uint32_t *room = polyc__alloc(&ctx->arena, (size_t)p->w * (size_t)p->h,
+                                      (BINS + 1) * sizeof(uint32_t));
+        if (room)
+            polyc__prior_smooth(p, room);
     }
     return POLYC_OK;
 }
@@ -497,6 +544,13 @@ static float share(const int *b, const float *kw, const uint32_t *cnt, uint32_t 
 static void smoothed(const polyc__prior *p, int32_t cx, int32_t cy, const int *bins, int nb,
                      uint32_t *cnt, uint32_t *n)
 {
+    if (p->smooth && cx >= 0 && cy >= 0 && cx < p->w && cy < p->h) {
+        const uint32_t *t = p->smooth + ((size_t)cy * (size_t)p->w + (size_t)cx) * (BINS + 1);
+        for (int k = 0; k < nb; k++)
+            cnt[bins[k]] = t[bins[k]];
+        *n = t[BINS];
+        return;
+    }
     const uint32_t *tot = totals(p);
     for (int k = 0; k < nb; k++)
         cnt[bins[k]] = 0;

@@ -58,7 +58,10 @@ polyc_status polyc__opt_setup(polyc_ctx *ctx, polyc__opt *o)
     o->rng.state = ctx->cfg.seed;
     int32_t V = o->s->v_cap;
     polyc__rays_init(&o->rays, ctx);
-    polyc_status st = polyc__prior_build(ctx, &o->prior);
+    /* what the optimiser will still take from the block after the prior */
+    size_t later = polyc__add(polyc__spacing_bytes(&ctx->lim),
+                              polyc__optimizer_bytes(&ctx->cfg, &ctx->lim));
+    polyc_status st = polyc__prior_build(ctx, &o->prior, later);
     if (st != POLYC_OK)
         return st;
     if ((st = polyc__spacing_build(ctx, &o->spacing)) != POLYC_OK)

@@ -164,7 +164,7 @@ static void test_room_corners_and_walls(void **state)
     make_ctx(&f, &sc, NULL, NULL);
     polyc_ctx *ctx = f.ctx;
     size_t before = ctx->arena.used;
-    assert_int_equal(polyc__prior_build(ctx, &f.prior), POLYC_OK);
+    assert_int_equal(polyc__prior_build(ctx, &f.prior, SIZE_MAX), POLYC_OK);
     const polyc__prior *p = &f.prior;
 
     /* the tile grid, frame-relative, and within the size query's bound */
@@ -197,6 +197,47 @@ static void test_room_corners_and_walls(void **state)
     free_ctx(&f);
 }
 
+/* The smoothed table (built when the block has room to spare) holds the
+ * sums the queries would make: every value, bit for bit, is the same,
+ * inside the grid, on its border and a cell outside it. */
+static void test_smoothed_table_same_values(void **state)
+{
+    (void)state;
+    static scene sc;
+    room_scene(&sc, 0.01f);
+    fixture f;
+    make_ctx(&f, &sc, NULL, NULL);
+    polyc_ctx *ctx = f.ctx;
+    assert_int_equal(polyc__prior_build(ctx, &f.prior, 0), POLYC_OK);
+    polyc__prior *p = &f.prior;
+    assert_non_null(p->smooth); /* the test block has room */
+    uint32_t *table = p->smooth;
+    size_t checked = 0;
+    for (int32_t cy = -1; cy <= p->h; cy++)
+        for (int32_t cx = -1; cx <= p->w; cx++) {
+            float x = (float)(p->origin_x + ((double)cx + 0.5) * (double)p->cell_m);
+            float y = (float)(p->origin_y + ((double)cy + 0.5) * (double)p->cell_m);
+            for (int a = 0; a <= 180; a += 5) {
+                p->smooth = table;
+                float with = polyc__prior_p(p, x, y, (float)a * DEG);
+                polyc__prior_place at;
+                polyc__prior_at(p, x, y, &at);
+                float with_at = polyc__prior_p_at(&at, (float)a * DEG);
+                p->smooth = NULL;
+                float without = polyc__prior_p(p, x, y, (float)a * DEG);
+                polyc__prior_at(p, x, y, &at);
+                assert_true(with == without);
+                assert_true(with_at == polyc__prior_p_at(&at, (float)a * DEG));
+                checked++;
+            }
+        }
+    assert_true(checked > 100);
+    /* a budget that leaves no room: no table */
+    assert_int_equal(polyc__prior_build(ctx, p, SIZE_MAX), POLYC_OK);
+    assert_null(p->smooth);
+    free_ctx(&f);
+}
+
 static void test_histogram_bins(void **state)
 {
     (void)state;
@@ -204,7 +245,7 @@ static void test_histogram_bins(void **state)
     room_scene(&sc, 0.0f);
     fixture f;
     make_ctx(&f, &sc, NULL, NULL);
-    assert_int_equal(polyc__prior_build(f.ctx, &f.prior), POLYC_OK);
+    assert_int_equal(polyc__prior_build(f.ctx, &f.prior, SIZE_MAX), POLYC_OK);
     const polyc__prior *p = &f.prior;
     /* the cell of the lower-left corner: 90 degree turns in bin 9 only */
     int32_t ix = (int32_t)floor(((double)fx(&f, ROOM.x0) - p->origin_x) / (double)p->cell_m);
@@ -240,7 +281,7 @@ static void test_straight_wall_has_no_corners(void **state)
     }
     fixture f;
     make_ctx(&f, &sc, NULL, NULL);
-    assert_int_equal(polyc__prior_build(f.ctx, &f.prior), POLYC_OK);
+    assert_int_equal(polyc__prior_build(f.ctx, &f.prior, SIZE_MAX), POLYC_OK);
     const polyc__prior *p = &f.prior;
     print_message("wall: corners %u straights %u\n", p->corners, p->straights);
     assert_int_equal(p->corners, 0);
@@ -260,7 +301,7 @@ static void test_empty_context(void **state)
     polyc_limits lim = {4, 1000, 1 << 16, 0, 0};
     make_ctx(&f, NULL, NULL, &lim);
     memset(&f.prior, 0xab, sizeof f.prior);
-    assert_int_equal(polyc__prior_build(f.ctx, &f.prior), POLYC_OK);
+    assert_int_equal(polyc__prior_build(f.ctx, &f.prior, SIZE_MAX), POLYC_OK);
     assert_int_equal(f.prior.w, 0);
     assert_int_equal(f.prior.h, 0);
     assert_null(f.prior.hist);
@@ -283,7 +324,7 @@ static void test_outside_and_bad_arguments(void **state)
     room_scene(&sc, 0.01f);
     fixture f;
     make_ctx(&f, &sc, NULL, NULL);
-    assert_int_equal(polyc__prior_build(f.ctx, &f.prior), POLYC_OK);
+    assert_int_equal(polyc__prior_build(f.ctx, &f.prior, SIZE_MAX), POLYC_OK);
     const polyc__prior *p = &f.prior;
     const float u = 1.0f / (float)POLYC__ANGLE_BINS;
     /* far outside the grid, NaN position: no evidence, uniform */
@@ -314,8 +355,8 @@ static void test_deterministic(void **state)
     fixture a, b;
     make_ctx(&a, &sc, NULL, NULL);
     make_ctx(&b, &sc, NULL, NULL);
-    assert_int_equal(polyc__prior_build(a.ctx, &a.prior), POLYC_OK);
-    assert_int_equal(polyc__prior_build(b.ctx, &b.prior), POLYC_OK);
+    assert_int_equal(polyc__prior_build(a.ctx, &a.prior, SIZE_MAX), POLYC_OK);
+    assert_int_equal(polyc__prior_build(b.ctx, &b.prior, SIZE_MAX), POLYC_OK);
     assert_int_equal(a.prior.w, b.prior.w);
     assert_int_equal(a.prior.h, b.prior.h);
     assert_int_equal(a.prior.corners, b.prior.corners);
@@ -324,7 +365,7 @@ static void test_deterministic(void **state)
     assert_memory_equal(a.prior.hist, b.prior.hist, n);
     /* building again in the same context gives the same prior */
     polyc__prior again;
-    assert_int_equal(polyc__prior_build(a.ctx, &again), POLYC_OK);
+    assert_int_equal(polyc__prior_build(a.ctx, &again, SIZE_MAX), POLYC_OK);
     assert_memory_equal(a.prior.hist, again.hist, n);
     free_ctx(&a);
     free_ctx(&b);
@@ -340,7 +381,7 @@ static void test_out_of_memory(void **state)
     polyc_ctx *ctx = f.ctx;
     size_t size = ctx->arena.size;
     ctx->arena.size = ctx->arena.used + 64; /* room for almost nothing */
-    assert_int_equal(polyc__prior_build(ctx, &f.prior), POLYC_ERR_NOMEM);
+    assert_int_equal(polyc__prior_build(ctx, &f.prior, SIZE_MAX), POLYC_ERR_NOMEM);
     assert_int_equal(f.prior.w, 0);
     assert_null(f.prior.hist);
     assert_string_equal(polyc_last_error(ctx), "no room for the angle prior");
@@ -348,7 +389,7 @@ static void test_out_of_memory(void **state)
     assert_float_equal(polyc__prior_p(&f.prior, 0.0f, 0.0f, 1.0f),
                        1.0f / (float)POLYC__ANGLE_BINS, 1e-6f);
     ctx->arena.size = size;
-    assert_int_equal(polyc__prior_build(ctx, &f.prior), POLYC_OK);
+    assert_int_equal(polyc__prior_build(ctx, &f.prior, SIZE_MAX), POLYC_OK);
     assert_true(f.prior.w > 0);
     free_ctx(&f);
 }
@@ -378,7 +419,7 @@ static void test_coarse_prior_for_thin_extent(void **state)
     polyc_ctx *ctx = f.ctx;
     assert_true(ctx->grid.tiles_x * ctx->grid.tiles_y > 16 * 4 + 64);
     size_t before = ctx->arena.used;
-    assert_int_equal(polyc__prior_build(ctx, &f.prior), POLYC_OK);
+    assert_int_equal(polyc__prior_build(ctx, &f.prior, SIZE_MAX), POLYC_OK);
     const polyc__prior *p = &f.prior;
     assert_true(ctx->arena.used - before <= polyc__prior_bytes(&ctx->lim));
     assert_true(p->w * p->h <= 16 * 4 + 64);
@@ -412,6 +453,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_room_corners_and_walls),
         cmocka_unit_test(test_histogram_bins),
+        cmocka_unit_test(test_smoothed_table_same_values),
         cmocka_unit_test(test_straight_wall_has_no_corners),
         cmocka_unit_test(test_empty_context),
         cmocka_unit_test(test_outside_and_bad_arguments),
