@@ -341,10 +341,47 @@ int polyc__op_merge(polyc__opt *o)
 
 /* ---- C: split ---- */
 
-static int cmp_float(const void *a, const void *b)
+/* Sorts a[0..n) ascending (no NaN): insertion for short runs, else heap
+ * sort; in place, no recursion, no callback per comparison (qsort's cost
+ * in this operator). */
+static void sort_floats(float *a, int32_t n)
 {
-    float x = *(const float *)a, y = *(const float *)b;
-    return (x > y) - (x < y);
+    if (n <= 24) {
+        for (int32_t i = 1; i < n; i++) {
+            float v = a[i];
+            int32_t j = i;
+            for (; j > 0 && a[j - 1] > v; j--)
+                a[j] = a[j - 1];
+            a[j] = v;
+        }
+        return;
+    }
+    for (int32_t end = n, i = n / 2 - 1;; ) {
+        /* sift a[i] down within a[0..end) */
+        float v = a[i];
+        int32_t k = i;
+        for (;;) {
+            int32_t c = 2 * k + 1;
+            if (c >= end)
+                break;
+            if (c + 1 < end && a[c + 1] > a[c])
+                c++;
+            if (a[c] <= v)
+                break;
+            a[k] = a[c];
+            k = c;
+        }
+        a[k] = v;
+        if (i > 0) {
+            i--; /* still building the heap */
+        } else {
+            if (--end <= 0)
+                break;
+            float top = a[0]; /* the largest goes to the end */
+            a[0] = a[end];
+            a[end] = top;
+        }
+    }
 }
 
 /* True if the positions t[0..n) along a segment of length len leave no
@@ -417,7 +454,7 @@ int polyc__op_split(polyc__opt *o)
         int32_t lo = off[v], hi = off[v + 1];
         if (no_gap_over(t + lo, hi - lo, len, gap_min))
             continue;
-        qsort(t + lo, (size_t)(hi - lo), sizeof(float), cmp_float);
+        sort_floats(t + lo, hi - lo);
         float prev = 0.0f, best = 0.0f, g0 = 0.0f;
         for (int32_t k = lo; k <= hi; k++) {
             float cur = k < hi ? t[k] : len;
