@@ -401,8 +401,22 @@ size_t polyc__prior_smooth_bytes(const polyc__prior *p)
     return polyc__bytes((size_t)p->w * (size_t)p->h, (BINS + 1) * sizeof(uint32_t));
 }
 
+/* Neighbour k (0..8) of cell (cx, cy) in the 3 x 3 smoothing: its index
+ * and weight (4 itself, 2 beside, 1 diagonal); 0 when outside the cells. */
+static int neighbour(const polyc__prior *p, int32_t cx, int32_t cy, int k, size_t *cell,
+                     uint32_t *w)
+{
+    int32_t i = k % 3 - 1, j = k / 3 - 1, ix = cx + i, iy = cy + j;
+    if (ix < 0 || iy < 0 || ix >= p->w || iy >= p->h)
+        return 0;
+    *cell = (size_t)iy * (size_t)p->w + (size_t)ix;
+    *w = (uint32_t)(4 >> ((i != 0) + (j != 0)));
+    return 1;
+}
+
 /* Scatters each cell with evidence into the 3 x 3 cells around it, with the
- * weights smoothed() gathers them with: the same sums of integers. */
+ * weights smoothed() gathers them with (they are symmetric): the same sums
+ * of integers. */
 void polyc__prior_smooth(polyc__prior *p, uint32_t *room)
 {
     const uint32_t *tot = totals(p);
@@ -410,24 +424,18 @@ void polyc__prior_smooth(polyc__prior *p, uint32_t *room)
     memset(room, 0, cells * (BINS + 1) * sizeof(uint32_t));
     for (int32_t cy = 0; cy < p->h; cy++)
         for (int32_t cx = 0; cx < p->w; cx++) {
-            size_t c = (size_t)cy * (size_t)p->w + (size_t)cx;
+            size_t c = (size_t)cy * (size_t)p->w + (size_t)cx, nb;
+            uint32_t w;
             if (tot[c] == 0)
                 continue; /* all its bins are 0 too */
             const uint16_t *h = p->hist + c * BINS;
-            for (int32_t j = -1; j <= 1; j++) {
-                int32_t iy = cy + j;
-                if (iy < 0 || iy >= p->h)
+            for (int k = 0; k < 9; k++) {
+                if (!neighbour(p, cx, cy, k, &nb, &w))
                     continue;
-                for (int32_t i = -1; i <= 1; i++) {
-                    int32_t ix = cx + i;
-                    if (ix < 0 || ix >= p->w)
-                        continue;
-                    uint32_t w = (uint32_t)(4 >> ((i != 0) + (j != 0)));
-                    uint32_t *t = room + ((size_t)iy * (size_t)p->w + (size_t)ix) * (BINS + 1);
-                    for (int b = 0; b < BINS; b++)
-                        t[b] += w * h[b];
-                    t[BINS] += w * tot[c];
-                }
+                uint32_t *t = room + nb * (BINS + 1);
+                for (int b = 0; b < BINS; b++)
+                    t[b] += w * h[b];
+                t[BINS] += w * tot[c];
             }
         }
     p->smooth = room;
@@ -555,25 +563,19 @@ static void smoothed(const polyc__prior *p, int32_t cx, int32_t cy, const int *b
     for (int k = 0; k < nb; k++)
         cnt[bins[k]] = 0;
     *n = 0;
-    for (int32_t j = -1; j <= 1; j++) {
-        int32_t iy = cy + j;
-        if (iy < 0 || iy >= p->h)
+    for (int k = 0; k < 9; k++) {
+        size_t cell;
+        uint32_t w;
+        if (!neighbour(p, cx, cy, k, &cell, &w))
             continue;
-        for (int32_t i = -1; i <= 1; i++) {
-            int32_t ix = cx + i;
-            if (ix < 0 || ix >= p->w)
-                continue;
-            uint32_t w = (uint32_t)(4 >> ((i != 0) + (j != 0)));
-            size_t cell = (size_t)iy * (size_t)p->w + (size_t)ix;
-            const uint16_t *h = p->hist + cell * BINS;
-            if (nb == BINS) /* all bins, in order: a loop the compiler vectorises */
-                for (int b = 0; b < BINS; b++)
-                    cnt[b] += w * h[b];
-            else
-                for (int k = 0; k < nb; k++)
-                    cnt[bins[k]] += w * h[bins[k]];
-            *n += w * tot[cell];
-        }
+        const uint16_t *h = p->hist + cell * BINS;
+        if (nb == BINS) /* all bins, in order: a loop the compiler vectorises */
+            for (int b = 0; b < BINS; b++)
+                cnt[b] += w * h[b];
+        else
+            for (int q = 0; q < nb; q++)
+                cnt[bins[q]] += w * h[bins[q]];
+        *n += w * tot[cell];
     }
 }
 
