@@ -396,11 +396,6 @@ static void learn_scan(prior_pass *q)
         cluster(q, start, s->count - 1);
 }
 
-size_t polyc__prior_smooth_bytes(const polyc__prior *p)
-{
-    return polyc__bytes((size_t)p->w * (size_t)p->h, (BINS + 1) * sizeof(uint32_t));
-}
-
 /* Neighbour k (0..8) of cell (cx, cy) in the 3 x 3 smoothing: its index
  * and weight (4 itself, 2 beside, 1 diagonal); 0 when outside the cells. */
 static int neighbour(const polyc__prior *p, int32_t cx, int32_t cy, int k, size_t *cell,
@@ -417,7 +412,7 @@ static int neighbour(const polyc__prior *p, int32_t cx, int32_t cy, int k, size_
 /* Scatters each cell with evidence into the 3 x 3 cells around it, with the
  * weights smoothed() gathers them with (they are symmetric): the same sums
  * of integers. */
-void polyc__prior_smooth(polyc__prior *p, uint32_t *room)
+static void smooth_table(polyc__prior *p, uint32_t *room)
 {
     const uint32_t *tot = totals(p);
     size_t cells = (size_t)p->w * (size_t)p->h;
@@ -490,13 +485,12 @@ polyc_status polyc__prior_build(polyc_ctx *ctx, polyc__prior *p, size_t spare)
     }
     /* the table only where the block has room beyond the budget: the
      * library's footprint stays what polyc_memory_size says */
-    size_t table = polyc__prior_smooth_bytes(p);
+    size_t table = polyc__bytes(cells, (BINS + 1) * sizeof(uint32_t));
     size_t free_bytes = ctx->arena.size - ctx->arena.used;
     if (table > 0 && free_bytes >= spare && free_bytes - spare >= table) {
-        uint32_t *room = polyc__alloc(&ctx->arena, (size_t)p->w * (size_t)p->h,
-                                      (BINS + 1) * sizeof(uint32_t));
+        uint32_t *room = polyc__alloc(&ctx->arena, cells, (BINS + 1) * sizeof(uint32_t));
         if (room)
-            polyc__prior_smooth(p, room);
+            smooth_table(p, room);
     }
     return POLYC_OK;
 }

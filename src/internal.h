@@ -159,11 +159,8 @@ typedef struct polyc__prior {
 size_t polyc__prior_bytes(const polyc_limits *lim);
 /* Learns the prior from the stored scans (needs the grid for its extent);
  * with `spare` bytes or more of the block free beyond what the later stages
- * are budgeted, also the smoothed table (polyc__prior_smooth). */
+ * are budgeted, also the table of smoothed counts (p->smooth). */
 polyc_status polyc__prior_build(polyc_ctx *ctx, polyc__prior *p, size_t spare);
-/* Bytes of the smoothed table of p; fills it from `room` (that many bytes). */
-size_t polyc__prior_smooth_bytes(const polyc__prior *p);
-void polyc__prior_smooth(polyc__prior *p, uint32_t *room);
 /* p(turn | x, y) in [0, 1]; x, y frame-relative metres; turn in [0, pi]. */
 float polyc__prior_p(const polyc__prior *p, float x, float y, float turn_rad);
 /* The same for many turns at one place: its cell's smoothed counts. */

@@ -117,6 +117,15 @@ static void make_ctx(fixture *f, const scene *sc, const polyc_config *cfg_in,
     assert_int_equal(polyc_build_grid(f->ctx), POLYC_OK);
 }
 
+/* make_ctx on the room scene with range noise noise_m (the scans are
+ * copied into the context, so one scene serves every test in turn) */
+static void make_room_ctx(fixture *f, float noise_m)
+{
+    static scene sc;
+    room_scene(&sc, noise_m);
+    make_ctx(f, &sc, NULL, NULL);
+}
+
 static void free_ctx(fixture *f)
 {
     free(f->block);
@@ -158,10 +167,8 @@ static void check_all_in_unit_interval(const polyc__prior *p, float x0, float y0
 static void test_room_corners_and_walls(void **state)
 {
     (void)state;
-    static scene sc;
-    room_scene(&sc, 0.01f);
     fixture f;
-    make_ctx(&f, &sc, NULL, NULL);
+    make_room_ctx(&f, 0.01f);
     polyc_ctx *ctx = f.ctx;
     size_t before = ctx->arena.used;
     assert_int_equal(polyc__prior_build(ctx, &f.prior, SIZE_MAX), POLYC_OK);
@@ -203,10 +210,8 @@ static void test_room_corners_and_walls(void **state)
 static void test_smoothed_table_same_values(void **state)
 {
     (void)state;
-    static scene sc;
-    room_scene(&sc, 0.01f);
     fixture f;
-    make_ctx(&f, &sc, NULL, NULL);
+    make_room_ctx(&f, 0.01f);
     polyc_ctx *ctx = f.ctx;
     assert_int_equal(polyc__prior_build(ctx, &f.prior, 0), POLYC_OK);
     polyc__prior *p = &f.prior;
@@ -241,10 +246,8 @@ static void test_smoothed_table_same_values(void **state)
 static void test_histogram_bins(void **state)
 {
     (void)state;
-    static scene sc;
-    room_scene(&sc, 0.0f);
     fixture f;
-    make_ctx(&f, &sc, NULL, NULL);
+    make_room_ctx(&f, 0.0f);
     assert_int_equal(polyc__prior_build(f.ctx, &f.prior, SIZE_MAX), POLYC_OK);
     const polyc__prior *p = &f.prior;
     /* the cell of the lower-left corner: 90 degree turns in bin 9 only */
@@ -320,10 +323,8 @@ static void test_empty_context(void **state)
 static void test_outside_and_bad_arguments(void **state)
 {
     (void)state;
-    static scene sc;
-    room_scene(&sc, 0.01f);
     fixture f;
-    make_ctx(&f, &sc, NULL, NULL);
+    make_room_ctx(&f, 0.01f);
     assert_int_equal(polyc__prior_build(f.ctx, &f.prior, SIZE_MAX), POLYC_OK);
     const polyc__prior *p = &f.prior;
     const float u = 1.0f / (float)POLYC__ANGLE_BINS;
@@ -374,10 +375,8 @@ static void test_deterministic(void **state)
 static void test_out_of_memory(void **state)
 {
     (void)state;
-    static scene sc;
-    room_scene(&sc, 0.01f);
     fixture f;
-    make_ctx(&f, &sc, NULL, NULL);
+    make_room_ctx(&f, 0.01f);
     polyc_ctx *ctx = f.ctx;
     size_t size = ctx->arena.size;
     ctx->arena.size = ctx->arena.used + 64; /* room for almost nothing */
