@@ -14,6 +14,13 @@ typedef struct endpoint {
     float fx, fy;                  /* offset from the cell centre, metres */
 } endpoint;
 
+/* The data rule: a cell with hits that the grid does not judge free. */
+static int cell_holds_data(const polyc_ctx *ctx, const polyc__tile *t, int idx)
+{
+    unsigned h = t->hits[idx], m = t->misses[idx];
+    return h > 0 && (float)h >= ctx->cfg.data_min_m * (float)(h + m);
+}
+
 static int endpoint_of(const polyc_ctx *ctx, const polyc__scan *s, uint32_t i, endpoint *e)
 {
     polyc__beam b;
@@ -28,11 +35,7 @@ static int endpoint_of(const polyc_ctx *ctx, const polyc__scan *s, uint32_t i, e
      * accepting points next to solid cells, lets people walking along walls
      * in: measured on the corridor scene, it tripled the vertex count.) */
     const polyc__tile *t = polyc__grid_tile(&ctx->grid, e->ix, e->iy);
-    if (!t)
-        return 0;
-    int idx = polyc__cell_index(e->ix, e->iy);
-    unsigned h = t->hits[idx], m = t->misses[idx];
-    return h > 0 && (float)h >= ctx->cfg.data_min_m * (float)(h + m);
+    return t && cell_holds_data(ctx, t, polyc__cell_index(e->ix, e->iy));
 }
 
 static float cell_centre(double origin, int32_t i, float cell)
@@ -68,17 +71,28 @@ static polyc_status collect_cells(polyc__opt *o, polyc__point *tmp, int32_t cap,
 {
     polyc_ctx *ctx = o->ctx;
     polyc__grid *g = &ctx->grid;
-    for (uint32_t k = 0; k < g->tile_count; k++)
-        memset(g->tiles[k].mark, 0, sizeof g->tiles[k].mark);
-    endpoint e;
-    for (uint32_t si = 0; si < ctx->scan_count; si++)
-        for (uint32_t i = 0; i < ctx->scans[si].count; i++)
-            if (endpoint_of(ctx, &ctx->scans[si], i, &e)) {
-                int32_t bx, by;
-                float fx, fy;
-                to_block(&e, g->cell_m, &bx, &by, &fx, &fy);
-                polyc__grid_tile(g, e.ix, e.iy)->mark[by & 31] |= 1u << (bx & 31);
+    /* The blocks that hold data, from the counters: the grid counts a hit
+     * only in the end cell of a reflection, the cell endpoint_of finds, so a
+     * cell with hits that passes the data rule holds an endpoint that
+     * endpoint_of accepts (and only such cells do). Same marks as a pass
+     * over the beams, without computing every endpoint once more. */
+    const int32_t side = POLYC__TILE_SIDE, block = ~(int32_t)(BLOCK_SIDE - 1);
+    for (uint32_t k = 0; k < g->tile_count; k++) {
+        polyc__tile *t = &g->tiles[k];
+        memset(t->mark, 0, sizeof t->mark);
+        for (int32_t r = 0; r < side; r++) {
+            /* most rows have no hit at all: one test for the row first */
+            uint64_t any = 0, word;
+            for (size_t at = 0; at < sizeof t->hits / POLYC__TILE_SIDE; at += sizeof word) {
+                memcpy(&word, (const char *)(t->hits + r * side) + at, sizeof word);
+                any |= word;
             }
+            for (int32_t c = 0; any != 0 && c < side; c++)
+                if (t->hits[r * side + c] != 0 && cell_holds_data(ctx, t, r * side + c))
+                    t->mark[r & block] |= 1u << (c & block);
+        }
+    }
+    endpoint e;
     uint32_t n = 0;
     for (uint32_t k = 0; k < g->tile_count; k++) {
         polyc__tile *t = &g->tiles[k];
