@@ -103,23 +103,34 @@ static int walk_map(polyc_ctx *ctx, const occ_map *m, polyc__walk *w)
     const polyc__grid *g = &ctx->grid;
     ptrdiff_t p = ((ptrdiff_t)w->iy + 1) * m->stride + w->ix + 1;
     const ptrdiff_t step_y = w->sty > 0 ? m->stride : -m->stride;
-    while (w->n > 0) {
+    /* (in locals: the compiler cannot tell that label's stores miss *w) */
+    int64_t kx = w->kx, ky = w->ky;
+    const int64_t inc_x = w->inc_x, inc_y = w->inc_y;
+    const ptrdiff_t step_x = w->stx;
+    for (int32_t n = w->n; n > 0; n--) {
         if (occ_bit(m, p)) {
             int32_t ix = (int32_t)(p % m->stride) - 1, iy = (int32_t)(p / m->stride) - 1;
             if (ix < 0 || iy < 0 || ix >= g->width || iy >= g->height)
                 return 1;
             return label(ctx, ix, iy);
         }
-        w->n--;
-        if (w->tmx < w->tmy) {
-            w->tmx += w->tdx;
-            p += w->stx;
+        if (kx < ky) {
+            kx += inc_x;
+            p += step_x;
         } else {
-            w->tmy += w->tdy;
+            ky += inc_y;
             p += step_y;
         }
     }
     return end_cell(ctx, w);
+}
+
+static int tile_empty(const polyc__tile *t)
+{
+    uint32_t any = 0;
+    for (int r = 0; t && r < POLYC__TILE_SIDE; r++)
+        any |= t->mark[r];
+    return any == 0;
 }
 
 /* The walk on the tiles' marks, when there is no room for the map. */
@@ -127,13 +138,23 @@ static int walk_tiles(polyc_ctx *ctx, polyc__walk *w)
 {
     const polyc__grid *g = &ctx->grid;
     const polyc__tile *t = polyc__grid_tile(g, w->ix, w->iy);
+    int empty = tile_empty(t);
     while (w->n > 0) {
-        if (t && occupied(t, w->idx))
-            return label(ctx, w->ix, w->iy);
-        if (polyc__walk_step(w) && w->n > 0) {
+        int left;
+        if (empty) {
+            left = polyc__walk_leave_tile(w);
+            while (!left && w->n > 0)
+                left = polyc__walk_step(w);
+        } else {
+            if (occupied(t, w->idx))
+                return label(ctx, w->ix, w->iy);
+            left = polyc__walk_step(w);
+        }
+        if (left && w->n > 0) {
             if (!polyc__walk_enter(w, g->width, g->height))
                 return 1;
             t = polyc__grid_tile(g, w->ix, w->iy);
+            empty = tile_empty(t);
         }
     }
     return end_cell(ctx, w);

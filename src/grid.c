@@ -235,11 +235,11 @@ static void count_beam(const count_pass *p, const polyc__beam *b)
         return;
     while (w.n > 0) {
         if (t == p->spill) {
-            /* nothing is counted here: only the walk to the tile's edge */
-            int left;
-            do
+            /* nothing is counted here: the walk leaves the tile in one move
+             * (or steps to its end cell if that is in the tile) */
+            int left = polyc__walk_leave_tile(&w);
+            while (!left && w.n > 0)
                 left = polyc__walk_step(&w);
-            while (!left && w.n > 0);
             if (left && w.n > 0 &&
                 (!polyc__walk_enter(&w, g->width, g->height) || !(t = tile_get(p, w.ix, w.iy))))
                 return;

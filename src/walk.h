@@ -1,6 +1,14 @@
-/* walk.h - the cell walk of polyc__traverse (Amanatides-Woo in float) as
- * inline steps, for the grid and contour passes, which visit every cell of
- * every beam and cannot afford a call through a pointer per cell. */
+/* walk.h - the cell walk of polyc__traverse (Amanatides-Woo) as inline
+ * steps, for the grid and contour passes, which visit every cell of every
+ * beam and cannot afford a call through a pointer per cell, and for the
+ * spatial hash's segment paths.
+ *
+ * In integers: the beam's ends in fixed point (F fractional bits, F chosen
+ * per beam so that no product exceeds 2^62), and for each axis a key that
+ * orders the boundary crossings exactly, the distance to the next boundary
+ * along that axis times the beam's extent along the other one. A step adds
+ * a constant to a key, so a walk can leave a whole tile in one move
+ * (polyc__walk_leave_tile) and be where its steps would have taken it. */
 #ifndef POLYC_WALK_H
 #define POLYC_WALK_H
 
@@ -15,10 +23,17 @@ typedef struct polyc__walk {
     int32_t ex, ey;                /* end cell, visited last whatever the rounding */
     int32_t stx, sty;              /* +1 or -1 */
     int32_t n;                     /* steps left before the end cell */
+    int64_t kx, ky;                /* keys of the next x and y crossings (INT64_MAX: none) */
+    int64_t inc_x, inc_y;          /* what a step adds to them */
+    double per_key;                /* beam parameter per key unit */
     float t;                       /* beam parameter where the walk entered the cell */
-    float tmx, tmy;                /* parameter of the next x and y cell boundary */
-    float tdx, tdy;                /* parameter per cell along x and y */
 } polyc__walk;
+
+/* floor(v * 2^f) of a finite v that fits */
+static inline int64_t polyc__fixed(float v, int f)
+{
+    return (int64_t)floor(ldexp((double)v, f));
+}
 
 static inline void polyc__walk_start(polyc__walk *w, const polyc__beam *b)
 {
@@ -26,15 +41,36 @@ static inline void polyc__walk_start(polyc__walk *w, const polyc__beam *b)
     w->iy = (int32_t)floorf(b->sy);
     w->ex = (int32_t)floorf(b->ex);
     w->ey = (int32_t)floorf(b->ey);
-    float dx = b->ex - b->sx, dy = b->ey - b->sy;
-    w->stx = dx > 0.0f ? 1 : -1;
-    w->sty = dy > 0.0f ? 1 : -1;
-    w->tdx = dx != 0.0f ? fabsf(1.0f / dx) : 1e30f;
-    w->tdy = dy != 0.0f ? fabsf(1.0f / dy) : 1e30f;
-    w->tmx = dx > 0.0f ? ((float)w->ix + 1.0f - b->sx) * w->tdx : (b->sx - (float)w->ix) * w->tdx;
-    w->tmy = dy > 0.0f ? ((float)w->iy + 1.0f - b->sy) * w->tdy : (b->sy - (float)w->iy) * w->tdy;
-    if (dx == 0.0f) w->tmx = 1e30f;
-    if (dy == 0.0f) w->tmy = 1e30f;
+    /* fractional bits: coordinates (plus a tile's worth of steps past the
+     * end) below 2^(30 - f) keep every key below 2^62 */
+    float m = fmaxf(fmaxf(fabsf(b->sx), fabsf(b->sy)), fmaxf(fabsf(b->ex), fabsf(b->ey))) + 64.0f;
+    int e;
+    (void)frexpf(m, &e);
+    int f = 30 - e;
+    f = f < 0 ? 0 : (f > 20 ? 20 : f);
+    int64_t sx = polyc__fixed(b->sx, f), sy = polyc__fixed(b->sy, f);
+    int64_t ex = polyc__fixed(b->ex, f), ey = polyc__fixed(b->ey, f);
+    int64_t one = (int64_t)1 << f;
+    w->stx = ex > sx ? 1 : -1;
+    w->sty = ey > sy ? 1 : -1;
+    int64_t dxa = ex > sx ? ex - sx : sx - ex, dya = ey > sy ? ey - sy : sy - ey;
+    /* distance to the first boundary along each axis */
+    int64_t ax = w->stx > 0 ? ((int64_t)w->ix + 1) * one - sx : sx - (int64_t)w->ix * one;
+    int64_t ay = w->sty > 0 ? ((int64_t)w->iy + 1) * one - sy : sy - (int64_t)w->iy * one;
+    if (dxa > 0 && dya > 0) {
+        w->kx = ax * dya;
+        w->ky = ay * dxa;
+        w->inc_x = one * dya;
+        w->inc_y = one * dxa;
+        w->per_key = 1.0 / ((double)dxa * (double)dya);
+    } else {
+        /* along one axis only (or not at all): its distance is the key */
+        w->kx = dxa > 0 ? ax : INT64_MAX;
+        w->ky = dya > 0 ? ay : INT64_MAX;
+        w->inc_x = dxa > 0 ? one : 0;
+        w->inc_y = dya > 0 ? one : 0;
+        w->per_key = dxa > 0 ? 1.0 / (double)dxa : (dya > 0 ? 1.0 / (double)dya : 0.0);
+    }
     /* the step count is fixed in advance, so the walk always ends */
     w->n = (w->ex > w->ix ? w->ex - w->ix : w->ix - w->ex) +
            (w->ey > w->iy ? w->ey - w->iy : w->iy - w->ey);
@@ -50,15 +86,15 @@ static inline void polyc__walk_start(polyc__walk *w, const polyc__beam *b)
 static inline int polyc__walk_step(polyc__walk *w)
 {
     w->n--;
-    if (w->tmx < w->tmy) {
-        w->t = w->tmx;
-        w->tmx += w->tdx;
+    if (w->kx < w->ky) {
+        w->t = (float)((double)w->kx * w->per_key);
+        w->kx += w->inc_x;
         w->ix += w->stx;
         w->idx += w->stx;
         return --w->left_x < 0;
     }
-    w->t = w->tmy;
-    w->tmy += w->tdy;
+    w->t = (float)((double)w->ky * w->per_key);
+    w->ky += w->inc_y;
     w->iy += w->sty;
     w->idx += w->sty * POLYC__TILE_SIDE;
     return --w->left_y < 0;
@@ -74,6 +110,38 @@ static inline int polyc__walk_enter(polyc__walk *w, int32_t width, int32_t heigh
     w->idx = polyc__cell_index(w->ix, w->iy);
     w->left_x = w->stx > 0 ? ((w->ix | m) < width ? w->ix | m : width - 1) - w->ix : w->ix & m;
     w->left_y = w->sty > 0 ? ((w->iy | m) < height ? w->iy | m : height - 1) - w->iy : w->iy & m;
+    return 1;
+}
+
+/* Moves the walk into the first cell past the current tile, where its steps
+ * would take it; 0 (and nothing moved) when the walk ends inside the tile.
+ * Needs the counts of polyc__walk_enter. A step goes along x when its key
+ * is below y's, so a walk that leaves across x has taken the y steps whose
+ * keys are at or below that x step's, and one that leaves across y the x
+ * steps whose keys are below. */
+static inline int polyc__walk_leave_tile(polyc__walk *w)
+{
+    int64_t last_x = w->inc_x ? w->kx + (int64_t)w->left_x * w->inc_x : INT64_MAX;
+    int64_t last_y = w->inc_y ? w->ky + (int64_t)w->left_y * w->inc_y : INT64_MAX;
+    int64_t sx, sy, key;
+    if (last_x < last_y) {
+        sx = (int64_t)w->left_x + 1;
+        sy = w->ky > last_x ? 0 : (last_x - w->ky) / w->inc_y + 1;
+        key = last_x;
+    } else {
+        sy = (int64_t)w->left_y + 1;
+        sx = w->kx >= last_y ? 0 : (last_y - w->kx - 1) / w->inc_x + 1;
+        key = last_y;
+    }
+    if (sx + sy > (int64_t)w->n)
+        return 0;
+    w->n -= (int32_t)(sx + sy);
+    w->t = (float)((double)key * w->per_key);
+    w->kx = w->inc_x ? w->kx + sx * w->inc_x : INT64_MAX;
+    w->ky = w->inc_y ? w->ky + sy * w->inc_y : INT64_MAX;
+    w->ix += w->stx * (int32_t)sx;
+    w->iy += w->sty * (int32_t)sy;
+    w->left_x = w->left_y = -1;
     return 1;
 }
 

@@ -5,7 +5,8 @@
  * reach them, with the same counters in every cell; the contour list is the
  * same, in the same order. Scenes: a room with clutter, no-return, short and
  * NaN ranges at several cell sizes; one pose seen 200 times (the sensor's
- * cell saturates); the contour with and without room for its bitmap. */
+ * cell saturates); the contour with and without room for its bitmap; and
+ * the walk's tile jump against its steps, beam by beam. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -17,6 +18,7 @@
 #include <string.h>
 
 #include "internal.h"
+#include "walk.h"
 
 #define PI_D 3.14159265358979323846
 #define BEAMS 361
@@ -339,12 +341,74 @@ static void test_contour_without_bitmap(void **state)
     free(f.block);
 }
 
+/* A coordinate in [0, w): integers (cell boundaries), halves, and any float. */
+static float coord(uint32_t *rng, float w)
+{
+    *rng = *rng * 1664525u + 1013904223u;
+    uint32_t r = *rng >> 8;
+    float v = (float)((double)(r % 1000000u) / 1000000.0 * (double)w);
+    switch (r % 4u) {
+    case 0: return floorf(v);
+    case 1: return floorf(v) + 0.5f;
+    default: return v;
+    }
+}
+
+/* polyc__walk_leave_tile puts a walk where its steps take it: same cell,
+ * same keys, same steps left, same entry parameter; on beams in every
+ * direction, along the axes, from and to cell boundaries. */
+static void test_tile_jump_matches_steps(void **state)
+{
+    (void)state;
+    const int32_t W = 300, H = 170;
+    uint32_t rng = 12345u;
+    uint32_t jumps = 0;
+    for (int k = 0; k < 20000; k++) {
+        polyc__beam b;
+        b.sx = coord(&rng, (float)W);
+        b.sy = coord(&rng, (float)H);
+        b.ex = coord(&rng, (float)W);
+        b.ey = coord(&rng, (float)H);
+        if (k % 10 == 1) b.ey = b.sy; /* along x */
+        if (k % 10 == 2) b.ex = b.sx; /* along y */
+        b.hit = 1;
+        b.miss_end = 1.0f;
+        polyc__walk a;
+        polyc__walk_start(&a, &b);
+        if (a.n == 0 || !polyc__walk_enter(&a, W, H))
+            continue;
+        while (a.n > 0) {
+            /* the jump from this tile entry, then the steps */
+            polyc__walk try = a;
+            int jumped = polyc__walk_leave_tile(&try);
+            int left = 0;
+            while (!left && a.n > 0)
+                left = polyc__walk_step(&a);
+            if (jumped) {
+                jumps++;
+                assert_true(left);
+                assert_int_equal(try.ix, a.ix);
+                assert_int_equal(try.iy, a.iy);
+                assert_int_equal(try.n, a.n);
+                assert_true(try.kx == a.kx && try.ky == a.ky);
+                assert_true(try.t == a.t);
+            } else {
+                assert_false(left && a.n > 0); /* it ended in the tile */
+            }
+            if (a.n > 0 && !polyc__walk_enter(&a, W, H))
+                break;
+        }
+    }
+    assert_true(jumps > 20000);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_passes_match_traversal),
         cmocka_unit_test(test_saturation_matches_traversal),
         cmocka_unit_test(test_contour_without_bitmap),
+        cmocka_unit_test(test_tile_jump_matches_steps),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
