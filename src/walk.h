@@ -15,6 +15,7 @@
 #include "internal.h"
 
 #include <math.h>
+#include <string.h>
 
 typedef struct polyc__walk {
     int32_t ix, iy;                /* current cell */
@@ -29,10 +30,17 @@ typedef struct polyc__walk {
     float t;                       /* beam parameter where the walk entered the cell */
 } polyc__walk;
 
-/* floor(v * 2^f) of a finite v that fits */
-static inline int64_t polyc__fixed(float v, int f)
+/* floor(v * scale) of a finite v that fits, scale a power of two (exact) */
+static inline int64_t polyc__fixed(float v, double scale)
 {
-    return (int64_t)floor(ldexp((double)v, f));
+    return (int64_t)floor((double)v * scale);
+}
+
+static inline float polyc__max_abs(float a, float b)
+{
+    a = a < 0.0f ? -a : a;
+    b = b < 0.0f ? -b : b;
+    return a > b ? a : b;
 }
 
 static inline void polyc__walk_start(polyc__walk *w, const polyc__beam *b)
@@ -42,15 +50,18 @@ static inline void polyc__walk_start(polyc__walk *w, const polyc__beam *b)
     w->ex = (int32_t)floorf(b->ex);
     w->ey = (int32_t)floorf(b->ey);
     /* fractional bits: coordinates (plus a tile's worth of steps past the
-     * end) below 2^(30 - f) keep every key below 2^62 */
-    float m = fmaxf(fmaxf(fabsf(b->sx), fabsf(b->sy)), fmaxf(fabsf(b->ex), fabsf(b->ey))) + 64.0f;
-    int e;
-    (void)frexpf(m, &e);
+     * end) below 2^(30 - f) keep every key below 2^62; at f = 0 that holds
+     * for any grid the configuration allows (1e6 m / 1 mm < 2^30 cells) */
+    float m = polyc__max_abs(polyc__max_abs(b->sx, b->sy), polyc__max_abs(b->ex, b->ey)) + 64.0f;
+    uint32_t bits;
+    memcpy(&bits, &m, sizeof bits);
+    int e = (int)((bits >> 23) & 0xffu) - 126; /* m < 2^e, a normal float >= 64 */
     int f = 30 - e;
     f = f < 0 ? 0 : (f > 20 ? 20 : f);
-    int64_t sx = polyc__fixed(b->sx, f), sy = polyc__fixed(b->sy, f);
-    int64_t ex = polyc__fixed(b->ex, f), ey = polyc__fixed(b->ey, f);
     int64_t one = (int64_t)1 << f;
+    double scale = (double)one;
+    int64_t sx = polyc__fixed(b->sx, scale), sy = polyc__fixed(b->sy, scale);
+    int64_t ex = polyc__fixed(b->ex, scale), ey = polyc__fixed(b->ey, scale);
     w->stx = ex > sx ? 1 : -1;
     w->sty = ey > sy ? 1 : -1;
     int64_t dxa = ex > sx ? ex - sx : sx - ex, dya = ey > sy ? ey - sy : sy - ey;
