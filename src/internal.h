@@ -135,6 +135,7 @@ typedef struct polyc__hash {
     int32_t *seg_head;             /* bx * by lists of segment entries */
     polyc__hash_entry *entries;
     int32_t entry_cap, entry_free, entry_live;
+    int32_t entry_top;             /* entries below it have been handed out */
     uint32_t *pt_start;            /* bx * by + 1: points sorted by bucket */
     int32_t *pt_order;             /* unused when points are stored sorted */
     int out_of_entries;

@@ -63,9 +63,10 @@ void polyc__hash_clear(polyc__opt *o)
     polyc__hash *h = &o->h;
     for (int32_t i = 0; i < h->bx * h->by; i++)
         h->seg_head[i] = POLYC__NONE;
-    for (int32_t i = 0; i < h->entry_cap; i++)
-        h->entries[i].next = i + 1 < h->entry_cap ? i + 1 : POLYC__NONE;
-    h->entry_free = h->entry_cap ? 0 : POLYC__NONE;
+    /* entries come from the freed ones first, then from the top: nothing
+     * to initialise for the (limit-sized) rest */
+    h->entry_free = POLYC__NONE;
+    h->entry_top = 0;
     h->entry_live = 0;
     h->out_of_entries = 0;
     if (o->seg_in)
@@ -193,12 +194,15 @@ void polyc__segment_region(polyc__opt *o, float ax, float ay, float bx, float by
 static void insert_in_bucket(polyc__opt *o, int32_t bucket)
 {
     polyc__hash *h = &o->h;
-    if (h->entry_free == POLYC__NONE) {
+    int32_t e = h->entry_free;
+    if (e != POLYC__NONE) {
+        h->entry_free = h->entries[e].next;
+    } else if (h->entry_top < h->entry_cap) {
+        e = h->entry_top++;
+    } else {
         h->out_of_entries = 1;
         return;
     }
-    int32_t e = h->entry_free;
-    h->entry_free = h->entries[e].next;
     h->entries[e].seg = o->cur_seg;
     h->entries[e].next = h->seg_head[bucket];
     h->seg_head[bucket] = e;
