@@ -177,11 +177,11 @@ void polyc__traverse(const polyc__beam *b, polyc__cell_fn visit, void *u)
     polyc__walk w;
     polyc__walk_start(&w, b);
     while (w.n > 0) {
-        if (visit(u, w.ix, w.iy, w.t, 0))
+        if (visit(u, w.ix, w.iy, polyc__walk_t(&w), 0))
             return;
         polyc__walk_step(&w);
     }
-    visit(u, w.ex, w.ey, w.t, 1);
+    visit(u, w.ex, w.ey, polyc__walk_t(&w), 1);
 }
 
 /* The grid pass stores a tile only where some beam ends in a hit (`wanted`,
@@ -245,7 +245,7 @@ static void count_beam(const count_pass *p, const polyc__beam *b)
                 return;
             continue;
         }
-        if (w.t < miss_end)
+        if (polyc__walk_t(&w) < miss_end)
             count_inc(&t->misses[w.idx], &t->hits[w.idx]);
         if (polyc__walk_step(&w) && w.n > 0 &&
             (!polyc__walk_enter(&w, g->width, g->height) || !(t = tile_get(p, w.ix, w.iy))))
@@ -258,7 +258,7 @@ static void count_beam(const count_pass *p, const polyc__beam *b)
     int idx = polyc__cell_index(w.ex, w.ey);
     if (b->hit)
         count_inc(&t->hits[idx], &t->misses[idx]);
-    else if (w.t < miss_end)
+    else if (polyc__walk_t(&w) < miss_end)
         count_inc(&t->misses[idx], &t->hits[idx]);
 }
 

@@ -26,14 +26,15 @@ typedef struct polyc__walk {
     int32_t n;                     /* steps left before the end cell */
     int64_t kx, ky;                /* keys of the next x and y crossings (INT64_MAX: none) */
     int64_t inc_x, inc_y;          /* what a step adds to them */
-    double per_key;                /* beam parameter per key unit */
-    float t;                       /* beam parameter where the walk entered the cell */
+    int64_t t_key;                 /* key of the step into the current cell (0: the start) */
+    float per_key;                 /* beam parameter per key unit */
 } polyc__walk;
 
-/* floor(v * scale) of a finite v that fits, scale a power of two (exact) */
-static inline int64_t polyc__fixed(float v, double scale)
+/* floor(v * scale) of a finite v that fits, scale a power of two: exact in
+ * float, so no double arithmetic (a microcontroller's FPU has none) */
+static inline int64_t polyc__fixed(float v, float scale)
 {
-    return (int64_t)floor((double)v * scale);
+    return (int64_t)floorf(v * scale);
 }
 
 static inline float polyc__max_abs(float a, float b)
@@ -59,7 +60,7 @@ static inline void polyc__walk_start(polyc__walk *w, const polyc__beam *b)
     int f = 30 - e;
     f = f < 0 ? 0 : (f > 20 ? 20 : f);
     int64_t one = (int64_t)1 << f;
-    double scale = (double)one;
+    float scale = (float)one;
     int64_t sx = polyc__fixed(b->sx, scale), sy = polyc__fixed(b->sy, scale);
     int64_t ex = polyc__fixed(b->ex, scale), ey = polyc__fixed(b->ey, scale);
     w->stx = ex > sx ? 1 : -1;
@@ -73,23 +74,29 @@ static inline void polyc__walk_start(polyc__walk *w, const polyc__beam *b)
         w->ky = ay * dxa;
         w->inc_x = one * dya;
         w->inc_y = one * dxa;
-        w->per_key = 1.0 / ((double)dxa * (double)dya);
+        w->per_key = 1.0f / ((float)dxa * (float)dya);
     } else {
         /* along one axis only (or not at all): its distance is the key */
         w->kx = dxa > 0 ? ax : INT64_MAX;
         w->ky = dya > 0 ? ay : INT64_MAX;
         w->inc_x = dxa > 0 ? one : 0;
         w->inc_y = dya > 0 ? one : 0;
-        w->per_key = dxa > 0 ? 1.0 / (double)dxa : (dya > 0 ? 1.0 / (double)dya : 0.0);
+        w->per_key = dxa > 0 ? 1.0f / (float)dxa : (dya > 0 ? 1.0f / (float)dya : 0.0f);
     }
     /* the step count is fixed in advance, so the walk always ends */
     w->n = (w->ex > w->ix ? w->ex - w->ix : w->ix - w->ex) +
            (w->ey > w->iy ? w->ey - w->iy : w->iy - w->ey);
-    w->t = 0.0f;
+    w->t_key = 0;
     /* set by polyc__walk_enter; until then steps count down from far away
      * (polyc__traverse never calls it: no use of indeterminate values) */
     w->idx = 0;
     w->left_x = w->left_y = INT32_MAX;
+}
+
+/* The beam parameter where the walk entered the current cell. */
+static inline float polyc__walk_t(const polyc__walk *w)
+{
+    return (float)w->t_key * w->per_key;
 }
 
 /* To the next cell. Returns 1 when it left the tile (or the grid): then
@@ -98,13 +105,13 @@ static inline int polyc__walk_step(polyc__walk *w)
 {
     w->n--;
     if (w->kx < w->ky) {
-        w->t = (float)((double)w->kx * w->per_key);
+        w->t_key = w->kx;
         w->kx += w->inc_x;
         w->ix += w->stx;
         w->idx += w->stx;
         return --w->left_x < 0;
     }
-    w->t = (float)((double)w->ky * w->per_key);
+    w->t_key = w->ky;
     w->ky += w->inc_y;
     w->iy += w->sty;
     w->idx += w->sty * POLYC__TILE_SIDE;
@@ -147,7 +154,7 @@ static inline int polyc__walk_leave_tile(polyc__walk *w)
     if (sx + sy > (int64_t)w->n)
         return 0;
     w->n -= (int32_t)(sx + sy);
-    w->t = (float)((double)key * w->per_key);
+    w->t_key = key;
     w->kx = w->inc_x ? w->kx + sx * w->inc_x : INT64_MAX;
     w->ky = w->inc_y ? w->ky + sy * w->inc_y : INT64_MAX;
     w->ix += w->stx * (int32_t)sx;

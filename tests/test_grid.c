@@ -355,7 +355,7 @@ static float coord(uint32_t *rng, float w)
 }
 
 /* polyc__walk_leave_tile puts a walk where its steps take it: same cell,
- * same keys, same steps left, same entry parameter; on beams in every
+ * same keys, same steps left, same entry key; on beams in every
  * direction, along the axes, from and to cell boundaries. */
 static void test_tile_jump_matches_steps(void **state)
 {
@@ -391,7 +391,7 @@ static void test_tile_jump_matches_steps(void **state)
                 assert_int_equal(try.iy, a.iy);
                 assert_int_equal(try.n, a.n);
                 assert_true(try.kx == a.kx && try.ky == a.ky);
-                assert_true(try.t == a.t);
+                assert_true(try.t_key == a.t_key);
             } else {
                 assert_false(left && a.n > 0); /* it ended in the tile */
             }
