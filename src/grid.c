@@ -245,9 +245,14 @@ static void count_beam(const count_pass *p, const polyc__beam *b)
                 return;
             continue;
         }
-        if (polyc__walk_t(&w) < miss_end)
-            count_inc(&t->misses[w.idx], &t->hits[w.idx]);
-        if (polyc__walk_step(&w) && w.n > 0 &&
+        /* a stored tile: counted up to its edge (or the end cell) */
+        int left;
+        do {
+            if (polyc__walk_t(&w) < miss_end)
+                count_inc(&t->misses[w.idx], &t->hits[w.idx]);
+            left = polyc__walk_step(&w);
+        } while (!left && w.n > 0);
+        if (left && w.n > 0 &&
             (!polyc__walk_enter(&w, g->width, g->height) || !(t = tile_get(p, w.ix, w.iy))))
             return;
     }
