@@ -125,6 +125,7 @@ static int walk_map(polyc_ctx *ctx, const occ_map *m, polyc__walk *w)
     return end_cell(ctx, w);
 }
 
+/* No occupied cell in the tile (or no tile stored there). */
 static int tile_empty(const polyc__tile *t)
 {
     uint32_t any = 0;
@@ -133,7 +134,8 @@ static int tile_empty(const polyc__tile *t)
     return any == 0;
 }
 
-/* The walk on the tiles' marks, when there is no room for the map. */
+/* The walk on the tiles' marks, when there is no room for the map; a tile
+ * without an occupied cell is left in one move. */
 static int walk_tiles(polyc_ctx *ctx, polyc__walk *w)
 {
     const polyc__grid *g = &ctx->grid;
