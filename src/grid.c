@@ -61,10 +61,10 @@ polyc__tile *polyc__grid_tile(const polyc__grid *g, int32_t ix, int32_t iy)
 static float exit_distance(float sx, float sy, float dx, float dy, float w, float h)
 {
     float t = 1e30f;
-    if (dx > 0.0f) t = fminf(t, (w - sx) / dx);
-    if (dx < 0.0f) t = fminf(t, -sx / dx);
-    if (dy > 0.0f) t = fminf(t, (h - sy) / dy);
-    if (dy < 0.0f) t = fminf(t, -sy / dy);
+    if (dx > 0.0f) t = polyc__minf(t, (w - sx) / dx);
+    if (dx < 0.0f) t = polyc__minf(t, -sx / dx);
+    if (dy > 0.0f) t = polyc__minf(t, (h - sy) / dy);
+    if (dy < 0.0f) t = polyc__minf(t, -sy / dy);
     return t < 0.0f ? 0.0f : t;
 }
 
@@ -132,7 +132,7 @@ static int beam_fill(const polyc_ctx *ctx, const polyc__scan *s, uint32_t i, pol
         len_m = r;
     } else if (r >= s->max_m && ctx->cfg.free_range_m > 0.0f) {
         b->hit = 0;
-        len_m = fminf(ctx->cfg.free_range_m, r < 1e30f ? r : 1e30f);
+        len_m = polyc__minf(ctx->cfg.free_range_m, r < 1e30f ? r : 1e30f);
     } else {
         return 0; /* too short, or no return with free-space marking off */
     }
@@ -152,8 +152,8 @@ static int beam_fill(const polyc_ctx *ctx, const polyc__scan *s, uint32_t i, pol
         /* The last cell / sin(incidence) of a beam runs within a cell of the
          * surface it hits: a grazing beam would count misses in the wall's
          * own cells there. Misses stop before that stretch. */
-        float sn = fmaxf(incidence_sin(ctx, s, i, r, rot), 0.05f);
-        float skip = fminf(ctx->cfg.grazing_cells / sn, 0.5f * len);
+        float sn = polyc__maxf(incidence_sin(ctx, s, i, r, rot), 0.05f);
+        float skip = polyc__minf(ctx->cfg.grazing_cells / sn, 0.5f * len);
         b->miss_end = len > 0.0f ? 1.0f - skip / len : 0.0f;
     }
     return 1;

@@ -246,6 +246,16 @@ static inline int polyc__cell_index(int32_t ix, int32_t iy)
 {
     return ((iy & (POLYC__TILE_SIDE - 1)) << POLYC__TILE_SHIFT) | (ix & (POLYC__TILE_SIDE - 1));
 }
+/* min and max of two floats that are not NaN: fminf and fmaxf are libm
+ * calls on x86-64 (their NaN rules keep the compiler from using minss) */
+static inline float polyc__minf(float a, float b)
+{
+    return a < b ? a : b;
+}
+static inline float polyc__maxf(float a, float b)
+{
+    return a > b ? a : b;
+}
 /* The angle between two directions in [0, pi] from their cross and dot
  * products, as atan2f(|cross|, dot) to within 2e-6 rad. Ours, not libm's:
  * it is about three times faster where the optimiser prices every trial

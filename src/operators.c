@@ -468,7 +468,7 @@ int polyc__op_split(polyc__opt *o)
          * spacings between neighbouring points: those are no gaps */
         float gx = a->x + (b->x - a->x) * (g0 + 0.5f * best) / len;
         float gy = a->y + (b->y - a->y) * (g0 + 0.5f * best) / len;
-        float need = fmaxf(gap_min, 2.5f * polyc__spacing_at(&o->spacing, gx, gy)) +
+        float need = polyc__maxf(gap_min, 2.5f * polyc__spacing_at(&o->spacing, gx, gy)) +
                      o->point_span_m;
         if (best > need && n_cut < o->cut_cap) {
             o->cut_seg[n_cut] = v;
@@ -541,12 +541,12 @@ int polyc__op_trim_ends(polyc__opt *o)
         float ax = a->x, ay = a->y, bx = s->v[w].x, by = s->v[w].y;
         float len = sqrtf((bx - ax) * (bx - ax) + (by - ay) * (by - ay));
         /* a margin of half a beam spacing keeps the last point's own beam on the map */
-        float margin = fmaxf(0.01f, 0.5f * polyc__spacing_at(&o->spacing, bx, by)) / len;
+        float margin = polyc__maxf(0.01f, 0.5f * polyc__spacing_at(&o->spacing, bx, by)) / len;
         float keep_tail = o->split_t[v] + margin, keep_head = o->trim_head[v] + margin;
         /* a single scan's ends also grow to its end beams */
         float most = o->rays.on ? 1.0f + 4.0f * margin : 1.0f;
-        keep_tail = fminf(keep_tail, most);
-        keep_head = fminf(keep_head, most);
+        keep_tail = polyc__minf(keep_tail, most);
+        keep_head = polyc__minf(keep_head, most);
         /* (there, under a millimetre is not worth a move, which would be
          * climbed again in the next iteration) */
         if (o->rays.on && fabsf(keep_tail - 1.0f) * len < 1e-3f)

@@ -356,10 +356,10 @@ static void gather_candidates(polyc__opt *o, const int32_t *old, int n_old, int3
                     }
                     const polyc__vertex *a = &o->s->v[sg], *c = &o->s->v[a->next];
                     float *box = o->cand_box + 4 * o->cand_n;
-                    box[0] = fminf(a->x, c->x);
-                    box[1] = fminf(a->y, c->y);
-                    box[2] = fmaxf(a->x, c->x);
-                    box[3] = fmaxf(a->y, c->y);
+                    box[0] = polyc__minf(a->x, c->x);
+                    box[1] = polyc__minf(a->y, c->y);
+                    box[2] = polyc__maxf(a->x, c->x);
+                    box[3] = polyc__maxf(a->y, c->y);
                     o->cand_seg[o->cand_n++] = sg;
                 }
             }
