@@ -63,8 +63,12 @@ static int try_corner(polyc__opt *o, int32_t b, int32_t c, int k)
             dangle += polyc__turn_cost(o, x, y, V[d].x, V[d].y, V[nd].x, V[nd].y);
     }
     double dbic = (double)o->cfg->alpha * (derr + gamma * dangle) - (double)k * o->log_n;
-    if (dbic >= 0.0 || polyc__blocks_beams(&o->rays, V[a].x, V[a].y, x, y) ||
-        polyc__blocks_beams(&o->rays, x, y, V[d].x, V[d].y))
+    if (dbic >= 0.0)
+        return 0;
+    float old_xy[4 * POLYC__EDIT_SEGS];
+    int n_xy = polyc__edit_segments(o, old, n_old, old_xy);
+    if (polyc__blocks_beams(&o->rays, V[a].x, V[a].y, x, y, old_xy, n_xy) ||
+        polyc__blocks_beams(&o->rays, x, y, V[d].x, V[d].y, old_xy, n_xy))
         return 0;
     polyc__chg_begin(o);
     polyc__op_move(o, b, x, y);

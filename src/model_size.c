@@ -83,8 +83,12 @@ double polyc__removal_delta_below(polyc__opt *o, int32_t v, double bound)
         xy[1] = V[p].y;
         xy[2] = V[n].x;
         xy[3] = V[n].y;
-        if (polyc__blocks_beams(&o->rays, xy[0], xy[1], xy[2], xy[3]))
-            return INFINITY; /* a single scan saw through there */
+        if (o->rays.on) {
+            float old_xy[4 * POLYC__EDIT_SEGS];
+            int n_xy = polyc__edit_segments(o, old, n_old, old_xy);
+            if (polyc__blocks_beams(&o->rays, xy[0], xy[1], xy[2], xy[3], old_xy, n_xy))
+                return INFINITY; /* a single scan saw through there */
+        }
         n_new = 1;
         dk = -1.0;
         dangle = -o->acost[p] - o->acost[v] - o->acost[n];
@@ -208,9 +212,13 @@ int polyc__op_add_vertices(polyc__opt *o, int max_tries)
             int32_t far = o->seg_far[u];
             if (o->pt_seg[far] != u)
                 continue; /* stale after an earlier addition */
+            float old_xy[4 * POLYC__EDIT_SEGS];
+            int n_xy = o->rays.on ? polyc__edit_segments(o, &u, 1, old_xy) : 0;
             if (o->rays.on &&
-                (polyc__blocks_beams(&o->rays, s->v[u].x, s->v[u].y, o->pts[far].x, o->pts[far].y) ||
-                 polyc__blocks_beams(&o->rays, o->pts[far].x, o->pts[far].y, s->v[w].x, s->v[w].y)))
+                (polyc__blocks_beams(&o->rays, s->v[u].x, s->v[u].y, o->pts[far].x, o->pts[far].y,
+                                     old_xy, n_xy) ||
+                 polyc__blocks_beams(&o->rays, o->pts[far].x, o->pts[far].y, s->v[w].x, s->v[w].y,
+                                     old_xy, n_xy)))
                 continue;
             double before = polyc__bic(o);
             float ux = s->v[u].x, uy = s->v[u].y, wx = s->v[w].x, wy = s->v[w].y;

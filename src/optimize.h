@@ -107,6 +107,8 @@ typedef struct polyc__opt {
 } polyc__opt;
 
 #define POLYC__CAND_MAX 48
+/* segments one edit replaces, at most (corners: a chain of 3 and its two ends) */
+#define POLYC__EDIT_SEGS 6
 
 /* optimize.c: carves the state from the arena after the trace, scores it */
 polyc_status polyc__opt_setup(polyc_ctx *ctx, polyc__opt *o);
@@ -197,7 +199,14 @@ double polyc__removal_delta_below(polyc__opt *o, int32_t v, double bound);
  * of its segments do so; holds_returns: some beam meets a-b within the
  * tolerance of its return (the map would lose that return without it) */
 void polyc__rays_init(polyc__rays *rays, const polyc_ctx *ctx);
-int polyc__blocks_beams(const polyc__rays *rays, float ax, float ay, float bx, float by);
+/* old_xy: the n_old segments (x0 y0 x1 y1 each) the edit replaces; a
+ * return one of them met within the tolerance is the new segment's own too,
+ * however far from its line (on a wall seen at a grazing angle) */
+int polyc__blocks_beams(const polyc__rays *rays, float ax, float ay, float bx, float by,
+                        const float *old_xy, int n_old);
+/* fills old_xy with the segments of `segs` (start vertices, NONE skipped)
+ * as they are now; returns their count (at most POLYC__EDIT_SEGS) */
+int polyc__edit_segments(const polyc__opt *o, const int32_t *segs, int n, float *old_xy);
 int polyc__vertex_blocks(const polyc__opt *o, int32_t v, float x, float y);
 int polyc__holds_returns(const polyc__rays *rays, float ax, float ay, float bx, float by);
 float polyc__ray_position(const polyc__rays *rays, float ax, float ay, float bx, float by,

@@ -266,31 +266,40 @@ static void test_blocks_beams(void **state)
     full_turn(&r, range);
     range[10] = 50.0f; /* no return (>= max) */
     /* in front of the returns: blocks */
-    assert_true(polyc__blocks_beams(&r, 1.0f, -0.2f, 1.0f, 0.2f));
+    assert_true(polyc__blocks_beams(&r, 1.0f, -0.2f, 1.0f, 0.2f, NULL, 0));
     /* on them, or within the tolerance: fine */
-    assert_false(polyc__blocks_beams(&r, 2.0f, -0.2f, 2.0f, 0.2f));
-    assert_false(polyc__blocks_beams(&r, 1.95f, -0.2f, 1.95f, 0.2f));
+    assert_false(polyc__blocks_beams(&r, 2.0f, -0.2f, 2.0f, 0.2f, NULL, 0));
+    assert_false(polyc__blocks_beams(&r, 1.95f, -0.2f, 1.95f, 0.2f, NULL, 0));
     /* behind its own returns by more than the tolerance: a misfit */
-    assert_true(polyc__blocks_beams(&r, 2.13f, -0.2f, 2.13f, 0.2f));
+    assert_true(polyc__blocks_beams(&r, 2.13f, -0.2f, 2.13f, 0.2f, NULL, 0));
     /* far behind: some other returns' business */
-    assert_false(polyc__blocks_beams(&r, 3.0f, -0.2f, 3.0f, 0.2f));
+    assert_false(polyc__blocks_beams(&r, 3.0f, -0.2f, 3.0f, 0.2f, NULL, 0));
+    /* unless a segment the edit replaces met those returns: they would lose
+     * their wall (as on a wall seen at a grazing angle, where a return can
+     * lie beyond the search radius of the new line and metres before it
+     * along its beam) */
+    const float own_xy[8] = {5.0f, 5.0f, 5.0f, 6.0f, 2.0f, -0.2f, 2.0f, 0.2f};
+    assert_true(polyc__blocks_beams(&r, 3.0f, -0.2f, 3.0f, 0.2f, own_xy, 2));
+    assert_false(polyc__blocks_beams(&r, 3.0f, -0.2f, 3.0f, 0.2f, own_xy, 1));
+    const float far_xy[4] = {3.5f, -0.2f, 3.5f, 0.2f};
+    assert_false(polyc__blocks_beams(&r, 3.0f, -0.2f, 3.0f, 0.2f, far_xy, 1));
     /* across the seam of the turn (beams 359 and 0) and at 180 degrees */
-    assert_true(polyc__blocks_beams(&r, 1.0f, 0.05f, 1.0f, -0.05f));
-    assert_true(polyc__blocks_beams(&r, -1.0f, 0.1f, -1.0f, -0.1f));
+    assert_true(polyc__blocks_beams(&r, 1.0f, 0.05f, 1.0f, -0.05f, NULL, 0));
+    assert_true(polyc__blocks_beams(&r, -1.0f, 0.1f, -1.0f, -0.1f, NULL, 0));
     /* only the no-return beam crosses it: nothing proven */
     float a = (float)(10.0 * r.step);
     assert_false(polyc__blocks_beams(&r, cosf(a) - 0.01f * sinf(a), sinf(a) + 0.01f * cosf(a),
-                                     cosf(a) + 0.01f * sinf(a), sinf(a) - 0.01f * cosf(a)));
+                                     cosf(a) + 0.01f * sinf(a), sinf(a) - 0.01f * cosf(a), NULL, 0));
     /* a 180-degree scan sees nothing behind it */
     r.base = -0.5 * PI;
     r.count = 181;
     r.step = PI / 180.0;
     r.step_cos = cos(r.step);
     r.step_sin = sin(r.step);
-    assert_false(polyc__blocks_beams(&r, -1.0f, 0.1f, -1.0f, -0.1f));
-    assert_true(polyc__blocks_beams(&r, 1.0f, -0.2f, 1.0f, 0.2f));
+    assert_false(polyc__blocks_beams(&r, -1.0f, 0.1f, -1.0f, -0.1f, NULL, 0));
+    assert_true(polyc__blocks_beams(&r, 1.0f, -0.2f, 1.0f, 0.2f, NULL, 0));
     r.on = 0;
-    assert_false(polyc__blocks_beams(&r, 1.0f, -0.2f, 1.0f, 0.2f));
+    assert_false(polyc__blocks_beams(&r, 1.0f, -0.2f, 1.0f, 0.2f, NULL, 0));
 }
 
 /* Which segments hold a return (an end segment that does may not go). */
