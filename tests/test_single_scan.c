@@ -310,7 +310,7 @@ static void test_holds_returns(void **state)
     polyc__rays r;
     full_turn(&r, range);
     range[5] = 50.0f;  /* no return */
-    range[90] = 12.0f; /* beyond the range where a return is held */
+    range[90] = 25.0f; /* far: held all the same */
     /* across the beams at their returns, or within the tolerance */
     assert_true(polyc__holds_returns(&r, 2.0f, -0.05f, 2.0f, 0.05f));
     assert_true(polyc__holds_returns(&r, 2.08f, -0.05f, 2.08f, 0.05f));
@@ -319,16 +319,16 @@ static void test_holds_returns(void **state)
     assert_false(polyc__holds_returns(&r, 2.5f, -0.05f, 2.5f, 0.05f));
     /* along a beam (grazing): no witness */
     assert_false(polyc__holds_returns(&r, 1.95f, 0.0f, 2.05f, 0.0001f));
-    /* a no-return beam, and a return beyond 10 m, hold nothing */
+    /* a no-return beam holds nothing; a far return is held */
     float a = (float)(5.0 * r.step), e = (float)(90.0 * r.step);
     assert_false(polyc__holds_returns(&r, 2.0f * cosf(a) - 0.005f * sinf(a),
                                       2.0f * sinf(a) + 0.005f * cosf(a),
                                       2.0f * cosf(a) + 0.005f * sinf(a),
                                       2.0f * sinf(a) - 0.005f * cosf(a)));
-    assert_false(polyc__holds_returns(&r, 12.0f * cosf(e) - 0.05f * sinf(e),
-                                      12.0f * sinf(e) + 0.05f * cosf(e),
-                                      12.0f * cosf(e) + 0.05f * sinf(e),
-                                      12.0f * sinf(e) - 0.05f * cosf(e)));
+    assert_true(polyc__holds_returns(&r, 25.0f * cosf(e) - 0.05f * sinf(e),
+                                     25.0f * sinf(e) + 0.05f * cosf(e),
+                                     25.0f * cosf(e) + 0.05f * sinf(e),
+                                     25.0f * sinf(e) - 0.05f * cosf(e)));
     r.on = 0;
     assert_false(polyc__holds_returns(&r, 2.0f, -0.05f, 2.0f, 0.05f));
 }
