@@ -68,7 +68,8 @@ static int try_corner(polyc__opt *o, int32_t b, int32_t c, int k)
     float old_xy[4 * POLYC__EDIT_SEGS];
     int n_xy = polyc__edit_segments(o, old, n_old, old_xy);
     if (polyc__blocks_beams(&o->rays, V[a].x, V[a].y, x, y, old_xy, n_xy) ||
-        polyc__blocks_beams(&o->rays, x, y, V[d].x, V[d].y, old_xy, n_xy))
+        polyc__blocks_beams(&o->rays, x, y, V[d].x, V[d].y, old_xy, n_xy) ||
+        polyc__loses_returns(&o->rays, old_xy, n_xy, xy, 2))
         return 0;
     polyc__chg_begin(o);
     polyc__op_move(o, b, x, y);

@@ -246,6 +246,12 @@ static inline int polyc__cell_index(int32_t ix, int32_t iy)
 {
     return ((iy & (POLYC__TILE_SIDE - 1)) << POLYC__TILE_SHIFT) | (ix & (POLYC__TILE_SIDE - 1));
 }
+/* one scan's beams (ray_check.c): a segment may not stand in front of a
+ * return, nor behind one of its own returns, by more than this along the
+ * beam; scan_chains.c links hits across beams whose return is in front of
+ * the link by more than this */
+#define POLYC__RAY_TOLERANCE_M 0.10
+
 /* min and max of two floats that are not NaN: fminf and fmaxf are libm
  * calls on x86-64 (their NaN rules keep the compiler from using minss) */
 static inline float polyc__minf(float a, float b)

@@ -86,8 +86,9 @@ double polyc__removal_delta_below(polyc__opt *o, int32_t v, double bound)
         if (o->rays.on) {
             float old_xy[4 * POLYC__EDIT_SEGS];
             int n_xy = polyc__edit_segments(o, old, n_old, old_xy);
-            if (polyc__blocks_beams(&o->rays, xy[0], xy[1], xy[2], xy[3], old_xy, n_xy))
-                return INFINITY; /* a single scan saw through there */
+            if (polyc__blocks_beams(&o->rays, xy[0], xy[1], xy[2], xy[3], old_xy, n_xy) ||
+                polyc__loses_returns(&o->rays, old_xy, n_xy, xy, 1))
+                return INFINITY; /* a single scan saw through there, or a return would go */
         }
         n_new = 1;
         dk = -1.0;

@@ -11,10 +11,6 @@ typedef struct polyc__heap_entry {
     int32_t pad;
 } polyc__heap_entry;
 
-/* one scan's beams (ray_check.c): a segment may not stand in front of a
- * return, nor behind one of its own returns, by more than this along the
- * beam */
-#define POLYC__RAY_TOLERANCE_M 0.10
 typedef struct polyc__rays {
     int on;                        /* the map comes from a single scan */
     double x, y, base, step;       /* origin, direction of beam 0, step */
@@ -207,6 +203,10 @@ int polyc__blocks_beams(const polyc__rays *rays, float ax, float ay, float bx, f
 /* fills old_xy with the segments of `segs` (start vertices, NONE skipped)
  * as they are now; returns their count (at most POLYC__EDIT_SEGS) */
 int polyc__edit_segments(const polyc__opt *o, const int32_t *segs, int n, float *old_xy);
+/* some return one of the old segments holds (holds_returns) is met by
+ * none of the new ones within the tolerance */
+int polyc__loses_returns(const polyc__rays *rays, const float *old_xy, int n_old,
+                         const float *new_xy, int n_new);
 int polyc__vertex_blocks(const polyc__opt *o, int32_t v, float x, float y);
 int polyc__holds_returns(const polyc__rays *rays, float ax, float ay, float bx, float by);
 float polyc__ray_position(const polyc__rays *rays, float ax, float ay, float bx, float by,

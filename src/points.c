@@ -206,8 +206,10 @@ polyc_status polyc__points_collect(polyc__opt *o)
     if (!o->pts || !tmp)
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the data points");
     int32_t n = 0;
-    polyc_status st = (o->cfg->flags & POLYC_FLAG_EXACT_POINTS) ? collect_raw(o, tmp, cap, &n)
-                                                                 : collect_cells(o, tmp, cap, &n);
+    /* one scan: a point per return, whose beam the ends are set by (a
+     * weighted point of several near returns would set them by their mean) */
+    int exact = (o->cfg->flags & POLYC_FLAG_EXACT_POINTS) || o->rays.on;
+    polyc_status st = exact ? collect_raw(o, tmp, cap, &n) : collect_cells(o, tmp, cap, &n);
     if (st != POLYC_OK)
         return st;
     /* counting sort by bucket: points of one bucket are contiguous */
@@ -234,7 +236,7 @@ polyc_status polyc__points_collect(polyc__opt *o)
     o->n = total;
     /* the span of one weighted point: gaps between points shorter than it
      * say nothing (split) */
-    o->point_span_m = (o->cfg->flags & POLYC_FLAG_EXACT_POINTS) ? 0.0f
+    o->point_span_m = exact ? 0.0f
                                                                : ctx->grid.cell_m * (float)BLOCK_SIDE;
     ctx->point_weight = total;
     ctx->stats.data_points = (uint64_t)total;

@@ -8,7 +8,10 @@
  * depth jump by distance alone; the beam order can. Two consecutive
  * endpoints belong to one surface unless the second lies farther than a
  * surface seen at LAMBDA or more to the beams would put it (the adaptive
- * breakpoint rule of Borges and Aldon, 2004). */
+ * breakpoint rule of Borges and Aldon, 2004). Beams whose return lies in
+ * front of the link between two endpoints (posts of a railing, a chair in
+ * front of a wall) do not break it: several chains can be open at once, and
+ * an endpoint joins the most recent one it links to. */
 #include "internal.h"
 
 #include <math.h>
@@ -19,9 +22,14 @@
 #define MAX_SKIP_NEAR 2      /* a chain bridges one beam without return, */
 #define MAX_SKIP 8           /* or seven going straight on (grazing walls) */
 
+#define MAX_OPEN (MAX_SKIP + 1) /* chains whose last hit is that recent */
+
 typedef struct chains {
     polyc_ctx *ctx;
     float *xy;                 /* every beam's endpoint; NaN without a hit */
+    const float *range;        /* every beam's range */
+    int32_t *chain_of;         /* per beam: its chain (first beam), -1 none */
+    int32_t cur;               /* the chain being emitted */
     uint8_t *keep;             /* per beam: a vertex of the simplified chain */
     float ox, oy;              /* the scan's origin */
     float step;                /* |angle step| */
@@ -30,8 +38,9 @@ typedef struct chains {
 
 size_t polyc__chains_bytes(const polyc_limits *lim)
 {
-    return polyc__add(polyc__bytes((size_t)lim->max_beams + 1, 2 * sizeof(float)),
-                      polyc__bytes((size_t)lim->max_beams + 1, 1));
+    size_t n = polyc__add(polyc__bytes((size_t)lim->max_beams + 1, 2 * sizeof(float)),
+                          polyc__bytes((size_t)lim->max_beams + 1, 1));
+    return polyc__add(n, polyc__bytes((size_t)lim->max_beams + 1, sizeof(int32_t)));
 }
 
 static int is_hit(const polyc__scan *s, float r)
@@ -53,6 +62,12 @@ static int has_point(const chains *c, int32_t i)
     return c->xy[2 * i] == c->xy[2 * i];
 }
 
+/* beam i has a hit of the chain being emitted */
+static int member(const chains *c, int32_t i)
+{
+    return c->chain_of[i] == c->cur;
+}
+
 /* Douglas-Peucker over the hits of beams [a, b], both hits: marks vertices
  * in c->keep. Without a stack (fixed memory): each pass splits every span
  * whose farthest point is beyond the tolerance, until none is. */
@@ -72,7 +87,7 @@ static void simplify(chains *c, int32_t a, int32_t b)
             while (!c->keep[j])
                 j++;
             for (int32_t k = i + 1; k < j; k++) {
-                if (!has_point(c, k))
+                if (!member(c, k))
                     continue;
                 float d = seg_dist2(&c->xy[2 * k], &c->xy[2 * i], &c->xy[2 * j]);
                 if (d > worst) {
@@ -135,7 +150,7 @@ static void fit(const chains *c, int32_t i, int32_t j, fitted *f)
 {
     float sx = 0.0f, sy = 0.0f, n = 0.0f;
     for (int32_t k = i; k <= j; k++)
-        if (has_point(c, k)) {
+        if (member(c, k)) {
             sx += c->xy[2 * k];
             sy += c->xy[2 * k + 1];
             n += 1.0f;
@@ -144,7 +159,7 @@ static void fit(const chains *c, int32_t i, int32_t j, fitted *f)
     f->cy = sy / n;
     float xx = 0.0f, xy = 0.0f, yy = 0.0f;
     for (int32_t k = i; k <= j; k++)
-        if (has_point(c, k)) {
+        if (member(c, k)) {
             float ex = c->xy[2 * k] - f->cx, ey = c->xy[2 * k + 1] - f->cy;
             xx += ex * ex;
             xy += ex * ey;
@@ -160,7 +175,7 @@ static void fit(const chains *c, int32_t i, int32_t j, fitted *f)
     by /= r;
     float lo = INFINITY, hi = -INFINITY, across = 0.0f, span = 2.0f * c->ctx->cfg.cell_m;
     for (int32_t k = i; k <= j; k++)
-        if (has_point(c, k)) {
+        if (member(c, k)) {
             float ex = c->xy[2 * k] - c->ox, ey = c->xy[2 * k + 1] - c->oy;
             float along = ex * bx + ey * by, side = fabsf(ey * bx - ex * by);
             lo = fminf(lo, along);
@@ -193,6 +208,32 @@ static int meet(const fitted *f, const fitted *g, float *x, float *y)
     return 1;
 }
 
+/* The end of a chain on its fitted line f, at beam i's hit: where beam i
+ * crosses the line, so that the beam meets the polyline (the hit's
+ * projection can lie on the wrong side of the beam when the range noise is
+ * as large as the beam spacing, as near the sensor); the projection if the
+ * beam runs within 3 degrees of the line or crosses it more than 50 cm from
+ * it. */
+static void end_on_line(const chains *c, const fitted *f, int32_t i, float *x, float *y)
+{
+    const float *p = &c->xy[2 * i];
+    project(f, p, x, y);
+    float bx = p[0] - c->ox, by = p[1] - c->oy, r = sqrtf(bx * bx + by * by);
+    if (r <= 0.0f)
+        return;
+    bx /= r;
+    by /= r;
+    float den = bx * f->dy - by * f->dx; /* sin(beam, line) */
+    if (fabsf(den) < 0.05f)
+        return;
+    float t = ((f->cx - c->ox) * f->dy - (f->cy - c->oy) * f->dx) / den;
+    float qx = c->ox + t * bx, qy = c->oy + t * by;
+    if (t > 0.0f && (qx - *x) * (qx - *x) + (qy - *y) * (qy - *y) <= 0.25f) {
+        *x = qx;
+        *y = qy;
+    }
+}
+
 /* (x, y) moved outwards from (ix, iy) by half a beam spacing at beam i */
 static void extend(const chains *c, int32_t i, float ix, float iy, float *x, float *y)
 {
@@ -213,6 +254,7 @@ static void extend(const chains *c, int32_t i, float ix, float iy, float *x, flo
 static polyc_status emit(chains *c, int32_t a, int32_t b)
 {
     polyc__store *s = &c->ctx->store;
+    c->cur = a;
     int32_t line = polyc__line_new(s);
     if (line == POLYC__NONE)
         return polyc__fail(c->ctx, POLYC_ERR_NOMEM, "too many polylines for limits.max_vertices");
@@ -230,7 +272,7 @@ static polyc_status emit(chains *c, int32_t a, int32_t b)
         j++;
     fit(c, i, j, &after);
     float x, y, ex, ey;
-    project(&after, &c->xy[2 * a], &x, &y);
+    end_on_line(c, &after, a, &x, &y);
     project(&after, &c->xy[2 * j], &ex, &ey);
     extend(c, a, ex, ey, &x, &y);
     polyc_status st = append(c, line, x, y);
@@ -257,10 +299,61 @@ static polyc_status emit(chains *c, int32_t a, int32_t b)
     }
     if (st != POLYC_OK)
         return st;
-    project(&after, &c->xy[2 * b], &x, &y);
+    end_on_line(c, &after, b, &x, &y);
     project(&after, &c->xy[2 * i], &ex, &ey);
     extend(c, b, ex, ey, &x, &y);
     return append(c, line, x, y);
+}
+
+typedef struct open_chain {
+    int32_t first, last, prev;     /* beams: first and last hit, the hit before last */
+} open_chain;
+
+/* Whether the hit of beam i continues chain h. The beams between them must
+ * have no return or one in front of the link (an occluder); one behind it
+ * saw through. Then the breakpoint rule over the angle between them (at
+ * most one beam without return), or, on a wall seen at a grazing angle,
+ * three hits in a line within GRAZING_REACH times that reach. */
+static int links(const chains *c, const open_chain *h, int32_t i, int32_t n)
+{
+    int32_t last = h->last;
+    if (i - last > MAX_SKIP)
+        return 0;
+    float lx = c->xy[2 * last], ly = c->xy[2 * last + 1];
+    float dx = c->xy[2 * i] - lx, dy = c->xy[2 * i + 1] - ly;
+    int missing = 0;
+    for (int32_t k = last + 1; k < i; k++) {
+        if (!has_point(c, k)) {
+            missing++;
+            continue;
+        }
+        /* where beam k crosses the link: the return must be in front */
+        float bx = c->xy[2 * k] - c->ox, by = c->xy[2 * k + 1] - c->oy;
+        float qx = lx - c->ox, qy = ly - c->oy;
+        float den = bx * dy - by * dx;  /* |beam| x link */
+        if (den == 0.0f)
+            return 0;
+        float t = (qx * dy - qy * dx) / den; /* in units of the return's range */
+        if (!(t > 1.0f + (float)POLYC__RAY_TOLERANCE_M / c->range[k]))
+            return 0;
+    }
+    float dphi = c->step; /* each beam between widens the reach by a step */
+    float reach = (float)(i - last) * c->range[last] * sinf(dphi) /
+                      sinf(polyc__maxf(LAMBDA_RAD - dphi, 0.01f)) +
+                  2.0f * c->ctx->cfg.cell_m;
+    float d2 = dx * dx + dy * dy;
+    if (missing < MAX_SKIP_NEAR && d2 <= reach * reach)
+        return 1;
+    if (d2 > GRAZING_REACH * GRAZING_REACH * reach * reach)
+        return 0;
+    /* a wall seen at a grazing angle: three points in a line, the chain's
+     * last two or the two with the next hit */
+    int32_t next = i + 1;
+    while (next < n && next - i <= MAX_SKIP && !has_point(c, next))
+        next++;
+    return (h->prev >= 0 && straight(c, h->prev, last, i)) ||
+           (next < n && next - i <= MAX_SKIP && straight(c, last, i, next) &&
+            dist2(c, i, next) <= GRAZING_REACH * GRAZING_REACH * reach * reach);
 }
 
 polyc_status polyc__chains_build(polyc_ctx *ctx)
@@ -275,55 +368,54 @@ polyc_status polyc__chains_build(polyc_ctx *ctx)
     c.ctx = ctx;
     c.xy = polyc__alloc(&ctx->arena, (size_t)n + 1, 2 * sizeof(float));
     c.keep = polyc__alloc(&ctx->arena, (size_t)n + 1, 1);
-    if (!c.xy || !c.keep)
+    c.chain_of = polyc__alloc(&ctx->arena, (size_t)n + 1, sizeof(int32_t));
+    if (!c.xy || !c.keep || !c.chain_of)
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the scan's chains");
     c.ox = s->x_m;
     c.oy = s->y_m;
     c.step = fabsf(s->step_rad);
     c.tol = ctx->cfg.cell_m;
+    c.cur = -1;
     const float *r = &ctx->ranges[s->first];
+    c.range = r;
     for (int32_t i = 0; i < n; i++) {
         float a = s->theta_rad + s->start_rad + (float)i * s->step_rad;
+        c.chain_of[i] = -1;
         c.xy[2 * i] = c.xy[2 * i + 1] = NAN;
         if (is_hit(s, r[i])) {
             c.xy[2 * i] = c.ox + r[i] * cosf(a);
             c.xy[2 * i + 1] = c.oy + r[i] * sinf(a);
         }
     }
-    /* chains: runs of hits where each is linked to the previous one */
-    int32_t first = -1, last = -1, prev = -1;
+    /* chains: hits linked to the last hit of an open chain */
+    open_chain open[MAX_OPEN];
+    int n_open = 0;
     for (int32_t i = 0; i <= n; i++) {
-        int hit = i < n && has_point(&c, i);
-        int linked = 0;
-        if (hit && last >= 0 && i - last <= MAX_SKIP) {
-            float dphi = c.step;   /* each missing beam widens the reach by a step */
-            float reach = (float)(i - last) * r[last] * sinf(dphi) / sinf(fmaxf(LAMBDA_RAD - dphi, 0.01f)) +
-                          2.0f * ctx->cfg.cell_m;
-            float dx = c.xy[2 * i] - c.xy[2 * last], dy = c.xy[2 * i + 1] - c.xy[2 * last + 1];
-            float d2 = dx * dx + dy * dy;
-            linked = i - last <= MAX_SKIP_NEAR && d2 <= reach * reach;
-            if (!linked && d2 <= GRAZING_REACH * GRAZING_REACH * reach * reach) {
-                /* a wall seen at a grazing angle: three points in a line,
-                 * the chain's last two or the two with the next hit */
-                int32_t next = i + 1;
-                while (next < n && next - i <= MAX_SKIP && !has_point(&c, next))
-                    next++;
-                linked = (prev >= 0 && straight(&c, prev, last, i)) ||
-                         (next < n && next - i <= MAX_SKIP && straight(&c, last, i, next) &&
-                          dist2(&c, i, next) <= GRAZING_REACH * GRAZING_REACH * reach * reach);
+        /* chains that no later hit can join any more go to the store */
+        for (int k = 0; k < n_open; k++)
+            if (i == n || i - open[k].last > MAX_SKIP) {
+                if ((st = emit(&c, open[k].first, open[k].last)) != POLYC_OK)
+                    return st;
+                open[k--] = open[--n_open];
             }
+        if (i == n || !has_point(&c, i))
+            continue;
+        /* the open chain with the most recent last hit that i links to */
+        int join = -1;
+        for (int k = 0; k < n_open; k++)
+            if ((join < 0 || open[k].last > open[join].last) && links(&c, &open[k], i, n))
+                join = k;
+        if (join < 0) {
+            /* a new chain (room: at most one chain ends at each of the
+             * last MAX_SKIP beams) */
+            open[n_open].first = open[n_open].last = i;
+            open[n_open].prev = -1;
+            join = n_open++;
+        } else {
+            open[join].prev = open[join].last;
+            open[join].last = i;
         }
-        if (first >= 0 && (i == n || (hit && !linked) || i - last > MAX_SKIP)) {
-            if ((st = emit(&c, first, last)) != POLYC_OK)
-                return st;
-            first = -1;
-        }
-        if (hit) {
-            if (first < 0)
-                first = i;
-            prev = first == i ? -1 : last;
-            last = i;
-        }
+        c.chain_of[i] = open[join].first;
     }
     ctx->arena.used = after_store;
     return POLYC_OK;

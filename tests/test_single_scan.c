@@ -180,6 +180,18 @@ static void test_near_returns_leave_gaps(void **state)
 }
 
 /* A wall seen at grazing angles is one chain, not a string of single hits. */
+/* Beams whose return lies in front (the posts) do not break the chain of
+ * the wall behind them: 8 posts and one wall. */
+static void test_occluders_do_not_break_chains(void **state)
+{
+    (void)state;
+    one_map m;
+    scene_map(&m, posts, 0, 0);
+    assert_int_equal(m.stats.polylines, 9);
+    assert_true(m.score.f >= 0.99);
+    done(&m);
+}
+
 static void test_grazing_wall_is_one_chain(void **state)
 {
     (void)state;
@@ -202,6 +214,9 @@ static void check_optimised(void (*scene)(scansim_scene *))
     assert_true(m.score.f >= 0.95);
     assert_true(m.score.ray_rmse_m <= 0.04);
     assert_true(m.worst_short_m > -POLYC__RAY_TOLERANCE_M - 0.03);
+    /* nor does any beam pass its return to meet the map farther on */
+    assert_true(m.worst_long_m < POLYC__RAY_TOLERANCE_M + 0.03);
+    assert_true(m.score.f >= 0.99);
     done(&m);
 }
 
@@ -317,8 +332,8 @@ static void test_holds_returns(void **state)
     /* in front of them or behind them: not theirs */
     assert_false(polyc__holds_returns(&r, 1.5f, -0.05f, 1.5f, 0.05f));
     assert_false(polyc__holds_returns(&r, 2.5f, -0.05f, 2.5f, 0.05f));
-    /* along a beam (grazing): no witness */
-    assert_false(polyc__holds_returns(&r, 1.95f, 0.0f, 2.05f, 0.0001f));
+    /* along a beam through its return: held too */
+    assert_true(polyc__holds_returns(&r, 1.95f, 0.0f, 2.05f, 0.0001f));
     /* a no-return beam holds nothing; a far return is held */
     float a = (float)(5.0 * r.step), e = (float)(90.0 * r.step);
     assert_false(polyc__holds_returns(&r, 2.0f * cosf(a) - 0.005f * sinf(a),
@@ -333,11 +348,38 @@ static void test_holds_returns(void **state)
     assert_false(polyc__holds_returns(&r, 2.0f, -0.05f, 2.0f, 0.05f));
 }
 
+/* An edit may not leave a return its old segments held without a new
+ * segment that meets its beam within the tolerance. */
+static void test_loses_returns(void **state)
+{
+    (void)state;
+    float range[360];
+    polyc__rays r;
+    full_turn(&r, range);
+    const float old_xy[4] = {2.0f, -0.05f, 2.0f, 0.05f};
+    const float same[4] = {2.0f, -0.05f, 2.0f, 0.05f};
+    const float near[4] = {2.05f, -0.06f, 1.98f, 0.06f}; /* within the tolerance */
+    const float short_xy[4] = {2.0f, 0.01f, 2.0f, 0.05f};  /* beam 0 passes below it */
+    const float behind[4] = {2.5f, -0.06f, 2.5f, 0.06f};
+    assert_false(polyc__loses_returns(&r, old_xy, 1, same, 1));
+    assert_false(polyc__loses_returns(&r, old_xy, 1, near, 1));
+    assert_true(polyc__loses_returns(&r, old_xy, 1, short_xy, 1));
+    assert_true(polyc__loses_returns(&r, old_xy, 1, behind, 1));
+    assert_true(polyc__loses_returns(&r, old_xy, 1, NULL, 0));
+    /* two new segments sharing the returns */
+    const float split[8] = {2.0f, -0.05f, 2.0f, 0.0f, 2.0f, 0.0f, 2.0f, 0.05f};
+    assert_false(polyc__loses_returns(&r, old_xy, 1, split, 2));
+    r.on = 0;
+    assert_false(polyc__loses_returns(&r, old_xy, 1, NULL, 0));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_blocks_beams),
         cmocka_unit_test(test_holds_returns),
+        cmocka_unit_test(test_loses_returns),
+        cmocka_unit_test(test_occluders_do_not_break_chains),
         cmocka_unit_test(test_chains_follow_the_beams),
         cmocka_unit_test(test_grazing_wall_is_one_chain),
         cmocka_unit_test(test_near_returns_leave_gaps),
