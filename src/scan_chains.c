@@ -28,8 +28,8 @@ typedef struct chains {
     polyc_ctx *ctx;
     float *xy;                 /* every beam's endpoint; NaN without a hit */
     const float *range;        /* every beam's range */
-    int32_t *chain_of;         /* per beam: its chain (first beam), -1 none */
-    int32_t cur;               /* the chain being emitted */
+    uint8_t *chain_of;         /* per beam: its chain's slot, 0 none */
+    uint8_t cur;               /* the slot of the chain being emitted */
     uint8_t *keep;             /* per beam: a vertex of the simplified chain */
     float ox, oy;              /* the scan's origin */
     float step;                /* |angle step| */
@@ -40,7 +40,7 @@ size_t polyc__chains_bytes(const polyc_limits *lim)
 {
     size_t n = polyc__add(polyc__bytes((size_t)lim->max_beams + 1, 2 * sizeof(float)),
                           polyc__bytes((size_t)lim->max_beams + 1, 1));
-    return polyc__add(n, polyc__bytes((size_t)lim->max_beams + 1, sizeof(int32_t)));
+    return polyc__add(n, polyc__bytes((size_t)lim->max_beams + 1, 1));
 }
 
 static int is_hit(const polyc__scan *s, float r)
@@ -254,7 +254,6 @@ static void extend(const chains *c, int32_t i, float ix, float iy, float *x, flo
 static polyc_status emit(chains *c, int32_t a, int32_t b)
 {
     polyc__store *s = &c->ctx->store;
-    c->cur = a;
     int32_t line = polyc__line_new(s);
     if (line == POLYC__NONE)
         return polyc__fail(c->ctx, POLYC_ERR_NOMEM, "too many polylines for limits.max_vertices");
@@ -305,8 +304,13 @@ static polyc_status emit(chains *c, int32_t a, int32_t b)
     return append(c, line, x, y);
 }
 
+/* An open chain. Its slot (1..MAX_OPEN) marks its beams in chain_of: a
+ * slot is free again once its chain is emitted, and a chain that takes it
+ * later starts past that chain's last beam, so a slot names one chain
+ * within any chain's span. */
 typedef struct open_chain {
     int32_t first, last, prev;     /* beams: first and last hit, the hit before last */
+    uint8_t slot;
 } open_chain;
 
 /* Whether the hit of beam i continues chain h. The beams between them must
@@ -368,19 +372,19 @@ polyc_status polyc__chains_build(polyc_ctx *ctx)
     c.ctx = ctx;
     c.xy = polyc__alloc(&ctx->arena, (size_t)n + 1, 2 * sizeof(float));
     c.keep = polyc__alloc(&ctx->arena, (size_t)n + 1, 1);
-    c.chain_of = polyc__alloc(&ctx->arena, (size_t)n + 1, sizeof(int32_t));
+    c.chain_of = polyc__alloc(&ctx->arena, (size_t)n + 1, 1);
     if (!c.xy || !c.keep || !c.chain_of)
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the scan's chains");
     c.ox = s->x_m;
     c.oy = s->y_m;
     c.step = fabsf(s->step_rad);
     c.tol = ctx->cfg.cell_m;
-    c.cur = -1;
+    c.cur = 0;
     const float *r = &ctx->ranges[s->first];
     c.range = r;
     for (int32_t i = 0; i < n; i++) {
         float a = s->theta_rad + s->start_rad + (float)i * s->step_rad;
-        c.chain_of[i] = -1;
+        c.chain_of[i] = 0;
         c.xy[2 * i] = c.xy[2 * i + 1] = NAN;
         if (is_hit(s, r[i])) {
             c.xy[2 * i] = c.ox + r[i] * cosf(a);
@@ -390,12 +394,15 @@ polyc_status polyc__chains_build(polyc_ctx *ctx)
     /* chains: hits linked to the last hit of an open chain */
     open_chain open[MAX_OPEN];
     int n_open = 0;
+    uint32_t slots_used = 0; /* bit s - 1: slot s */
     for (int32_t i = 0; i <= n; i++) {
         /* chains that no later hit can join any more go to the store */
         for (int k = 0; k < n_open; k++)
             if (i == n || i - open[k].last > MAX_SKIP) {
+                c.cur = open[k].slot;
                 if ((st = emit(&c, open[k].first, open[k].last)) != POLYC_OK)
                     return st;
+                slots_used &= ~(1u << (open[k].slot - 1));
                 open[k--] = open[--n_open];
             }
         if (i == n || !has_point(&c, i))
@@ -408,14 +415,19 @@ polyc_status polyc__chains_build(polyc_ctx *ctx)
         if (join < 0) {
             /* a new chain (room: at most one chain ends at each of the
              * last MAX_SKIP beams) */
+            uint8_t slot = 1;
+            while (slots_used & (1u << (slot - 1)))
+                slot++;
+            slots_used |= 1u << (slot - 1);
             open[n_open].first = open[n_open].last = i;
             open[n_open].prev = -1;
+            open[n_open].slot = slot;
             join = n_open++;
         } else {
             open[join].prev = open[join].last;
             open[join].last = i;
         }
-        c.chain_of[i] = open[join].first;
+        c.chain_of[i] = open[join].slot;
     }
     ctx->arena.used = after_store;
     return POLYC_OK;
