@@ -162,7 +162,7 @@ int polyc__hill_climb(polyc__opt *o, int32_t v)
     if (gamma > 0.0f)
         places_init(o, v, &pl);
     double cur = polyc__local_current(o) + (double)gamma * local_angles(o, &pl, v, x, y);
-    int moved = 0, last = -1;
+    int moved = 0, last = -1, limited = 1;
     for (int it = 0; it < 64; it++) {
         double best = cur;
         int best_d = -1;
@@ -174,8 +174,10 @@ int polyc__hill_climb(polyc__opt *o, int32_t v)
             if (d < 0 || (k > 0 && (d == last || (last >= 0 && d == (last + 4) % 8))))
                 continue;
             float cx = x + step * DIR_X[d], cy = y + step * DIR_Y[d];
-            if ((cx - x0) * (cx - x0) + (cy - y0) * (cy - y0) > reach * reach)
+            if ((cx - x0) * (cx - x0) + (cy - y0) * (cy - y0) > reach * reach) {
+                limited = 2;
                 continue;
+            }
             ns = segs_at(o, v, cx, cy, xy);
             double e = polyc__local_eval(o, xy, ns) + (double)gamma * local_angles(o, &pl, v, cx, cy);
             if (e < best - 1e-12 * (1.0 + fabs(best))) {
@@ -185,8 +187,11 @@ int polyc__hill_climb(polyc__opt *o, int32_t v)
                     break;
             }
         }
-        if (best_d < 0)
+        if (best_d < 0) {
+            limited = limited == 2 ? 2 : 0;
             break;
+        }
+        limited = 1;
         x += step * DIR_X[best_d];
         y += step * DIR_Y[best_d];
         cur = best;
@@ -198,7 +203,7 @@ int polyc__hill_climb(polyc__opt *o, int32_t v)
     if (!moved || (o->rays.on && polyc__vertex_blocks(o, v, x, y) && !polyc__vertex_blocks(o, v, x0, y0)))
         return 0;
     commit_move(o, v, x, y);
-    return 1;
+    return limited ? 2 : 1;
 }
 
 /* Rounds of hill climbing; after the first, only vertices next to one that
@@ -218,10 +223,12 @@ int polyc__op_adjust(polyc__opt *o, int max_rounds, uint32_t since)
         for (int32_t v = 0; v < s->v_high; v++) {
             if (o->v_work[v] != stamp || s->v[v].line == POLYC__NONE)
                 continue;
-            if (!polyc__hill_climb(o, v))
+            int how = polyc__hill_climb(o, v);
+            if (!how)
                 continue;
             moved++;
-            o->v_work[v] = next;
+            if (how == 2 || !o->rays.on)
+                o->v_work[v] = next;
             int32_t nb[4] = {s->v[v].prev, s->v[v].next, POLYC__NONE, POLYC__NONE};
             if (nb[0] != POLYC__NONE) nb[2] = s->v[nb[0]].prev;
             if (nb[1] != POLYC__NONE) nb[3] = s->v[nb[1]].next;
