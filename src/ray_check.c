@@ -182,17 +182,35 @@ typedef int (*beam_test)(const polyc__rays *rays, int32_t i, double c, double sn
 /* Whether `test` holds for some beam whose direction crosses segment a-b.
  * The directions of a run of beams come from rotating the first by the
  * step: one cosine and sine per run, not per beam. */
+/* The direction of (x, y) in (-pi, pi], to within 2e-6 rad (polyc__turn_rad:
+ * libm's atan2 was a tenth of the ray checks' time) */
+static double angle_of(double x, double y)
+{
+    double a = (double)polyc__turn_rad((float)y, (float)x);
+    return y < 0.0 ? -a : a;
+}
+
+/* d wrapped into [-pi, pi] */
+static double wrap(double d)
+{
+    return d - TWO_PI * floor(d / TWO_PI + 0.5);
+}
+
 static int any_beam(const polyc__rays *rays, const beam_query *q, beam_test test)
 {
     float ax = q->ax, ay = q->ay, bx = q->bx, by = q->by;
     if (!rays->on || rays->step == 0.0)
         return 0;
-    double ta = atan2((double)ay - rays->y, (double)ax - rays->x);
-    double tb = atan2((double)by - rays->y, (double)bx - rays->x);
-    /* beam index space: the segment covers [ia, ib] the short way round */
-    double ia = remainder(ta - rays->base, TWO_PI) / rays->step;
-    double span = remainder(tb - ta, TWO_PI) / rays->step;
+    double ta = angle_of((double)ax - rays->x, (double)ay - rays->y);
+    double tb = angle_of((double)bx - rays->x, (double)by - rays->y);
+    /* beam index space: the segment covers [ia, ib] the short way round,
+     * widened by a hundredth of a beam for the angles' error (a beam that
+     * does not cross the segment passes every test) */
+    double ia = wrap(ta - rays->base) / rays->step;
+    double span = wrap(tb - ta) / rays->step;
     double lo = span < 0.0 ? ia + span : ia, hi = span < 0.0 ? ia : ia + span;
+    lo -= 0.01;
+    hi += 0.01;
     /* lo, hi lie in [-turn, turn]: beam i is index i, i - turn or i + turn
      * (bounded by the beam count, however fine the step) */
     int32_t offsets[3] = {0, rays->turn, -rays->turn};
