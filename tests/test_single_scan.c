@@ -179,27 +179,29 @@ static void test_near_returns_leave_gaps(void **state)
     done(&m);
 }
 
-/* A wall seen at grazing angles is one chain, not a string of single hits. */
+/* The initial polylines of `scene`: `chains` of them, every beam on the map. */
+static void check_chains(void (*scene)(scansim_scene *), uint32_t chains)
+{
+    one_map m;
+    scene_map(&m, scene, 0, 0);
+    assert_int_equal(m.stats.polylines, chains);
+    assert_true(m.score.f >= 0.99);
+    done(&m);
+}
+
 /* Beams whose return lies in front (the posts) do not break the chain of
  * the wall behind them: 8 posts and one wall. */
 static void test_occluders_do_not_break_chains(void **state)
 {
     (void)state;
-    one_map m;
-    scene_map(&m, posts, 0, 0);
-    assert_int_equal(m.stats.polylines, 9);
-    assert_true(m.score.f >= 0.99);
-    done(&m);
+    check_chains(posts, 9);
 }
 
+/* A wall seen at grazing angles is one chain, not a string of single hits. */
 static void test_grazing_wall_is_one_chain(void **state)
 {
     (void)state;
-    one_map m;
-    scene_map(&m, corridor, 0, 0);
-    assert_int_equal(m.stats.polylines, 2);
-    assert_true(m.score.f >= 0.99);
-    done(&m);
+    check_chains(corridor, 2);
 }
 
 /* The optimised map of one scan: compact, and still true along the beams:
