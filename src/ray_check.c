@@ -165,7 +165,7 @@ static int beam_blocked(const polyc__rays *rays, int32_t i, double c, double sn,
  * RMSE from 115 to 188 mm, with ends kept decimetres off along beams 25-40 m
  * long. With that rule, and polyc__loses_returns, holding every return
  * keeps every reflected beam on the map at no ray error: measured on 10
- * scans of each real log, f >= 0.9997 and ray RMSE <= 29 mm everywhere.) */
+ * scans of each real log, f >= 0.999 and ray RMSE <= 29 mm everywhere.) */
 static int beam_own(const polyc__rays *rays, int32_t i, double c, double sn, const beam_query *q)
 {
     float ax = q->ax, ay = q->ay, bx = q->bx, by = q->by;
