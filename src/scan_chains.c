@@ -316,8 +316,9 @@ typedef struct open_chain {
 /* Whether the hit of beam i continues chain h. The beams between them must
  * have no return or one in front of the link (an occluder); one behind it
  * saw through. Then the breakpoint rule over the angle between them (at
- * most one beam without return), or, on a wall seen at a grazing angle,
- * three hits in a line within GRAZING_REACH times that reach. */
+ * most one beam without return), or, on a wall seen at a grazing angle and
+ * with no occluder between, three hits in a line within GRAZING_REACH
+ * times that reach. */
 static int links(const chains *c, const open_chain *h, int32_t i, int32_t n)
 {
     int32_t last = h->last;
@@ -325,12 +326,13 @@ static int links(const chains *c, const open_chain *h, int32_t i, int32_t n)
         return 0;
     float lx = c->xy[2 * last], ly = c->xy[2 * last + 1];
     float dx = c->xy[2 * i] - lx, dy = c->xy[2 * i + 1] - ly;
-    int missing = 0;
+    int missing = 0, occluders = 0;
     for (int32_t k = last + 1; k < i; k++) {
         if (!has_point(c, k)) {
             missing++;
             continue;
         }
+        occluders++;
         /* where beam k crosses the link: the return must be in front */
         float bx = c->xy[2 * k] - c->ox, by = c->xy[2 * k + 1] - c->oy;
         float qx = lx - c->ox, qy = ly - c->oy;
@@ -348,7 +350,10 @@ static int links(const chains *c, const open_chain *h, int32_t i, int32_t n)
     float d2 = dx * dx + dy * dy;
     if (missing < MAX_SKIP_NEAR && d2 <= reach * reach)
         return 1;
-    if (d2 > GRAZING_REACH * GRAZING_REACH * reach * reach)
+    /* (not behind occluders: hits receding along the beams behind a near
+     * object, three of them in a line, are not a wall seen at a grazing
+     * angle; such a link ran 1.2 m along a beam of csail's) */
+    if (occluders > 0 || d2 > GRAZING_REACH * GRAZING_REACH * reach * reach)
         return 0;
     /* a wall seen at a grazing angle: three points in a line, the chain's
      * last two or the two with the next hit */
