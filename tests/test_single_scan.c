@@ -197,6 +197,68 @@ static void test_occluders_do_not_break_chains(void **state)
     check_chains(posts, 9);
 }
 
+/* Hits receding along the beams behind a near object are not a wall seen at
+ * a grazing angle: a 0.5-degree scan whose beam 79 returns at 2.4 m, beams
+ * 80-86 at 0.9 m (the object), and beams 87 and 88 on the line from beam
+ * 79's return to a point 1 m out on beam 89. Beam 79 stays out of their
+ * chain. */
+static void test_no_grazing_link_behind_occluders(void **state)
+{
+    (void)state;
+    enum { N = 361 };
+    float range[N];
+    const double step = PI / 360.0, start = -PI / 2.0;
+    double ax = 2.4 * cos(start + 79 * step), ay = 2.4 * sin(start + 79 * step);
+    double qx = 1.0 * cos(start + 89 * step), qy = 1.0 * sin(start + 89 * step);
+    for (int i = 0; i < N; i++)
+        range[i] = 5.0f;
+    range[79] = 2.4f;
+    for (int i = 80; i <= 86; i++)
+        range[i] = 0.9f;
+    for (int i = 87; i <= 88; i++) {
+        /* where beam i meets the line a-q */
+        double c = cos(start + i * step), sn = sin(start + i * step);
+        double ex = qx - ax, ey = qy - ay;
+        range[i] = (float)((ax * ey - ay * ex) / (c * ey - sn * ex));
+    }
+    polyc_scan scan;
+    memset(&scan, 0, sizeof scan);
+    scan.start_angle_rad = (float)start;
+    scan.angle_step_rad = (float)step;
+    scan.min_range_m = 0.05f;
+    scan.max_range_m = 30.0f;
+    scan.beam_count = N;
+    scan.range_m = range;
+    polyc_config c;
+    polyc_limits lim;
+    polyc_ctx *ctx;
+    polyc_config_default(&c);
+    assert_int_equal(polyc_limits_for_scans(&c, &scan, 1, &lim), POLYC_OK);
+    size_t size = polyc_memory_size(&c, &lim);
+    void *block = malloc(size);
+    assert_non_null(block);
+    assert_int_equal(polyc_init(block, size, &c, &lim, &ctx), POLYC_OK);
+    assert_int_equal(polyc_add_scan(ctx, &scan), POLYC_OK);
+    assert_int_equal(polyc_build_grid(ctx), POLYC_OK);
+    assert_int_equal(polyc_trace(ctx), POLYC_OK);
+    double bx = (double)range[88] * cos(start + 88 * step), by = (double)range[88] * sin(start + 88 * step);
+    int found88 = 0;
+    for (uint32_t l = 0; l < polyc_polyline_count(ctx); l++) {
+        polyc_polyline pl;
+        assert_int_equal(polyc_get_polyline(ctx, l, &pl), POLYC_OK);
+        int near79 = 0, near88 = 0;
+        for (uint32_t k = 0; k < pl.point_count; k++) {
+            double x = pl.xy_m[2 * k], y = pl.xy_m[2 * k + 1];
+            near79 |= hypot(x - ax, y - ay) < 0.05;
+            near88 |= hypot(x - bx, y - by) < 0.05;
+        }
+        found88 |= near88;
+        assert_false(near79 && near88);
+    }
+    assert_true(found88);
+    free(block);
+}
+
 /* A wall seen at grazing angles is one chain, not a string of single hits. */
 static void test_grazing_wall_is_one_chain(void **state)
 {
@@ -382,6 +444,7 @@ int main(void)
         cmocka_unit_test(test_holds_returns),
         cmocka_unit_test(test_loses_returns),
         cmocka_unit_test(test_occluders_do_not_break_chains),
+        cmocka_unit_test(test_no_grazing_link_behind_occluders),
         cmocka_unit_test(test_chains_follow_the_beams),
         cmocka_unit_test(test_grazing_wall_is_one_chain),
         cmocka_unit_test(test_near_returns_leave_gaps),
