@@ -145,7 +145,9 @@ static void commit_move(polyc__opt *o, int32_t v, float x, float y)
 }
 
 /* Moves v by steps of step_m while the local score (error plus gamma times
- * the angle terms) falls; the move is then committed as one change. */
+ * the angle terms) falls; the move is then committed as one change.
+ * Returns 0 if v did not move, 1 if it stopped at a local optimum, 2 if it
+ * moved but stopped at the reach or the step cap (worth climbing again). */
 int polyc__hill_climb(polyc__opt *o, int32_t v)
 {
     const polyc__vertex *V = o->s->v;
@@ -162,8 +164,10 @@ int polyc__hill_climb(polyc__opt *o, int32_t v)
     if (gamma > 0.0f)
         places_init(o, v, &pl);
     double cur = polyc__local_current(o) + (double)gamma * local_angles(o, &pl, v, x, y);
-    int moved = 0, last = -1, limited = 1;
+    int moved = 0, last = -1;
+    int optimum = 0, cut = 0; /* no better trial in the last round; some trial was beyond reach */
     for (int it = 0; it < 64; it++) {
+        cut = 0;
         double best = cur;
         int best_d = -1;
         /* the direction that paid last time first: if it pays again, take
@@ -175,7 +179,7 @@ int polyc__hill_climb(polyc__opt *o, int32_t v)
                 continue;
             float cx = x + step * DIR_X[d], cy = y + step * DIR_Y[d];
             if ((cx - x0) * (cx - x0) + (cy - y0) * (cy - y0) > reach * reach) {
-                limited = 2;
+                cut = 1;
                 continue;
             }
             ns = segs_at(o, v, cx, cy, xy);
@@ -188,10 +192,9 @@ int polyc__hill_climb(polyc__opt *o, int32_t v)
             }
         }
         if (best_d < 0) {
-            limited = limited == 2 ? 2 : 0;
+            optimum = 1;
             break;
         }
-        limited = 1;
         x += step * DIR_X[best_d];
         y += step * DIR_Y[best_d];
         cur = best;
@@ -203,7 +206,7 @@ int polyc__hill_climb(polyc__opt *o, int32_t v)
     if (!moved || (o->rays.on && polyc__vertex_blocks(o, v, x, y) && !polyc__vertex_blocks(o, v, x0, y0)))
         return 0;
     commit_move(o, v, x, y);
-    return limited ? 2 : 1;
+    return optimum && !cut ? 1 : 2;
 }
 
 /* Rounds of hill climbing; after the first, only vertices next to one that

@@ -236,8 +236,7 @@ polyc_status polyc__points_collect(polyc__opt *o)
     o->n = total;
     /* the span of one weighted point: gaps between points shorter than it
      * say nothing (split) */
-    o->point_span_m = exact ? 0.0f
-                                                               : ctx->grid.cell_m * (float)BLOCK_SIDE;
+    o->point_span_m = exact ? 0.0f : ctx->grid.cell_m * (float)BLOCK_SIDE;
     ctx->point_weight = total;
     ctx->stats.data_points = (uint64_t)total;
     ctx->stats.weighted_points = (uint32_t)n;

@@ -116,13 +116,26 @@ int polyc__vertex_blocks(const polyc__opt *o, int32_t v, float x, float y)
     return polyc__loses_returns(&o->rays, old_xy, n_old, new_xy, n_new);
 }
 
-/* A segment a-b to test beams against, and the segments the edit that
- * makes it replaces. */
+/* A segment a-b to test beams against, and a list of other segments (x0 y0
+ * x1 y1 each): for blocks_beams those the edit replaces, for loses_returns
+ * those that replace a-b. */
 typedef struct beam_query {
     float ax, ay, bx, by;
-    const float *old_xy;
-    int n_old;
+    const float *others;
+    int n_others;
 } beam_query;
+
+/* Whether one of the n segments in xy meets beam (c, sn) within the
+ * tolerance of range r. */
+static int met_by_any(const polyc__rays *rays, double c, double sn, float r, const float *xy, int n)
+{
+    for (int k = 0; k < n; k++) {
+        const float *e = xy + 4 * k;
+        if (fabs(range_to(rays, c, sn, e[0], e[1], e[2], e[3]) - (double)r) <= rays->tol_m)
+            return 1;
+    }
+    return 0;
+}
 
 /* Beam i against the query's segment: 1 if the segment stands in front of
  * its return, or behind it while the return is its own: near its line, or
@@ -149,11 +162,7 @@ static int beam_blocked(const polyc__rays *rays, int32_t i, double c, double sn,
         double cr = px * ey - py * ex;
         if (cr * cr < rays->own_m * rays->own_m * (ex * ex + ey * ey))
             return 1;
-        for (int k = 0; k < q->n_old; k++) {
-            const float *e = q->old_xy + 4 * k;
-            if (fabs(range_to(rays, c, sn, e[0], e[1], e[2], e[3]) - (double)r) <= rays->tol_m)
-                return 1;
-        }
+        return met_by_any(rays, c, sn, r, q->others, q->n_others);
     }
     return 0;
 }
@@ -179,9 +188,6 @@ static int beam_own(const polyc__rays *rays, int32_t i, double c, double sn, con
 typedef int (*beam_test)(const polyc__rays *rays, int32_t i, double c, double sn,
                          const beam_query *q);
 
-/* Whether `test` holds for some beam whose direction crosses segment a-b.
- * The directions of a run of beams come from rotating the first by the
- * step: one cosine and sine per run, not per beam. */
 /* The direction of (x, y) in (-pi, pi], to within 2e-6 rad (polyc__turn_rad:
  * libm's atan2 was a tenth of the ray checks' time) */
 static double angle_of(double x, double y)
@@ -196,6 +202,9 @@ static double wrap(double d)
     return d - TWO_PI * floor(d / TWO_PI + 0.5);
 }
 
+/* Whether `test` holds for some beam whose direction crosses segment a-b.
+ * The directions of a run of beams come from rotating the first by the
+ * step: one cosine and sine per run, not per beam. */
 static int any_beam(const polyc__rays *rays, const beam_query *q, beam_test test)
 {
     float ax = q->ax, ay = q->ay, bx = q->bx, by = q->by;
@@ -246,17 +255,11 @@ int polyc__holds_returns(const polyc__rays *rays, float ax, float ay, float bx, 
 }
 
 /* A return the query's (old) segment holds that none of the new segments
- * (q->old_xy here) meets within the tolerance. */
+ * (the query's others) meets within the tolerance. */
 static int beam_lost(const polyc__rays *rays, int32_t i, double c, double sn, const beam_query *q)
 {
-    if (!beam_own(rays, i, c, sn, q))
-        return 0;
-    for (int k = 0; k < q->n_old; k++) {
-        const float *e = q->old_xy + 4 * k;
-        if (fabs(range_to(rays, c, sn, e[0], e[1], e[2], e[3]) - (double)rays->range[i]) <= rays->tol_m)
-            return 0;
-    }
-    return 1;
+    return beam_own(rays, i, c, sn, q) &&
+           !met_by_any(rays, c, sn, rays->range[i], q->others, q->n_others);
 }
 
 int polyc__loses_returns(const polyc__rays *rays, const float *old_xy, int n_old,
