@@ -224,8 +224,9 @@ static int any_beam(const polyc__rays *rays, const beam_query *q, beam_test test
      * (bounded by the beam count, however fine the step) */
     int32_t offsets[3] = {0, rays->turn, -rays->turn};
     for (int k = 0; k < (rays->turn > 0 ? 3 : 1); k++) {
-        double from = fmax(ceil(lo), (double)offsets[k]);
-        double to = fmin(hi, (double)offsets[k] + (double)rays->count - 1.0);
+        double from = ceil(lo), to = (double)offsets[k] + (double)rays->count - 1.0;
+        from = from > (double)offsets[k] ? from : (double)offsets[k];
+        to = hi < to ? hi : to;
         if (!(from <= to))
             continue;
         double a = rays->base + (from - (double)offsets[k]) * rays->step;

@@ -178,9 +178,9 @@ static void fit(const chains *c, int32_t i, int32_t j, fitted *f)
         if (member(c, k)) {
             float ex = c->xy[2 * k] - c->ox, ey = c->xy[2 * k + 1] - c->oy;
             float along = ex * bx + ey * by, side = fabsf(ey * bx - ex * by);
-            lo = fminf(lo, along);
-            hi = fmaxf(hi, along);
-            across = fmaxf(across, side);
+            lo = polyc__minf(lo, along);
+            hi = polyc__maxf(hi, along);
+            across = polyc__maxf(across, side);
         }
     if (hi - lo <= span && 2.0f * across <= span) {
         f->dx = -by;

@@ -47,23 +47,23 @@ polyc_status polyc__spacing_build(polyc_ctx *ctx, polyc__spacing *sp)
     for (int32_t y = 0; y < sp->h; y++)
         for (int32_t x = 0; x < sp->w; x++) {
             float *d = &sp->dist[(size_t)y * (size_t)sp->w + (size_t)x];
-            if (x > 0) *d = fminf(*d, d[-1] + a);
+            if (x > 0) *d = polyc__minf(*d, d[-1] + a);
             if (y > 0) {
                 const float *up = d - sp->w;
-                *d = fminf(*d, up[0] + a);
-                if (x > 0) *d = fminf(*d, up[-1] + b);
-                if (x + 1 < sp->w) *d = fminf(*d, up[1] + b);
+                *d = polyc__minf(*d, up[0] + a);
+                if (x > 0) *d = polyc__minf(*d, up[-1] + b);
+                if (x + 1 < sp->w) *d = polyc__minf(*d, up[1] + b);
             }
         }
     for (int32_t y = sp->h - 1; y >= 0; y--)
         for (int32_t x = sp->w - 1; x >= 0; x--) {
             float *d = &sp->dist[(size_t)y * (size_t)sp->w + (size_t)x];
-            if (x + 1 < sp->w) *d = fminf(*d, d[1] + a);
+            if (x + 1 < sp->w) *d = polyc__minf(*d, d[1] + a);
             if (y + 1 < sp->h) {
                 const float *dn = d + sp->w;
-                *d = fminf(*d, dn[0] + a);
-                if (x + 1 < sp->w) *d = fminf(*d, dn[1] + b);
-                if (x > 0) *d = fminf(*d, dn[-1] + b);
+                *d = polyc__minf(*d, dn[0] + a);
+                if (x + 1 < sp->w) *d = polyc__minf(*d, dn[1] + b);
+                if (x > 0) *d = polyc__minf(*d, dn[-1] + b);
             }
         }
     return POLYC_OK;
