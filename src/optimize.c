@@ -217,7 +217,8 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
          * on purpose, and a run of them all worse than iteration 0 stopped
          * infinite-corridor at iteration 5 with 5,766 vertices (3,793 when
          * the noise is allowed to decay) */
-        quiet = bic < best - 1.0 ? 0 : (noise > 0.0 ? quiet : quiet + 1);
+        int gained = bic < best - 1.0;
+        quiet = gained ? 0 : (noise > 0.0 ? quiet : quiet + 1);
         if (bic < best - 1e-9 * fabs(best)) {
             best = bic;
             polyc__flat_from_store(&o.best, o.s);
@@ -245,6 +246,12 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
          * the same best map. */
         int noisy_later = !o.rays.on && sigma >= 0.5 * (double)cfg->step_m;
         if (!noisy_later && !edited_since(&o, start))
+            break;
+        /* A single scan has no noise either: an iteration that gained less
+         * than one BIC unit leaves so little edited that the next ones gain
+         * nothing measurable (the 130 bench scans: 4 vertices more in
+         * all, the same f and ray RMSE, 4 % fewer instructions) */
+        if (o.rays.on && !gained)
             break;
     }
     ctx->stats.iterations = it < cfg->max_iterations ? it + (result == POLYC_OK) : it;
