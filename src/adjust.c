@@ -126,6 +126,7 @@ static void commit_move(polyc__opt *o, int32_t v, float x, float y)
         }
         o->err += c - o->pt_cost[i];
         o->pt_cost[i] = c;
+        polyc__split_due_pt(o, o->pt_seg[i], sg);
         o->pt_seg[i] = sg;
     }
     /* the aggregated points: on their segment, whatever the move */
@@ -135,6 +136,7 @@ static void commit_move(polyc__opt *o, int32_t v, float x, float y)
             double c = polyc__cost(&o->pts[i], xy[4 * j], xy[4 * j + 1], xy[4 * j + 2], xy[4 * j + 3]);
             o->err += c - o->pt_cost[i];
             o->pt_cost[i] = c;
+            polyc__split_due_pt(o, o->pt_seg[i], id[j]);
             o->pt_seg[i] = id[j];
         }
     for (int k = 0; k < 3; k++)

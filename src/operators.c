@@ -412,24 +412,30 @@ static int no_gap_over(const float *t, int32_t n, float len, float gap)
 /* A segment with a stretch longer than split_gap_m (or 2.5 beam spacings
  * where the data are sparser than that), plus the span of a weighted point,
  * onto which no data point projects is cut there: the polyline ends on
- * either side of the gap. */
+ * either side of the gap. Only the segments split_due are looked at: one
+ * whose ends and points are what they were when it was last found whole
+ * is whole still (the search calls this several times an iteration, and
+ * between two calls most segments did not change). */
 int polyc__op_split(polyc__opt *o)
 {
     polyc__store *s = o->s;
     int32_t nv = s->v_high;
     int32_t *off = o->split_off;
     float *t = o->split_t;
+    const uint8_t *due = o->split_due;
     for (int32_t v = 0; v <= nv; v++)
         off[v] = 0;
-    for (int32_t i = 0; i < o->np; i++)
-        if (o->pt_seg[i] != POLYC__NONE)
-            off[o->pt_seg[i] + 1]++;
+    for (int32_t i = 0; i < o->np; i++) {
+        int32_t sg = o->pt_seg[i];
+        if (sg != POLYC__NONE && due[sg])
+            off[sg + 1]++;
+    }
     for (int32_t v = 0; v < nv; v++)
         off[v + 1] += off[v];
     /* fill: positions along the segment, metres */
     for (int32_t i = 0; i < o->np; i++) {
         int32_t sg = o->pt_seg[i];
-        if (sg == POLYC__NONE)
+        if (sg == POLYC__NONE || !due[sg])
             continue;
         const polyc__vertex *a = &s->v[sg], *b = &s->v[a->next];
         float dx = b->x - a->x, dy = b->y - a->y;
@@ -445,10 +451,13 @@ int polyc__op_split(polyc__opt *o)
     float gap_min = o->cfg->split_gap_m;
     for (int32_t v = 0; v < nv; v++) {
         const polyc__vertex *a = &s->v[v];
-        if (a->line == POLYC__NONE || a->next == POLYC__NONE)
+        if (!due[v] || a->line == POLYC__NONE || a->next == POLYC__NONE)
             continue;
         const polyc__vertex *b = &s->v[a->next];
         float len = sqrtf((b->x - a->x) * (b->x - a->x) + (b->y - a->y) * (b->y - a->y));
+        /* looked at: due again only when it or its points change (a cut
+         * changes them; one left for the next pass stays due) */
+        o->split_due[v] = 0;
         if (len <= gap_min)
             continue;
         int32_t lo = off[v], hi = off[v + 1];
@@ -476,6 +485,8 @@ int polyc__op_split(polyc__opt *o)
             o->cut_t0[n_cut] = g0 / len;
             o->cut_t1[n_cut] = (g0 + best) / len;
             n_cut++;
+        } else if (best > need) {
+            o->split_due[v] = 1; /* no room for its cut in this pass */
         }
     }
     for (int32_t k = 0; k < n_cut; k++) {
@@ -494,6 +505,8 @@ int polyc__op_split(polyc__opt *o)
                 c = POLYC__NONE;
         if (c != POLYC__NONE)
             polyc__op_cut(o, c);
+        else
+            o->split_due[u] = 1; /* no room for a vertex: try again next pass */
         polyc__chg_commit(o);
     }
     return n_cut;

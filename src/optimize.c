@@ -33,13 +33,13 @@ size_t polyc__optimizer_bytes(const polyc_config *cfg, const polyc_limits *lim)
     n = polyc__add(n, polyc__bytes(V + 1, sizeof(int32_t)));      /* split_off */
     n = polyc__add(n, polyc__bytes(V / 4 + 64, 2 * sizeof(float) + 2 * sizeof(int32_t))); /* cuts */
     n = polyc__add(n, polyc__bytes(V, sizeof(double) + 3 * sizeof(float))); /* acost, seg stats */
-    n = polyc__add(n, polyc__bytes(V, 6 * sizeof(int32_t) + 1));  /* marks, lists, seg_in */
+    n = polyc__add(n, polyc__bytes(V, 6 * sizeof(int32_t) + 2));  /* marks, lists, seg_in, split_due */
     n = polyc__add(n, polyc__bytes(V + 1024, sizeof(polyc__heap_entry)));
     n = polyc__add(n, polyc__bytes(ADDED_CAP, sizeof(int32_t)));
     n = polyc__add(n, polyc__bytes(NB, 4 * sizeof(int32_t)));     /* heads, starts, marks, list */
     n = polyc__add(n, polyc__bytes(NE, sizeof(polyc__hash_entry)));
     n = polyc__add(n, polyc__flat_bytes(lim));                    /* best model */
-    return polyc__add(n, 32 * 16);                                /* alignment slack */
+    return polyc__add(n, 33 * 16);                                /* alignment slack */
 }
 
 #define ALLOC(ptr, count) \
@@ -99,6 +99,7 @@ polyc_status polyc__opt_setup(polyc_ctx *ctx, polyc__opt *o)
     ALLOC(o->v_dirty, V);
     ALLOC(o->dirty_list, V);
     ALLOC(o->seg_in, V);
+    ALLOC(o->split_due, V);
     ALLOC(o->v_work, V);
     memset(o->v_work, 0, (size_t)V * sizeof(uint32_t));
     ALLOC(o->v_touch, V);
@@ -111,6 +112,7 @@ polyc_status polyc__opt_setup(polyc_ctx *ctx, polyc__opt *o)
     memset(o->seg_dead, 0, (size_t)V * sizeof(uint32_t));
     memset(o->v_dirty, 0, (size_t)V * sizeof(uint32_t));
     memset(o->seg_in, 0, (size_t)V);
+    memset(o->split_due, 0, (size_t)V);
     int32_t vcap = V;
     if ((st = polyc__flat_init(ctx, &o->best, (uint32_t)(vcap / 2 + 16), (uint32_t)vcap)) != POLYC_OK)
         return st;

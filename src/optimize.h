@@ -46,6 +46,8 @@ typedef struct polyc__opt {
 
     polyc__hash h;
     uint8_t *seg_in;               /* per vertex: its segment is in the hash */
+    uint8_t *split_due;            /* per vertex: its segment or its points changed
+                                    * since op_split last looked at it */
     int32_t cur_seg;               /* segment being entered or removed */
 
     /* one change (a batch of edits) being recorded */
@@ -80,7 +82,8 @@ typedef struct polyc__opt {
     int agg_moving_b[2];           /* the moving end is the segment's b */
     double agg_ax[2], agg_ay[2], agg_m[2][3];
 
-    /* split scratch: per segment offsets, positions of its points */
+    /* split scratch: per segment offsets, positions of its points (of the
+     * segments split_due only) */
     int32_t *split_off;
     float *split_t;
     int32_t *cut_seg, *cut_next, cut_cap;
@@ -189,6 +192,16 @@ int polyc__op_remove_vertices(polyc__opt *o, uint32_t since);
 /* the change of the BIC if v is removed when that is below `bound`, else
  * some value >= bound (INFINITY: always exact) */
 double polyc__removal_delta_below(polyc__opt *o, int32_t v, double bound);
+/* A point changes segment from `from` to `to`: both are due for op_split. */
+static inline void polyc__split_due_pt(polyc__opt *o, int32_t from, int32_t to)
+{
+    if (from == to)
+        return;
+    if (from != POLYC__NONE)
+        o->split_due[from] = 1;
+    if (to != POLYC__NONE)
+        o->split_due[to] = 1;
+}
 /* ray_check.c: single-scan mode (rays.on) only, else every answer is 0.
  * blocks_beams: segment a-b stands in front of a return, or behind one of
  * its own, by more than the tolerance; vertex_blocks: v at (x, y) makes one

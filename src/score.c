@@ -228,6 +228,7 @@ void polyc__chg_commit(polyc__opt *o)
                 }
             }
             o->pt_cost[i] = c;
+            polyc__split_due_pt(o, o->pt_seg[i], seg);
             o->pt_seg[i] = seg;
             o->err += c - old;
         }

@@ -241,6 +241,7 @@ int polyc__hash_insert(polyc__opt *o, int32_t seg)
     o->cur_seg = seg;
     polyc__segment_buckets(o, a->x, a->y, b->x, b->y, insert_in_bucket);
     o->seg_in[seg] = 1;
+    o->split_due[seg] = 1; /* every new or moved segment comes in here */
     return !o->h.out_of_entries;
 }
 

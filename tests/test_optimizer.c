@@ -1012,6 +1012,42 @@ static void test_split_keeps_wall_with_data(void **state)
     fx_close(&f);
 }
 
+/* op_split looks only at segments whose ends or points changed since its
+ * last pass: a wall that loses its points to another one, without moving,
+ * must be looked at again. */
+static void test_split_after_points_leave(void **state)
+{
+    (void)state;
+    static fixture f;
+    static ptlist p;
+    fx_open_hand(&f, 0.0f);
+    p.n = 0;
+    pts_line(&p, -1.2f, 1.0f, 1.2f, 1.0f, 0.01f);
+    pts_line(&p, -0.4f, 3.0f, 0.4f, 3.0f, 0.01f);
+    set_points(&f, p.xy, p.n);
+    clear_lines(&f.o);
+    const float wall[4] = {-1.2f, 1.01f, 1.2f, 1.01f}; /* 1 cm off its points */
+    const float piece[4] = {-0.4f, 3.0f, 0.4f, 3.0f};  /* on points of its own */
+    int32_t l = add_line(&f.o, wall, 2, 0);
+    int32_t m = add_line(&f.o, piece, 2, 0);
+    rebuild(&f.o);
+    assert_int_equal(polyc__op_split(&f.o), 0); /* data all along the wall */
+    /* the piece comes onto the points: the 80 cm of them under it leave the
+     * wall, which did not move */
+    int32_t a = f.o.s->l[m].head, b = f.o.s->v[a].next;
+    polyc__chg_begin(&f.o);
+    polyc__op_move(&f.o, a, -0.4f, 1.0f);
+    polyc__op_move(&f.o, b, 0.4f, 1.0f);
+    polyc__chg_commit(&f.o);
+    check_books(&f.o, "piece moved");
+    assert_int_equal(polyc__op_split(&f.o), 1);
+    check_books(&f.o, "wall split");
+    assert_int_equal(live_lines(&f.o), 3);
+    assert_true(f.o.s->l[l].count == 2 && line_with_end(&f.o, -1.2f, 1.01f) != POLYC__NONE);
+    assert_int_equal(polyc__op_split(&f.o), 0);
+    fx_close(&f);
+}
+
 /* ---- D: hill climbing ---- */
 
 /* L-shaped walls meeting at the origin, 1 cm point spacing */
@@ -1545,6 +1581,7 @@ int main(void)
         cmocka_unit_test(test_merge_closes_polyline),
         cmocka_unit_test(test_split_cuts_doorway),
         cmocka_unit_test(test_split_keeps_wall_with_data),
+        cmocka_unit_test(test_split_after_points_leave),
         cmocka_unit_test(test_hill_climb_returns_to_corner),
         cmocka_unit_test(test_adjust_never_raises_bic),
         cmocka_unit_test(test_bic_checked_operators_never_raise_bic),
