@@ -496,7 +496,7 @@ static int single_scans(const options *o, const scene *s)
         uint32_t idx = (uint32_t)(((uint64_t)2u * k + 1u) * log.count / (2u * o->single));
         const polyc_scan *scan = &log.scans[idx];
         double times[ST_COUNT] = {0}, run_total[MAX_RUNS], run_stage[ST_COUNT][MAX_RUNS];
-        double t0 = now_ms();
+        double t0 = now_ms(), cold = 0.0;
         pipeline p;
         polyc_polyline *lines;
         uint32_t count = 0, i;
@@ -516,7 +516,7 @@ static int single_scans(const options *o, const scene *s)
                 run_stage[i][r] = times[i];
             }
             if (r == 0)
-                cold_sum += now_ms() - t0;
+                cold = now_ms() - t0;
         }
         if (bad || (lines = get_lines(&p, &count)) == NULL) {
             printf("%-24s scan %u: error in %s: %s (%s)\n", label, idx,
@@ -526,6 +526,7 @@ static int single_scans(const options *o, const scene *s)
             continue;
         }
         ms_sum += median(run_total, o->runs);
+        cold_sum += cold; /* a scan that failed counts in neither */
         for (i = ST_GRID; i <= ST_OPT; i++)
             stage_sum[i] += median(run_stage[i], o->runs);
         for (i = 0; i < count; i++)
