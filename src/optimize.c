@@ -13,6 +13,11 @@
 #define ADDED_CAP 64
 
 
+int32_t polyc__loc_soa_cap(const polyc_limits *lim)
+{
+    return lim->max_scans > 1 ? POLYC__LOC_SOA : 0;
+}
+
 size_t polyc__optimizer_bytes(const polyc_config *cfg, const polyc_limits *lim)
 {
     size_t P = (size_t)polyc__points_bound(cfg, lim);
@@ -28,6 +33,7 @@ size_t polyc__optimizer_bytes(const polyc_config *cfg, const polyc_limits *lim)
     n = polyc__add(n, polyc__bytes(P, sizeof(int32_t)));          /* loc_seg */
     n = polyc__add(n, polyc__bytes(P, sizeof(int32_t)));          /* agg_pt */
     n = polyc__add(n, polyc__bytes(POLYC__CAND_MAX, sizeof(int32_t) + 4 * sizeof(float))); /* cand */
+    n = polyc__add(n, polyc__bytes((size_t)polyc__loc_soa_cap(lim), 7 * sizeof(double))); /* lsoa */
     n = polyc__add(n, polyc__bytes(P + V, sizeof(float)));        /* split_t */
     n = polyc__add(n, polyc__bytes(V, sizeof(float)));            /* trim_head */
     n = polyc__add(n, polyc__bytes(V + 1, sizeof(int32_t)));      /* split_off */
@@ -39,7 +45,7 @@ size_t polyc__optimizer_bytes(const polyc_config *cfg, const polyc_limits *lim)
     n = polyc__add(n, polyc__bytes(NB, 4 * sizeof(int32_t)));     /* heads, starts, marks, list */
     n = polyc__add(n, polyc__bytes(NE, sizeof(polyc__hash_entry)));
     n = polyc__add(n, polyc__flat_bytes(lim));                    /* best model */
-    return polyc__add(n, 33 * 16);                                /* alignment slack */
+    return polyc__add(n, 40 * 16);                                /* alignment slack */
 }
 
 #define ALLOC(ptr, count) \
@@ -80,6 +86,17 @@ polyc_status polyc__opt_setup(polyc_ctx *ctx, polyc__opt *o)
     ALLOC(o->agg_pt, P);
     ALLOC(o->cand_seg, POLYC__CAND_MAX);
     ALLOC(o->cand_box, 4 * POLYC__CAND_MAX);
+    o->lsoa_cap = polyc__loc_soa_cap(&ctx->lim);
+    o->lsoa_n = -1;
+    if (o->lsoa_cap > 0) {
+        ALLOC(o->lsoa_x, o->lsoa_cap);
+        ALLOC(o->lsoa_y, o->lsoa_cap);
+        ALLOC(o->lsoa_w, o->lsoa_cap);
+        ALLOC(o->lsoa_cxx, o->lsoa_cap);
+        ALLOC(o->lsoa_cxy, o->lsoa_cap);
+        ALLOC(o->lsoa_cyy, o->lsoa_cap);
+        ALLOC(o->lsoa_c, o->lsoa_cap);
+    }
     o->agg_cap = P;
     ALLOC(o->split_t, P > V ? P : V);
     ALLOC(o->trim_head, V);

@@ -66,6 +66,12 @@ typedef struct polyc__opt {
     double *loc_base;              /* their cost without the edited segments */
     int32_t *loc_seg;              /* and the segment giving it */
     int32_t loc_n;
+    /* the listed points again, by field (when there are 8 to lsoa_cap of
+     * them), so that a trial's costs are computed several at a time
+     * (trial_costs.c): lsoa_n == loc_n when they are valid */
+    double *lsoa_x, *lsoa_y, *lsoa_w, *lsoa_cxx, *lsoa_cxy, *lsoa_cyy;
+    double *lsoa_c;
+    int32_t lsoa_n, lsoa_cap;
     double loc_fixed, loc_fixed_cur; /* pruned points: base and current sums */
     /* moving one vertex: points sure to stay in the interior of one of its
      * segments and nearest to it, whatever the move within reach, are
@@ -106,6 +112,12 @@ typedef struct polyc__opt {
 } polyc__opt;
 
 #define POLYC__CAND_MAX 48
+/* listed points copied by field for the trials (intel: all but 170 of
+ * 524,000 trials list fewer); none for a context of one scan, whose trials
+ * list fewer than 8 points nine times in ten (and whose block is the
+ * embedded one) */
+#define POLYC__LOC_SOA 256
+int32_t polyc__loc_soa_cap(const polyc_limits *lim);
 /* segments one edit replaces, at most (corners: a chain of 3 and its two ends) */
 #define POLYC__EDIT_SEGS 6
 
@@ -138,6 +150,15 @@ void polyc__segment_buckets(polyc__opt *o, float ax, float ay, float bx, float b
 /* lists in o->bucket_list, once per epoch (o->bucket_mark), every bucket
  * within one bucket of the segment a-b: those whose points it can reach */
 void polyc__segment_region(polyc__opt *o, float ax, float ay, float bx, float by);
+
+/* A segment prepared for many cost evaluations (score.c). */
+typedef struct polyc__seg_pre {
+    double ax, ay, bx, by, dx, dy, inv_l2, nx, ny;
+} polyc__seg_pre;
+
+/* trial_costs.c: c[k] = min(c[k], cost of listed point k on segment q) for
+ * the lsoa_n points copied by field; the values of score.c's per-point cost */
+void polyc__trial_costs_min(const polyc__opt *o, const polyc__seg_pre *q, double *c);
 
 /* score.c */
 double polyc__cost(const polyc__point *p, float ax, float ay, float bx, float by);

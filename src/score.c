@@ -245,12 +245,7 @@ void polyc__chg_commit(polyc__opt *o)
 
 /* ---- local evaluation (read-only) ---- */
 
-/* A segment prepared for many cost evaluations. */
-typedef struct seg_pre {
-    double ax, ay, bx, by, dx, dy, inv_l2, nx, ny;
-} seg_pre;
-
-static void seg_prepare(seg_pre *q, const float *xy)
+static void seg_prepare(polyc__seg_pre *q, const float *xy)
 {
     q->ax = (double)xy[0];
     q->ay = (double)xy[1];
@@ -266,7 +261,7 @@ static void seg_prepare(seg_pre *q, const float *xy)
 }
 
 /* Same value as polyc__cost, without the per-call divisions. */
-static double seg_cost(const seg_pre *q, const polyc__point *p)
+static double seg_cost(const polyc__seg_pre *q, const polyc__point *p)
 {
     double mx = (double)p->x - q->ax, my = (double)p->y - q->ay;
     double t = (mx * q->dx + my * q->dy) * q->inv_l2;
@@ -507,6 +502,21 @@ static void prepare(polyc__opt *o, const int32_t *old, int n_old, const float *s
         }
     }
     o->bucket_n = 0;
+    o->lsoa_n = -1;
+    /* for a few points (most of a single scan's trials) the copy costs
+     * more than it saves */
+    if (o->loc_n >= 8 && o->loc_n <= o->lsoa_cap) {
+        for (int32_t k = 0; k < o->loc_n; k++) {
+            const polyc__point *p = &o->pts[o->loc_pt[k]];
+            o->lsoa_x[k] = (double)p->x;
+            o->lsoa_y[k] = (double)p->y;
+            o->lsoa_w[k] = (double)p->w;
+            o->lsoa_cxx[k] = (double)p->cxx;
+            o->lsoa_cxy[k] = (double)p->cxy;
+            o->lsoa_cyy[k] = (double)p->cyy;
+        }
+        o->lsoa_n = o->loc_n;
+    }
 }
 
 void polyc__local_prepare(polyc__opt *o, const int32_t *old, int n_old, const float *seg_xy,
@@ -523,7 +533,7 @@ void polyc__local_prepare_move(polyc__opt *o, const int32_t *old, int n_old, con
 
 double polyc__local_eval(const polyc__opt *o, const float *seg_xy, int n_new)
 {
-    seg_pre q[4];
+    polyc__seg_pre q[4];
     POLYC_ASSERT(n_new <= 4);
     for (int j = 0; j < n_new; j++)
         seg_prepare(&q[j], seg_xy + 4 * j);
@@ -538,6 +548,17 @@ double polyc__local_eval(const polyc__opt *o, const float *seg_xy, int n_new)
             const double *m = o->agg_m[j];
             sum += (m[0] * uy * uy - 2.0 * m[1] * ux * uy + m[2] * ux * ux) / (ux * ux + uy * uy);
         }
+    if (o->lsoa_n == o->loc_n) {
+        double *c = o->lsoa_c;
+        for (int32_t k = 0; k < o->loc_n; k++)
+            c[k] = o->loc_base[k];
+        for (int j = 0; j < n_new; j++)
+            polyc__trial_costs_min(o, &q[j], c);
+        /* summed in the order of the scalar loop below: the same bits */
+        for (int32_t k = 0; k < o->loc_n; k++)
+            sum += c[k];
+        return sum;
+    }
     for (int32_t k = 0; k < o->loc_n; k++) {
         const polyc__point *p = &o->pts[o->loc_pt[k]];
         double c = o->loc_base[k];
@@ -594,7 +615,7 @@ double polyc__local_delta(polyc__opt *o, const int32_t *old, int n_old, const fl
                           int n_new, double limit)
 {
     const polyc__hash *h = &o->h;
-    seg_pre q[4];
+    polyc__seg_pre q[4];
     POLYC_ASSERT(n_new <= 4);
     for (int j = 0; j < n_new; j++)
         seg_prepare(&q[j], seg_xy + 4 * j);
@@ -609,6 +630,7 @@ double polyc__local_delta(polyc__opt *o, const int32_t *old, int n_old, const fl
     }
     double sure = 0.0; /* exact part so far; pending points add >= 0 each */
     int32_t n = 0;
+    o->lsoa_n = -1; /* loc_pt and loc_base are a heap here */
     for (int32_t k = 0; k < o->bucket_n; k++) {
         int32_t b = o->bucket_list[k];
         for (uint32_t i = h->pt_start[b]; i < h->pt_start[b + 1]; i++) {

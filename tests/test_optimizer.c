@@ -745,6 +745,55 @@ static void test_move_eval_moments_match(void **state)
     fx_close(&f);
 }
 
+/* A trial's costs computed a vector at a time (trial_costs.c, from the
+ * points copied by field) equal the point-by-point loop's to the bit, for
+ * trials around every vertex of a noisy map, with and without moments. */
+static void test_trial_costs_by_field_match(void **state)
+{
+    (void)state;
+    static fixture f;
+    fx_open(&f, 0.0f, 0.002f, 0); /* weighted: moments in the costs */
+    assert_true(f.o.lsoa_cap > 0); /* several scans: the copy is made */
+    polyc__rng r = {91};
+    make_start_map(&f.o, &r);
+    polyc__op_noise(&f.o, 0.02);
+    rebuild(&f.o);
+    const float reach = 0.05f;
+    int by_field = 0;
+    for (int32_t v = 0; v < f.o.s->v_high; v++) {
+        const polyc__vertex *V = f.o.s->v;
+        if (V[v].line == POLYC__NONE || V[v].prev == POLYC__NONE || V[v].next == POLYC__NONE)
+            continue;
+        float x0 = V[v].x, y0 = V[v].y;
+        const float xy[8] = {V[V[v].prev].x, V[V[v].prev].y, x0, y0, x0, y0, V[V[v].next].x, V[V[v].next].y};
+        int32_t old[2] = {V[v].prev, v};
+        for (int t = 0; t < 12; t++) {
+            float ang = (float)(6.283185307179586 * urand(&r)), rad = reach * (float)urand(&r);
+            float trial[8];
+            memcpy(trial, xy, sizeof trial);
+            trial[2] = trial[4] = x0 + rad * cosf(ang);
+            trial[3] = trial[5] = y0 + rad * sinf(ang);
+            for (int move = 0; move < 2; move++) {
+                if (move)
+                    polyc__local_prepare_move(&f.o, old, 2, xy, 2, reach, x0, y0);
+                else
+                    polyc__local_prepare(&f.o, old, 2, xy, 2, reach);
+                if (f.o.lsoa_n != f.o.loc_n)
+                    continue;
+                by_field++;
+                double vec = polyc__local_eval(&f.o, trial, 2);
+                f.o.lsoa_n = -1;
+                double one = polyc__local_eval(&f.o, trial, 2);
+                if (memcmp(&vec, &one, sizeof vec) != 0)
+                    fail_msg("vertex %d trial %d move %d: by field %.17g, point by point %.17g", v, t,
+                             move, vec, one);
+            }
+        }
+    }
+    assert_true(by_field > 20); /* the case is exercised */
+    fx_close(&f);
+}
+
 /* ---- two bugs the random edits found (fixed in b8dcafa), on minimal cases ---- */
 
 /* Merging two heads reverses one polyline: all its segments go out and come
@@ -1593,6 +1642,7 @@ int main(void)
         cmocka_unit_test(test_add_vertex_at_cut_corner),
         cmocka_unit_test(test_removal_delta_is_exact),
         cmocka_unit_test(test_move_eval_moments_match),
+        cmocka_unit_test(test_trial_costs_by_field_match),
         cmocka_unit_test(test_corner_replaces_spike),
         cmocka_unit_test(test_corners_leave_clean_map),
         cmocka_unit_test(test_trim_pulls_end_back_to_data),

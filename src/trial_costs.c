@@ -1,0 +1,35 @@
+/* trial_costs.c - the costs of a hill-climbing trial, several points at once.
+ * Takes: the points a prepared move lists (copied by field, in double) and one trial
+ * segment. Gives: each point's cost on that segment, folded into a running
+ * minimum. The loop has no branches, so that the compiler can vectorise it;
+ * it is built with -fno-trapping-math (Makefile), without which gcc keeps
+ * the comparisons as branches. The same flag on score.c made its branchy
+ * per-point code slower (single scans 3 %), hence a file of its own. */
+#include "optimize.h"
+
+/* Each value is the one score.c's seg_cost computes, operation for
+ * operation, selected instead of branched to. */
+void polyc__trial_costs_min(const polyc__opt *o, const polyc__seg_pre *q, double *restrict c)
+{
+    const double *restrict X = o->lsoa_x, *restrict Y = o->lsoa_y, *restrict W = o->lsoa_w;
+    const double *restrict XX = o->lsoa_cxx, *restrict XY = o->lsoa_cxy, *restrict YY = o->lsoa_cyy;
+    const double ax = q->ax, ay = q->ay, bx = q->bx, by = q->by, dx = q->dx, dy = q->dy;
+    const double il2 = q->inv_l2, nx = q->nx, ny = q->ny;
+    const double nxx = nx * nx, nxy2 = 2.0 * nx * ny, nyy = ny * ny;
+    const int point_like = il2 == 0.0;
+    const int32_t n = o->lsoa_n;
+    for (int32_t k = 0; k < n; k++) {
+        double px = X[k], py = Y[k], w = W[k], cxx = XX[k], cyy = YY[k];
+        double mx = px - ax, my = py - ay;
+        double t = (mx * dx + my * dy) * il2;
+        double ca = w * (mx * mx + my * my) + (cxx + cyy);
+        double ex = px - bx, ey = py - by;
+        double cb = w * (ex * ex + ey * ey) + (cxx + cyy);
+        double d = nx * mx + ny * my;
+        double ci = w * d * d + (nxx * cxx + nxy2 * XY[k] + nyy * cyy);
+        ci = ci > 0.0 ? ci : 0.0;
+        double cj = t >= 1.0 ? cb : ci;
+        cj = (t <= 0.0) | point_like ? ca : cj;
+        c[k] = cj < c[k] ? cj : c[k];
+    }
+}
