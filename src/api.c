@@ -209,11 +209,12 @@ size_t polyc_memory_size(const polyc_config *config, const polyc_limits *limits)
     size_t n = polyc__bytes(1, sizeof(polyc_ctx)) + 16; /* + alignment of the block */
     n = polyc__add(n, scans_bytes(limits));
     n = polyc__add(n, polyc__grid_budget_bytes(limits));
-    n = polyc__add(n, polyc__contour_bytes(limits));
     n = polyc__add(n, polyc__store_bytes(limits));
-    /* tracing scratch: the contour walk, or a single scan's chains */
-    size_t trace_scratch = polyc__contour_bytes(limits), chains = polyc__chains_bytes(limits);
-    n = polyc__add(n, trace_scratch > chains ? trace_scratch : chains);
+    /* the contour's cells and the walk that traces them, or a single scan's
+     * chains, which start where the contour would (need_stage) */
+    size_t contour = polyc__add(polyc__contour_bytes(limits), polyc__contour_bytes(limits));
+    size_t chains = polyc__chains_bytes(limits);
+    n = polyc__add(n, contour > chains ? contour : chains);
     n = polyc__add(n, polyc__flat_bytes(limits));
     n = polyc__add(n, polyc__prior_bytes(limits));
     n = polyc__add(n, 2 * polyc__spacing_bytes(limits)); /* trace and optimiser */
@@ -436,8 +437,18 @@ static polyc_status need_stage(polyc_ctx *ctx, polyc__stage want)
     }
     if (st == POLYC_OK && ctx->stage < POLYC__STAGE_CONTOUR && want >= POLYC__STAGE_CONTOUR)
         st = run_stage(ctx, POLYC__STAGE_CONTOUR, ctx->grid_mark, stage_contour, POLYC__STAGE_GRID);
-    if (st == POLYC_OK && ctx->stage < POLYC__STAGE_TRACE && want >= POLYC__STAGE_TRACE)
-        st = run_stage(ctx, POLYC__STAGE_TRACE, ctx->contour_mark, stage_trace, POLYC__STAGE_CONTOUR);
+    if (st == POLYC_OK && ctx->stage < POLYC__STAGE_TRACE && want >= POLYC__STAGE_TRACE) {
+        /* a single scan's chains take the room of a contour list they do not
+         * read (one asked for by polyc_extract_contour is released; the grid
+         * keeps its contour bits), so that polyc_memory_size charges the
+         * larger of the two, not both */
+        size_t mark = ctx->contour_mark;
+        if (one_scan_chains(ctx)) {
+            mark = ctx->contour_mark = ctx->grid_mark;
+            ctx->contour_count = 0;
+        }
+        st = run_stage(ctx, POLYC__STAGE_TRACE, mark, stage_trace, POLYC__STAGE_CONTOUR);
+    }
     return st;
 }
 

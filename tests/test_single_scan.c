@@ -316,6 +316,42 @@ static void test_grid_trace_flag(void **state)
     done(&m);
 }
 
+/* A contour asked for in a one-scan context is released by the trace: the
+ * chains start where it began (polyc_memory_size charges the larger of the
+ * two, not both), the grid keeps its contour bits, and the map is the one
+ * built without it. */
+static void test_chains_take_the_contour_room(void **state)
+{
+    (void)state;
+    one_map m;
+    scene_map(&m, room_with_box, UINT32_MAX, 0);
+    size_t chains_room = m.ctx->trace_mark - m.ctx->grid_mark;
+    uint32_t vertices = m.stats.vertices;
+    assert_int_equal(polyc_extract_contour(m.ctx), POLYC_OK);
+    uint32_t w = 0, h = 0, cx = 0, cy = 0, found = 0;
+    assert_int_equal(polyc_grid_info(m.ctx, NULL, NULL, NULL, &w, &h), POLYC_OK);
+    for (uint32_t y = 0; y < h && !found; y++)
+        for (uint32_t x = 0; x < w && !found; x++) {
+            uint32_t hits, misses, contour;
+            assert_int_equal(polyc_grid_cell(m.ctx, x, y, &hits, &misses, &contour), POLYC_OK);
+            if (contour) {
+                cx = x;
+                cy = y;
+                found = 1;
+            }
+        }
+    assert_true(found);
+    assert_int_equal(polyc_trace(m.ctx), POLYC_OK);
+    assert_int_equal(m.ctx->trace_mark - m.ctx->grid_mark, chains_room);
+    uint32_t hits, misses, contour = 0;
+    assert_int_equal(polyc_grid_cell(m.ctx, cx, cy, &hits, &misses, &contour), POLYC_OK);
+    assert_int_equal(contour, 1);
+    assert_int_equal(polyc_optimize(m.ctx, NULL, NULL), POLYC_OK);
+    assert_int_equal(polyc_get_stats(m.ctx, &m.stats), POLYC_OK);
+    assert_int_equal(m.stats.vertices, vertices);
+    done(&m);
+}
+
 /* polyc__blocks_beams on hand cases: a scan whose every return is at 2 m. */
 /* A full turn of 360 beams from the origin, every return at 2 m but for
  * what the caller changes in `range`. */
@@ -452,6 +488,7 @@ int main(void)
         cmocka_unit_test(test_optimised_room),
         cmocka_unit_test(test_optimised_corridor),
         cmocka_unit_test(test_grid_trace_flag),
+        cmocka_unit_test(test_chains_take_the_contour_room),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
