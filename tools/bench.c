@@ -100,7 +100,7 @@ static double median(const double *v, unsigned n)
     return n % 2u ? tmp[n / 2u] : 0.5 * (tmp[n / 2u - 1u] + tmp[n / 2u]);
 }
 
-static double peak_rss_mb(void)
+static double peak_rss_mib(void)
 {
     struct rusage ru;
     if (getrusage(RUSAGE_SELF, &ru) != 0)
@@ -108,7 +108,7 @@ static double peak_rss_mb(void)
     return (double)ru.ru_maxrss / 1024.0; /* Linux: kilobytes */
 }
 
-static double mb(uint64_t bytes)
+static double mib(uint64_t bytes)
 {
     return (double)bytes / (1024.0 * 1024.0);
 }
@@ -339,12 +339,12 @@ static void print_header(const options *o)
     printf("libpolyc %u.%u.%u bench: median of %u run%s, data %s\n", polyc_version() / 10000u,
            polyc_version() / 100u % 100u, polyc_version() % 100u, o->runs,
            o->runs == 1 ? "" : "s", o->data);
-    printf("%-24s %6s %8s | %7s %6s %7s %7s %7s %8s %6s %8s | %7s %7s %7s | %6s %7s %6s "
+    printf("%-24s %6s %8s | %7s %6s %7s %7s %7s %8s %6s %8s | %8s %8s %7s | %6s %7s %6s "
            "%5s | %6s %6s %6s %6s %6s\n",
            "scene", "scans", "beams", "parse", "add", "grid", "contour", "trace", "optimise",
-           "output", "total", "blockMB", "usedMB", "rssMB", "lines", "verts", "ideal", "x",
+           "output", "total", "blockMiB", "usedMiB", "rssMiB", "lines", "verts", "ideal", "x",
            "rms", "p95", "floor", "compl", "end5");
-    printf("%-24s %6s %8s | %7s %6s %7s %7s %7s %8s %6s %8s | %7s %7s %7s | %6s %7s %6s "
+    printf("%-24s %6s %8s | %7s %6s %7s %7s %7s %8s %6s %8s | %8s %8s %7s | %6s %7s %6s "
            "%5s | %6s %6s %6s %6s %6s\n",
            "", "", "", "ms", "ms", "ms", "ms", "ms", "ms", "ms", "ms", "", "", "", "", "", "",
            "", "mm", "mm", "mm", "", "");
@@ -448,12 +448,12 @@ static int bench_scene(const options *o, const scene *s)
     polyc_get_stats(p.ctx, &stats);
     accuracy(s, &log, lines, count, &acc);
 
-    printf("%-24s %6u %8llu | %7.1f %6.1f %7.1f %7.1f %7.1f %8.1f %6.1f %8.1f | %7.1f %7.1f "
+    printf("%-24s %6u %8llu | %7.1f %6.1f %7.1f %7.1f %7.1f %8.1f %6.1f %8.1f | %8.2f %8.2f "
            "%7.1f | %6u %7u ",
            label, log.count, (unsigned long long)log.beams, med[ST_PARSE], med[ST_ADD],
            med[ST_GRID], med[ST_CONTOUR], med[ST_TRACE], med[ST_OPT], med[ST_OUT],
-           med[ST_TOTAL], mb(stats.memory_size_bytes), mb(stats.memory_used_bytes),
-           peak_rss_mb(), acc.lines, acc.vertices);
+           med[ST_TOTAL], mib(stats.memory_size_bytes), mib(stats.memory_used_bytes),
+           peak_rss_mib(), acc.lines, acc.vertices);
     if (acc.has_truth) {
         char floor_mm[16] = "-";
         if (acc.floor_m >= 0.0)
@@ -669,7 +669,7 @@ int main(int argc, char **argv)
             if (strcmp(list[i].kind, "carmen") == 0 && single_scans(&o, &list[i]) != 0)
                 failed = 1;
     }
-    printf("\npeak RSS of the process: %.1f MB\n", peak_rss_mb());
+    printf("\npeak RSS of the process: %.1f MiB\n", peak_rss_mib());
     free(list);
     return failed ? EXIT_FAILED : 0;
 }
