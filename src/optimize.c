@@ -13,7 +13,9 @@
 #define ADDED_CAP 64
 
 
-int32_t polyc__loc_soa_cap(const polyc_limits *lim)
+/* No copy for a context of one scan: its trials list fewer than 8 points
+ * nine times in ten (and its block is the embedded one). */
+static int32_t loc_soa_cap(const polyc_limits *lim)
 {
     return lim->max_scans > 1 ? POLYC__LOC_SOA : 0;
 }
@@ -33,7 +35,7 @@ size_t polyc__optimizer_bytes(const polyc_config *cfg, const polyc_limits *lim)
     n = polyc__add(n, polyc__bytes(P, sizeof(int32_t)));          /* loc_seg */
     n = polyc__add(n, polyc__bytes(P, sizeof(int32_t)));          /* agg_pt */
     n = polyc__add(n, polyc__bytes(POLYC__CAND_MAX, sizeof(int32_t) + 4 * sizeof(float))); /* cand */
-    n = polyc__add(n, polyc__bytes((size_t)polyc__loc_soa_cap(lim), 7 * sizeof(double))); /* lsoa */
+    n = polyc__add(n, polyc__bytes((size_t)loc_soa_cap(lim), 7 * sizeof(double))); /* lsoa */
     n = polyc__add(n, polyc__bytes(P + V, sizeof(float)));        /* split_t */
     n = polyc__add(n, polyc__bytes(V, sizeof(float)));            /* trim_head */
     n = polyc__add(n, polyc__bytes(V + 1, sizeof(int32_t)));      /* split_off */
@@ -86,7 +88,7 @@ polyc_status polyc__opt_setup(polyc_ctx *ctx, polyc__opt *o)
     ALLOC(o->agg_pt, P);
     ALLOC(o->cand_seg, POLYC__CAND_MAX);
     ALLOC(o->cand_box, 4 * POLYC__CAND_MAX);
-    o->lsoa_cap = polyc__loc_soa_cap(&ctx->lim);
+    o->lsoa_cap = loc_soa_cap(&ctx->lim);
     o->lsoa_n = -1;
     if (o->lsoa_cap > 0) {
         ALLOC(o->lsoa_x, o->lsoa_cap);

@@ -113,11 +113,8 @@ typedef struct polyc__opt {
 
 #define POLYC__CAND_MAX 48
 /* listed points copied by field for the trials (intel: all but 170 of
- * 524,000 trials list fewer); none for a context of one scan, whose trials
- * list fewer than 8 points nine times in ten (and whose block is the
- * embedded one) */
+ * 524,000 trials list fewer) */
 #define POLYC__LOC_SOA 256
-int32_t polyc__loc_soa_cap(const polyc_limits *lim);
 /* segments one edit replaces, at most (corners: a chain of 3 and its two ends) */
 #define POLYC__EDIT_SEGS 6
 
