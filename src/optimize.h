@@ -83,6 +83,8 @@ typedef struct polyc__opt {
      * the points whose own segment goes: cand_n < 0 not gathered yet,
      * POLYC__CAND_MAX + 1 too many (then the hash is queried) */
     int32_t *cand_seg, cand_n;
+    int32_t cand_src;              /* the bucket whose 3 x 3 were gathered last */
+    uint32_t cand_stamp;           /* epoch of the gathering (bucket and segment marks) */
     float *cand_box;               /* per candidate: min x, min y, max x, max y */
     int agg_on;                    /* 0: no aggregation prepared */
     int agg_moving_b[2];           /* the moving end is the segment's b */

@@ -315,51 +315,58 @@ static double stay_bound(const polyc__point *p, double ax, double ay, double cx,
     return lo > 0.0 && worst < w * lo * lo ? worst : 0.0;
 }
 
-#define QUERIES_BEFORE_GATHER 3
-
-/* The segments other than `old` in the buckets within one of the first
- * region_n listed ones: every segment a nearest query from a point of those
- * buckets could meet (it looks at the 3 x 3 buckets around the point). */
-static void gather_candidates(polyc__opt *o, const int32_t *old, int n_old, int32_t region_n)
+/* The candidates of the points whose own segment goes: the segments other
+ * than `old` that a nearest query from such a point could meet, the ones in
+ * the 3 x 3 buckets around its bucket. They are gathered for a bucket the
+ * first time one of its points asks (most of the region's buckets hold no
+ * point of the old segments). */
+static void gather_start(polyc__opt *o, const int32_t *old, int n_old)
 {
-    const polyc__hash *h = &o->h;
-    /* a new epoch: the region's bucket marks are not needed any more, and
-     * seg_dead (compared with the epoch of a change, which starts a new one)
-     * marks the segments met */
-    uint32_t stamp = ++o->epoch;
+    /* a new epoch: the region's bucket marks are not needed any more (the
+     * region is listed), and seg_dead (compared with the epoch of a change,
+     * which starts a new one) marks the segments met */
+    o->cand_stamp = ++o->epoch;
+    o->cand_src = POLYC__NONE;
     o->cand_n = 0;
     for (int j = 0; j < n_old; j++)
         if (old[j] != POLYC__NONE)
-            o->seg_dead[old[j]] = stamp;
-    for (int32_t k = 0; k < region_n; k++) {
-        int32_t b = o->bucket_list[k], bx = b % h->bx, by = b / h->bx;
-        int32_t x0 = bx > 0 ? bx - 1 : 0, x1 = bx + 1 < h->bx ? bx + 1 : h->bx - 1;
-        int32_t y0 = by > 0 ? by - 1 : 0, y1 = by + 1 < h->by ? by + 1 : h->by - 1;
-        for (int32_t y = y0; y <= y1; y++)
-            for (int32_t x = x0; x <= x1; x++) {
-                int32_t nb = y * h->bx + x;
-                if (o->bucket_mark[nb] == stamp)
+            o->seg_dead[old[j]] = o->cand_stamp;
+}
+
+static void gather_around(polyc__opt *o, int32_t b)
+{
+    const polyc__hash *h = &o->h;
+    const uint32_t stamp = o->cand_stamp;
+    if (b == o->cand_src)
+        return; /* the points come bucket by bucket */
+    o->cand_src = b;
+    int32_t bx = b % h->bx, by = b / h->bx;
+    int32_t x0 = bx > 0 ? bx - 1 : 0, x1 = bx + 1 < h->bx ? bx + 1 : h->bx - 1;
+    int32_t y0 = by > 0 ? by - 1 : 0, y1 = by + 1 < h->by ? by + 1 : h->by - 1;
+    for (int32_t y = y0; y <= y1; y++)
+        for (int32_t x = x0; x <= x1; x++) {
+            int32_t nb = y * h->bx + x;
+            if (o->bucket_mark[nb] == stamp)
+                continue;
+            o->bucket_mark[nb] = stamp;
+            for (int32_t e = h->seg_head[nb]; e != POLYC__NONE; e = h->entries[e].next) {
+                int32_t sg = h->entries[e].seg;
+                if (o->seg_dead[sg] == stamp)
                     continue;
-                o->bucket_mark[nb] = stamp;
-                for (int32_t e = h->seg_head[nb]; e != POLYC__NONE; e = h->entries[e].next) {
-                    int32_t sg = h->entries[e].seg;
-                    if (o->seg_dead[sg] == stamp)
-                        continue;
-                    o->seg_dead[sg] = stamp;
-                    if (o->cand_n == POLYC__CAND_MAX) {
-                        o->cand_n = POLYC__CAND_MAX + 1;
-                        return;
-                    }
-                    const polyc__vertex *a = &o->s->v[sg], *c = &o->s->v[a->next];
-                    float *box = o->cand_box + 4 * o->cand_n;
-                    box[0] = polyc__minf(a->x, c->x);
-                    box[1] = polyc__minf(a->y, c->y);
-                    box[2] = polyc__maxf(a->x, c->x);
-                    box[3] = polyc__maxf(a->y, c->y);
-                    o->cand_seg[o->cand_n++] = sg;
+                o->seg_dead[sg] = stamp;
+                if (o->cand_n == POLYC__CAND_MAX) {
+                    o->cand_n = POLYC__CAND_MAX + 1; /* too many: the hash is queried */
+                    return;
                 }
+                const polyc__vertex *a = &o->s->v[sg], *c = &o->s->v[a->next];
+                float *box = o->cand_box + 4 * o->cand_n;
+                box[0] = polyc__minf(a->x, c->x);
+                box[1] = polyc__minf(a->y, c->y);
+                box[2] = polyc__maxf(a->x, c->x);
+                box[3] = polyc__maxf(a->y, c->y);
+                o->cand_seg[o->cand_n++] = sg;
             }
-    }
+        }
 }
 
 /* nearest_below over the gathered candidates: the same segments it would
@@ -412,7 +419,6 @@ static void prepare(polyc__opt *o, const int32_t *old, int n_old, const float *s
         const float *q = seg_xy + 4 * k;
         polyc__segment_region(o, q[0], q[1], q[2], q[3]);
     }
-    int32_t region_n = o->bucket_n, queries = 0;
     o->cand_n = -1;
     o->loc_n = 0;
     o->loc_fixed = 0.0;
@@ -467,10 +473,10 @@ static void prepare(polyc__opt *o, const int32_t *old, int n_old, const float *s
                 /* without the old segments: a query within the bound is
                  * enough to tell that the point stays (most do) */
                 double cap = cap_of(o, p), start = bound > 0.0 && bound < cap ? bound : cap;
-                /* the first queries walk the hash; from the QUERIES_BEFORE_GATHER-th on
-                 * the region's candidates pay for gathering them */
-                if (o->cand_n < 0 && ++queries >= QUERIES_BEFORE_GATHER)
-                    gather_candidates(o, old, n_old, region_n);
+                if (o->cand_n < 0)
+                    gather_start(o, old, n_old);
+                if (o->cand_n >= 0 && o->cand_n <= POLYC__CAND_MAX)
+                    gather_around(o, b);
                 base = o->cand_n >= 0 && o->cand_n <= POLYC__CAND_MAX
                            ? nearest_candidate(o, (int32_t)i, start, &base_seg)
                            : nearest_below(o, (int32_t)i, old, n_old, start, &base_seg);

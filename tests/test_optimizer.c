@@ -745,6 +745,79 @@ static void test_move_eval_moments_match(void **state)
     fx_close(&f);
 }
 
+/* the error with every point on its brute-force nearest segment */
+static double brute_error(const polyc__opt *o)
+{
+    double e = 0.0;
+    for (int32_t i = 0; i < o->np; i++)
+        e += brute_nearest(o, &o->pts[i], NULL);
+    return e;
+}
+
+/* A vertex move's local evaluation sees a neighbouring polyline 3 cm away
+ * whether it runs through the points' own buckets or the next ones: the
+ * candidates of a point whose own segment moves are the segments in the
+ * 3 x 3 buckets around it. The scene is shifted across a bucket in eight
+ * steps; each trial's change of the error equals the brute-force one. */
+static void test_move_eval_sees_neighbouring_buckets(void **state)
+{
+    (void)state;
+    static fixture f;
+    static ptlist p;
+    fx_open_hand(&f, 0.0f);
+    polyc__opt *o = &f.o;
+    const float bucket = o->h.bucket_m, reach = 0.05f;
+    int differs = 0; /* trials where the other polyline serves some point */
+    for (int k = 0; k < 8; k++) {
+        float dy = bucket * (float)k / 8.0f;
+        p.n = 0;
+        pts_line(&p, -1.0f, dy, 1.0f, dy, 0.01f);
+        pts_line(&p, -1.0f, dy + 0.03f, 1.0f, dy + 0.03f, 0.02f);
+        set_points(&f, p.xy, p.n);
+        clear_lines(o);
+        const float a[6] = {-1.0f, dy, 0.0f, dy, 1.0f, dy};
+        const float b[6] = {-1.0f, dy + 0.03f, 0.0f, dy + 0.03f, 1.0f, dy + 0.03f};
+        int32_t la = add_line(o, a, 3, 0);
+        add_line(o, b, 3, 0);
+        rebuild(o);
+        int32_t v = o->s->v[o->s->l[la].head].next; /* A's middle vertex */
+        polyc__vertex *V = o->s->v;
+        float x0 = V[v].x, y0 = V[v].y;
+        int32_t old[2] = {V[v].prev, v};
+        float xy[8] = {V[V[v].prev].x, V[V[v].prev].y, x0, y0, x0, y0, V[V[v].next].x, V[V[v].next].y};
+        double before = brute_error(o);
+        for (int t = 0; t < 8; t++) {
+            float ang = 6.2831853f * (float)t / 8.0f;
+            float cx = x0 + 0.04f * cosf(ang), cy = y0 + 0.04f * sinf(ang), trial[8];
+            memcpy(trial, xy, sizeof trial);
+            trial[2] = trial[4] = cx;
+            trial[3] = trial[5] = cy;
+            polyc__local_prepare_move(o, old, 2, xy, 2, reach, x0, y0);
+            double local = polyc__local_eval(o, trial, 2) - polyc__local_current(o);
+            V[v].x = cx; /* the brute force reads the vertices only */
+            V[v].y = cy;
+            double brute = brute_error(o) - before;
+            V[v].x = x0;
+            V[v].y = y0;
+            /* with A alone, the points of A would cost what A gives them */
+            int32_t seg;
+            for (int32_t i = 0; i < o->np && !differs; i++) {
+                V[v].x = cx;
+                V[v].y = cy;
+                brute_nearest(o, &o->pts[i], &seg);
+                V[v].x = x0;
+                V[v].y = y0;
+                differs = fabsf(o->pts[i].y - dy) < 1e-4f && seg != POLYC__NONE &&
+                          o->s->v[seg].line != la;
+            }
+            if (!close_rel(local, brute, 1e-9))
+                fail_msg("shift %d trial %d: local %.12f, brute force %.12f", k, t, local, brute);
+        }
+    }
+    assert_true(differs); /* the case is exercised */
+    fx_close(&f);
+}
+
 /* A trial's costs computed a vector at a time (trial_costs.c, from the
  * points copied by field) equal the point-by-point loop's to the bit, for
  * trials around every vertex of a noisy map, with and without moments. */
@@ -1643,6 +1716,7 @@ int main(void)
         cmocka_unit_test(test_removal_delta_is_exact),
         cmocka_unit_test(test_move_eval_moments_match),
         cmocka_unit_test(test_trial_costs_by_field_match),
+        cmocka_unit_test(test_move_eval_sees_neighbouring_buckets),
         cmocka_unit_test(test_corner_replaces_spike),
         cmocka_unit_test(test_corners_leave_clean_map),
         cmocka_unit_test(test_trim_pulls_end_back_to_data),
