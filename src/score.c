@@ -397,6 +397,35 @@ static double nearest_candidate(const polyc__opt *o, int32_t pi, double start, i
     return best;
 }
 
+/* The old segments of an edit, for the test every listed point makes: the
+ * first two compared directly (a climb has two), the rest in a loop. */
+typedef struct old_set {
+    int32_t a, b;
+    const int32_t *rest;
+    int n_rest;
+} old_set;
+
+static old_set old_set_of(const int32_t *old, int n_old)
+{
+    old_set s;
+    s.a = n_old > 0 ? old[0] : POLYC__NONE;
+    s.b = n_old > 1 ? old[1] : POLYC__NONE;
+    s.rest = old + 2;
+    s.n_rest = n_old > 2 ? n_old - 2 : 0;
+    return s;
+}
+
+/* whether the point's segment seg (NONE: none) is one of them */
+static int is_old(const old_set *s, int32_t seg)
+{
+    if (seg == POLYC__NONE)
+        return 0;
+    int hit = seg == s->a || seg == s->b;
+    for (int j = 0; j < s->n_rest; j++)
+        hit |= seg == s->rest[j];
+    return hit;
+}
+
 /* Collects the points near the `old` segments and the candidate geometry,
  * with their cost when the old segments are gone (loc_base, loc_seg). With
  * reach > 0 the candidates stay within `reach` of seg_xy: a point not on an
@@ -408,6 +437,7 @@ static void prepare(polyc__opt *o, const int32_t *old, int n_old, const float *s
                     float reach, int move, float mx, float my)
 {
     const polyc__hash *h = &o->h;
+    const old_set olds = old_set_of(old, n_old);
     o->epoch++;
     o->bucket_n = 0;
     for (int k = 0; k < n_old; k++)
@@ -442,9 +472,7 @@ static void prepare(polyc__opt *o, const int32_t *old, int n_old, const float *s
         int32_t b = o->bucket_list[k];
         for (uint32_t i = h->pt_start[b]; i < h->pt_start[b + 1]; i++) {
             int32_t seg = o->pt_seg[i];
-            int hit = 0;
-            for (int j = 0; j < n_old; j++)
-                hit |= seg != POLYC__NONE && seg == old[j];
+            int hit = is_old(&olds, seg);
             int32_t base_seg = seg;
             double base = o->pt_cost[i];
             const polyc__point *p = &o->pts[i];
@@ -621,6 +649,7 @@ double polyc__local_delta(polyc__opt *o, const int32_t *old, int n_old, const fl
                           int n_new, double limit)
 {
     const polyc__hash *h = &o->h;
+    const old_set olds = old_set_of(old, n_old);
     polyc__seg_pre q[4];
     POLYC_ASSERT(n_new <= 4);
     for (int j = 0; j < n_new; j++)
@@ -648,9 +677,7 @@ double polyc__local_delta(polyc__opt *o, const int32_t *old, int n_old, const fl
                     c = cj;
             }
             int32_t seg = o->pt_seg[i];
-            int hit = 0;
-            for (int j = 0; j < n_old; j++)
-                hit |= seg != POLYC__NONE && seg == old[j];
+            int hit = is_old(&olds, seg);
             if (!hit || c <= cur) {
                 /* not hit: its cost without the old segments is cur; hit
                  * with c <= cur: no other segment beats c (all are >= cur) */
