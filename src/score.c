@@ -278,11 +278,27 @@ static double seg_cost(const polyc__seg_pre *q, const polyc__point *p)
     return c > 0.0 ? c : 0.0; /* as polyc__cost */
 }
 
-static double point_seg_dist(const polyc__point *p, const float *xy)
+/* A segment's start, direction and squared length, for point_seg_dist. */
+typedef struct seg_span {
+    double ax, ay, dx, dy, l2;
+} seg_span;
+
+static seg_span seg_span_of(const float *xy)
 {
-    double dx = (double)xy[2] - (double)xy[0], dy = (double)xy[3] - (double)xy[1];
-    double mx = (double)p->x - (double)xy[0], my = (double)p->y - (double)xy[1];
-    double l2 = dx * dx + dy * dy;
+    seg_span q;
+    q.ax = (double)xy[0];
+    q.ay = (double)xy[1];
+    q.dx = (double)xy[2] - (double)xy[0];
+    q.dy = (double)xy[3] - (double)xy[1];
+    q.l2 = q.dx * q.dx + q.dy * q.dy;
+    return q;
+}
+
+static double point_seg_dist(const polyc__point *p, const seg_span *q)
+{
+    double dx = q->dx, dy = q->dy;
+    double mx = (double)p->x - q->ax, my = (double)p->y - q->ay;
+    double l2 = q->l2;
     double t = l2 > 1e-18 ? (mx * dx + my * dy) / l2 : 0.0;
     t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
     double ex = mx - t * dx, ey = my - t * dy;
@@ -438,6 +454,10 @@ static void prepare(polyc__opt *o, const int32_t *old, int n_old, const float *s
 {
     const polyc__hash *h = &o->h;
     const old_set olds = old_set_of(old, n_old);
+    seg_span span[4];
+    POLYC_ASSERT(n_new <= 4);
+    for (int j = 0; j < n_new; j++)
+        span[j] = seg_span_of(seg_xy + 4 * j);
     o->epoch++;
     o->bucket_n = 0;
     for (int k = 0; k < n_old; k++)
@@ -480,7 +500,7 @@ static void prepare(polyc__opt *o, const int32_t *old, int n_old, const float *s
             if (reach > 0.0f) {
                 double dmin = 1e30;
                 for (int j = 0; j < n_new; j++) {
-                    double dj = point_seg_dist(p, seg_xy + 4 * j);
+                    double dj = point_seg_dist(p, &span[j]);
                     if (j < 2)
                         d[j] = dj;
                     if (dj < dmin)
