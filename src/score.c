@@ -426,7 +426,7 @@ static old_set old_set_of(const int32_t *old, int n_old)
     old_set s;
     s.a = n_old > 0 ? old[0] : POLYC__NONE;
     s.b = n_old > 1 ? old[1] : POLYC__NONE;
-    s.rest = old + 2;
+    s.rest = n_old > 2 ? old + 2 : old; /* never past the caller's array */
     s.n_rest = n_old > 2 ? n_old - 2 : 0;
     return s;
 }
