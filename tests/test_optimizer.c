@@ -797,19 +797,15 @@ static void test_move_eval_sees_neighbouring_buckets(void **state)
             V[v].x = cx; /* the brute force reads the vertices only */
             V[v].y = cy;
             double brute = brute_error(o) - before;
-            V[v].x = x0;
-            V[v].y = y0;
-            /* with A alone, the points of A would cost what A gives them */
-            int32_t seg;
+            /* some point of A is nearer to B than to the moved A */
             for (int32_t i = 0; i < o->np && !differs; i++) {
-                V[v].x = cx;
-                V[v].y = cy;
+                int32_t seg;
                 brute_nearest(o, &o->pts[i], &seg);
-                V[v].x = x0;
-                V[v].y = y0;
                 differs = fabsf(o->pts[i].y - dy) < 1e-4f && seg != POLYC__NONE &&
                           o->s->v[seg].line != la;
             }
+            V[v].x = x0;
+            V[v].y = y0;
             if (!close_rel(local, brute, 1e-9))
                 fail_msg("shift %d trial %d: local %.12f, brute force %.12f", k, t, local, brute);
         }
