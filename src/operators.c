@@ -226,9 +226,35 @@ static float other_dist2(const polyc__opt *o, float x, float y, int32_t v)
 
 /* ---- A: overlaps ---- */
 
-/* An open polyline whose end segment runs along another polyline (both of
- * its vertices within overlap_m of it) loses that end vertex, repeatedly:
- * the duplicate stretch is zipped away and the ends are left for merging. */
+/* Whether the segment from vertex e to its neighbour e2 runs along other
+ * segments: its two vertices and points along it, at most overlap_m apart,
+ * all lie within overlap_m of segments of other polylines (or of its own,
+ * away from it). The ends alone are not enough: a wall between two corners
+ * traced as separate polylines has both ends within reach of them. On
+ * intel that test took segments of up to 3.3 m (median 1.3 m) bridging two
+ * other polylines for overlaps, and zipping them away raised the BIC by
+ * 4,000 to 14,000 an iteration, which the rest of the iteration had to win
+ * back. */
+static int runs_along(const polyc__opt *o, int32_t e, int32_t e2, float lim)
+{
+    const polyc__vertex *a = &o->s->v[e], *b = &o->s->v[e2];
+    float lim2 = lim * lim;
+    if (other_dist2(o, a->x, a->y, e) > lim2 || other_dist2(o, b->x, b->y, e2) > lim2)
+        return 0;
+    float dx = b->x - a->x, dy = b->y - a->y;
+    int n = (int)ceilf(sqrtf(dx * dx + dy * dy) / lim);
+    for (int k = 1; k < n; k++) {
+        float t = (float)k / (float)n;
+        if (other_dist2(o, a->x + t * dx, a->y + t * dy, e2) > lim2)
+            return 0;
+    }
+    return 1;
+}
+
+/* An open polyline whose end segment runs along another polyline (every
+ * point of it within overlap_m of one, runs_along) loses that end vertex,
+ * repeatedly: the duplicate stretch is zipped away and the ends are left
+ * for merging. */
 int polyc__op_overlaps(polyc__opt *o)
 {
     polyc__store *s = o->s;
@@ -244,8 +270,7 @@ int polyc__op_overlaps(polyc__opt *o)
                     break;
                 int32_t e = side ? ln->tail : ln->head;
                 int32_t e2 = side ? s->v[e].prev : s->v[e].next;
-                if (other_dist2(o, s->v[e].x, s->v[e].y, e) > lim2 ||
-                    other_dist2(o, s->v[e2].x, s->v[e2].y, e2) > lim2)
+                if (!runs_along(o, e, e2, o->cfg->overlap_m))
                     break;
                 polyc__apply_remove(o, e);
                 changed++;

@@ -971,6 +971,39 @@ static void test_overlaps_leaves_separate_lines(void **state)
     fx_close(&f);
 }
 
+static void test_overlaps_leaves_a_wall_between_two_lines(void **state)
+{
+    (void)state;
+    static fixture f;
+    fx_open_hand(&f, 0.0f);
+    clear_lines(&f.o);
+    /* a 1 m wall whose two ends touch two other walls (corners traced as
+     * separate polylines): both of its vertices lie within overlap_m of
+     * other polylines, but the stretch between them does not run along
+     * any; it is not an overlap */
+    const float left[4] = {-0.5f, -1.0f, -0.5f, 1.0f};
+    const float right[4] = {0.52f, -1.0f, 0.52f, 1.0f};
+    const float wall[4] = {-0.48f, 0.3f, 0.5f, 0.3f};
+    add_line(&f.o, left, 2, 0);
+    add_line(&f.o, right, 2, 0);
+    int32_t lw = add_line(&f.o, wall, 2, 0);
+    rebuild(&f.o);
+    assert_int_equal(polyc__op_overlaps(&f.o), 0);
+    assert_int_equal(f.o.s->l[lw].count, 2);
+    assert_int_equal(f.o.s->v_live, 6);
+    /* the same wall laid along the left one is an overlap: it goes, one
+     * end vertex at a time, down to its last one */
+    clear_lines(&f.o);
+    const float along[4] = {-0.48f, -0.6f, -0.48f, 0.4f};
+    add_line(&f.o, left, 2, 0);
+    int32_t la = add_line(&f.o, along, 2, 0);
+    rebuild(&f.o);
+    assert_int_equal(polyc__op_overlaps(&f.o), 1);
+    check_books(&f.o, "overlaps along");
+    assert_true(f.o.s->l[la].count < 2);
+    fx_close(&f);
+}
+
 /* ---- B: merge ---- */
 
 static void merge_case(fixture *f, const float *a, const float *b, int n)
@@ -1694,6 +1727,7 @@ int main(void)
         cmocka_unit_test(test_insert_recycling_removed_vertex_angle),
         cmocka_unit_test(test_overlaps_trims_overlapping_end),
         cmocka_unit_test(test_overlaps_leaves_separate_lines),
+        cmocka_unit_test(test_overlaps_leaves_a_wall_between_two_lines),
         cmocka_unit_test(test_merge_joins_ends_10cm_apart),
         cmocka_unit_test(test_merge_leaves_ends_30cm_apart),
         cmocka_unit_test(test_merge_closes_polyline),
