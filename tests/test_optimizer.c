@@ -991,8 +991,8 @@ static void test_overlaps_leaves_a_wall_between_two_lines(void **state)
     assert_int_equal(polyc__op_overlaps(&f.o), 0);
     assert_int_equal(f.o.s->l[lw].count, 2);
     assert_int_equal(f.o.s->v_live, 6);
-    /* the same wall laid along the left one is an overlap: it goes, one
-     * end vertex at a time, down to its last one */
+    /* the same wall laid along the left one is an overlap: it loses an
+     * end vertex, and no segment of it is left */
     clear_lines(&f.o);
     const float along[4] = {-0.48f, -0.6f, -0.48f, 0.4f};
     add_line(&f.o, left, 2, 0);
