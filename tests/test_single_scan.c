@@ -267,10 +267,11 @@ static void test_grazing_wall_is_one_chain(void **state)
 }
 
 /* Initial chains drop the vertices Douglas-Peucker kept on range noise:
- * each corridor wall (1 cm noise, seen along 15 m) is one segment, and the
- * room keeps its corners: two pieces of wall around the box's shadow with a
- * corner each and the box's two faces, 9 vertices (10: the shadow's edge
- * on the far wall leaves a 17 cm stub). Every return stays on the map. */
+ * each corridor wall (1 cm noise, seen along 15 m) is one segment (it kept
+ * 10 vertices a wall), and the room keeps its corners: two pieces of wall
+ * around the box's shadow with a corner each (6 vertices), the box's near
+ * face (2), and its other face, seen edge-on, as 3 cm of a chain of its own
+ * (2; 1 if the faces come as one chain). Every return stays on the map. */
 static void test_chains_drop_noise_vertices(void **state)
 {
     (void)state;
