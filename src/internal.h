@@ -149,10 +149,16 @@ typedef struct polyc__prior {
     double origin_x, origin_y;     /* frame-relative lower-left corner */
     float cell_m, inv_cell;
     int32_t w, h;
-    uint16_t *hist;                /* w * h * POLYC__ANGLE_BINS counts, saturating */
-    /* per cell, when the block has room to spare: the smoothed counts of
-     * its 18 bins and their total, which queries would sum over 3 x 3 cells
-     * (the same integers); NULL: queries sum them */
+    /* per cell (w * h): 1 + its row of counts, 0 for a cell without evidence */
+    uint32_t *row_of;
+    uint16_t *hist;                /* rows * POLYC__ANGLE_BINS counts, saturating */
+    uint32_t *total;               /* per row: the sum of its counts */
+    uint32_t rows;
+    /* when the block has room to spare: per cell, 1 + its row of smoothed
+     * counts (18 bins and their total, which queries would sum over 3 x 3
+     * cells: the same integers), 0 where no cell of the 3 x 3 has evidence;
+     * smooth NULL: queries sum them */
+    uint32_t *smooth_of;
     uint32_t *smooth;
     uint32_t corners, straights;   /* observations recorded */
 } polyc__prior;
@@ -173,12 +179,16 @@ typedef struct polyc__prior_place {
 void polyc__prior_at(const polyc__prior *p, float x, float y, polyc__prior_place *at);
 int polyc__prior_same_place(const polyc__prior *p, const polyc__prior_place *at, float x, float y);
 float polyc__prior_p_at(const polyc__prior_place *at, float turn_rad);
+/* The 18 counts of prior cell (cx, cy); NULL without evidence or outside. */
+const uint16_t *polyc__prior_counts(const polyc__prior *p, int32_t cx, int32_t cy);
 
 /* ---- expected beam spacing (spacing.c) ---- */
 typedef struct polyc__spacing {
     float origin_x, origin_y, tile_m, min_step_rad;
     int32_t w, h;
     float *dist;                   /* per tile: distance to the nearest pose */
+    const polyc__scan *poses;      /* or, for a few poses, these (dist NULL) */
+    uint32_t pose_count;
 } polyc__spacing;
 
 size_t polyc__spacing_bytes(const polyc_limits *lim);

@@ -253,16 +253,30 @@ static void test_histogram_bins(void **state)
     /* the cell of the lower-left corner: 90 degree turns in bin 9 only */
     int32_t ix = (int32_t)floor(((double)fx(&f, ROOM.x0) - p->origin_x) / (double)p->cell_m);
     int32_t iy = (int32_t)floor(((double)fy(&f, ROOM.y0) - p->origin_y) / (double)p->cell_m);
-    const uint16_t *h = p->hist + ((size_t)iy * (size_t)p->w + (size_t)ix) * POLYC__ANGLE_BINS;
+    const uint16_t *h = polyc__prior_counts(p, ix, iy);
+    assert_non_null(h);
     assert_true(h[9] > 0);
     assert_true(h[0] > 0);
     for (int b = 1; b < POLYC__ANGLE_BINS; b++)
         if (b != 9)
             assert_int_equal(h[b], 0);
-    /* every recorded observation is in the histogram */
+    /* every recorded observation is in the histogram, in the row of its
+     * cell: the rows are those of the cells with evidence, each once */
     uint64_t sum = 0;
-    for (size_t i = 0; i < (size_t)p->w * (size_t)p->h * POLYC__ANGLE_BINS; i++)
-        sum += p->hist[i];
+    uint32_t cells_with = 0;
+    for (int32_t cy = 0; cy < p->h; cy++)
+        for (int32_t cx = 0; cx < p->w; cx++) {
+            const uint16_t *c = polyc__prior_counts(p, cx, cy);
+            if (!c)
+                continue;
+            cells_with++;
+            uint32_t n = 0;
+            for (int b = 0; b < POLYC__ANGLE_BINS; b++)
+                n += c[b];
+            assert_true(n > 0);
+            sum += n;
+        }
+    assert_int_equal(cells_with, p->rows);
     assert_int_equal(sum, (uint64_t)p->corners * 8u + p->straights); /* corners weigh 8 */
     free_ctx(&f);
 }
@@ -362,11 +376,18 @@ static void test_deterministic(void **state)
     assert_int_equal(a.prior.h, b.prior.h);
     assert_int_equal(a.prior.corners, b.prior.corners);
     assert_int_equal(a.prior.straights, b.prior.straights);
-    size_t n = (size_t)a.prior.w * (size_t)a.prior.h * POLYC__ANGLE_BINS * sizeof(uint16_t);
+    /* the same rows, handed out in the same order */
+    size_t cells = (size_t)a.prior.w * (size_t)a.prior.h * sizeof(uint32_t);
+    size_t n = (size_t)a.prior.rows * POLYC__ANGLE_BINS * sizeof(uint16_t);
+    assert_int_equal(a.prior.rows, b.prior.rows);
+    assert_true(a.prior.rows > 0);
+    assert_memory_equal(a.prior.row_of, b.prior.row_of, cells);
     assert_memory_equal(a.prior.hist, b.prior.hist, n);
     /* building again in the same context gives the same prior */
     polyc__prior again;
     assert_int_equal(polyc__prior_build(a.ctx, &again, SIZE_MAX), POLYC_OK);
+    assert_int_equal(again.rows, a.prior.rows);
+    assert_memory_equal(a.prior.row_of, again.row_of, cells);
     assert_memory_equal(a.prior.hist, again.hist, n);
     free_ctx(&a);
     free_ctx(&b);
@@ -437,12 +458,14 @@ static void test_size_query(void **state)
 {
     (void)state;
     polyc_limits lim = {1, 1, 0, 0, 0};
-    size_t cell = POLYC__ANGLE_BINS * sizeof(uint16_t) + sizeof(uint32_t);
+    /* per cell: its row index, a row of counters and a total */
+    size_t cell = sizeof(uint32_t) + POLYC__ANGLE_BINS * sizeof(uint16_t) + sizeof(uint32_t);
     assert_true(polyc__prior_bytes(&lim) >= 64 * cell);
     lim.max_grid_cells = 1u << 20; /* 1024 tiles */
     assert_true(polyc__prior_bytes(&lim) >= (1024 * 4 + 64) * cell);
-    /* and a scratch row for one beam's endpoint (x, y, range), aligned */
-    assert_true(polyc__prior_bytes(&lim) < (1024 * 4 + 64) * cell + 16 + 3 * sizeof(float) + 16);
+    /* and a scratch row for one beam's endpoint (x, y, range), each of the
+     * four arrays aligned */
+    assert_true(polyc__prior_bytes(&lim) < (1024 * 4 + 64) * cell + 3 * 16 + 3 * sizeof(float) + 16);
     lim.max_grid_cells = UINT32_MAX;
     assert_true(polyc__prior_bytes(&lim) > 0);
 }

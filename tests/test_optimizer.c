@@ -1579,6 +1579,64 @@ static void test_trim_pulls_end_back_to_data(void **state)
     fx_close(&f);
 }
 
+/* The beam spacing: with a few poses (here 3) the distance to the nearest
+ * one is measured when asked; with more, a chamfer field over the tiles
+ * holds it, within 1.5 tiles (a tile diagonal: the field knows the tiles
+ * of the pose and of the query, not where in them they are) and the
+ * chamfer's 8 % of the measured one, inside the room. */
+static void test_spacing_direct_and_field(void **state)
+{
+    (void)state;
+    static fixture f;
+    fx_open_hand(&f, 0.0f);
+    const polyc__spacing *sp = &f.o.spacing;
+    const polyc_ctx *ctx = f.ctx;
+    assert_null(sp->dist);
+    assert_int_equal(sp->pose_count, N_POSES);
+    float step = (float)(2.0 * PI_D / BEAMS);
+    assert_float_equal(sp->min_step_rad, step, 1e-9f);
+    /* the same scans twice: six poses, a field */
+    polyc_limits lim;
+    polyc_scan twice[2 * N_POSES];
+    for (int k = 0; k < 2 * N_POSES; k++)
+        twice[k] = f.scans[k % N_POSES];
+    check_st(polyc_limits_for_scans(&f.cfg, twice, 2 * N_POSES, &lim), NULL, "limits");
+    size_t size = polyc_memory_size(&f.cfg, &lim);
+    void *block = malloc(size);
+    assert_non_null(block);
+    polyc_ctx *c2;
+    check_st(polyc_init(block, size, &f.cfg, &lim, &c2), NULL, "init");
+    for (int k = 0; k < 2 * N_POSES; k++)
+        check_st(polyc_add_scan(c2, &twice[k]), c2, "add_scan");
+    check_st(polyc_trace(c2), c2, "trace");
+    polyc__spacing field;
+    check_st(polyc__spacing_build(c2, &field), c2, "spacing");
+    assert_non_null(field.dist);
+    assert_null(field.poses);
+    int checked = 0;
+    for (float y = (float)ROOM_Y0; y <= (float)ROOM_Y1; y += 0.125f)
+        for (float x = (float)ROOM_X0; x <= (float)ROOM_X1; x += 0.125f) {
+            /* (x, y) in the room's frame; both contexts share its origin */
+            float fx = x - (float)ctx->frame_x, fy = y - (float)ctx->frame_y;
+            float best = 1e30f;
+            for (uint32_t k = 0; k < ctx->scan_count; k++) {
+                float dx = fx - ctx->scans[k].x_m, dy = fy - ctx->scans[k].y_m;
+                best = fminf(best, sqrtf(dx * dx + dy * dy));
+            }
+            float direct = polyc__spacing_at(sp, fx, fy);
+            assert_float_equal(direct, best * step, 1e-6f);
+            float gx = x - (float)c2->frame_x, gy = y - (float)c2->frame_y;
+            float from_field = polyc__spacing_at(&field, gx, gy) / step;
+            if (fabsf(from_field - best) > 0.08f * best + 1.5f * field.tile_m)
+                fail_msg("at (%.2f, %.2f): field %.3f m, nearest pose %.3f m", (double)x,
+                         (double)y, (double)from_field, (double)best);
+            checked++;
+        }
+    assert_true(checked > 700);
+    free(block);
+    fx_close(&f);
+}
+
 /* ---- spatial hash ---- */
 
 static void test_hash_matches_brute_force(void **state)
@@ -1750,6 +1808,7 @@ int main(void)
         cmocka_unit_test(test_corner_replaces_spike),
         cmocka_unit_test(test_corners_leave_clean_map),
         cmocka_unit_test(test_trim_pulls_end_back_to_data),
+        cmocka_unit_test(test_spacing_direct_and_field),
         cmocka_unit_test(test_hash_matches_brute_force),
         cmocka_unit_test(test_hash_segment_leaving_area),
         cmocka_unit_test(test_optimize_room),
