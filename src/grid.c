@@ -235,13 +235,15 @@ static void count_beam(const count_pass *p, const polyc__beam *b)
         return;
     while (w.n > 0) {
         if (t == p->spill) {
-            /* nothing is counted here: the walk leaves the tile in one move
-             * (or steps to its end cell if that is in the tile) */
-            int left = polyc__walk_leave_tile(&w);
-            while (!left && w.n > 0)
-                left = polyc__walk_step(&w);
-            if (left && w.n > 0 &&
-                (!polyc__walk_enter(&w, g->width, g->height) || !(t = tile_get(p, w.ix, w.iy))))
+            /* nothing is counted here or in the tiles after it until one
+             * where some beam ends in a hit: the walk goes there in one
+             * move, or ends (then its end cell), or leaves the grid */
+            int to = polyc__walk_skip_tiles(&w, g->width, g->height, g->tiles_x, p->wanted);
+            if (to < 0)
+                return;
+            if (to == 0)
+                break;
+            if (!polyc__walk_enter(&w, g->width, g->height) || !(t = tile_get(p, w.ix, w.iy)))
                 return;
             continue;
         }

@@ -27,6 +27,7 @@ typedef struct polyc__walk {
     int64_t kx, ky;                /* keys of the next x and y crossings (INT64_MAX: none) */
     int64_t inc_x, inc_y;          /* what a step adds to them */
     int64_t t_key;                 /* key of the step into the current cell (0: the start) */
+    int64_t end_key;               /* key of the end point: no step's is larger */
     float per_key;                 /* beam parameter per key unit */
 } polyc__walk;
 
@@ -74,6 +75,7 @@ static inline void polyc__walk_start(polyc__walk *w, const polyc__beam *b)
         w->ky = ay * dxa;
         w->inc_x = one * dya;
         w->inc_y = one * dxa;
+        w->end_key = dxa * dya;
         w->per_key = 1.0f / ((float)dxa * (float)dya);
     } else {
         /* along one axis only (or not at all): its distance is the key */
@@ -81,6 +83,7 @@ static inline void polyc__walk_start(polyc__walk *w, const polyc__beam *b)
         w->ky = dya > 0 ? ay : INT64_MAX;
         w->inc_x = dxa > 0 ? one : 0;
         w->inc_y = dya > 0 ? one : 0;
+        w->end_key = dxa > 0 ? dxa : dya;
         w->per_key = dxa > 0 ? 1.0f / (float)dxa : (dya > 0 ? 1.0f / (float)dya : 0.0f);
     }
     /* the step count is fixed in advance, so the walk always ends */
@@ -153,6 +156,78 @@ static inline int polyc__walk_leave_tile(polyc__walk *w)
     }
     if (sx + sy > (int64_t)w->n)
         return 0;
+    w->n -= (int32_t)(sx + sy);
+    w->t_key = key;
+    w->kx = w->inc_x ? w->kx + sx * w->inc_x : INT64_MAX;
+    w->ky = w->inc_y ? w->ky + sy * w->inc_y : INT64_MAX;
+    w->ix += w->stx * (int32_t)sx;
+    w->iy += w->sty * (int32_t)sy;
+    w->left_x = w->left_y = -1;
+    return 1;
+}
+
+/* Moves the walk, from inside a tile whose counts polyc__walk_enter set,
+ * into the first tile of its path whose bit is set in `stop` (a bit per
+ * tile, row-major over tiles_x columns), where its steps would take it,
+ * and returns 1; if its steps end first (the step into that tile would be
+ * the last, or none is left), 0; if they leave the width x height grid
+ * first, -1 (nothing moved in either case). Tile by tile only the keys of
+ * the steps that leave each tile are compared (the same order as the
+ * steps: across x when its key is below y's), so a beam's crossing of
+ * many tiles without a stop costs a comparison and an addition each; the
+ * step counts (a division) are worked out where it stops. No step has a
+ * key past the end point's (end_key): ties there are why a walk can end a
+ * cell off its end cell, and why the step counts decide. */
+static inline int polyc__walk_skip_tiles(polyc__walk *w, int32_t width, int32_t height,
+                                         int32_t tiles_x, const uint32_t *stop)
+{
+    const int32_t S = POLYC__TILE_SIDE, m = S - 1;
+    int32_t tx = w->ix >> POLYC__TILE_SHIFT, ty = w->iy >> POLYC__TILE_SHIFT;
+    /* keys of the steps that leave the current tile along x and along y */
+    int64_t lx = w->inc_x ? w->kx + (int64_t)w->left_x * w->inc_x : INT64_MAX;
+    int64_t ly = w->inc_y ? w->ky + (int64_t)w->left_y * w->inc_y : INT64_MAX;
+    int64_t key;
+    int across_x, outside;
+    for (;;) {
+        across_x = lx < ly;
+        key = across_x ? lx : ly;
+        if (key > w->end_key)
+            return 0;
+        if (across_x) {
+            tx += w->stx;
+            int32_t lo = tx * S;
+            outside = tx < 0 || lo >= width;
+            /* the columns it crosses in the new tile (the last tile may be cut by the grid) */
+            int32_t cols = w->stx > 0 ? ((lo + m < width ? lo + m : width - 1) - lo + 1) : S;
+            lx = key + (int64_t)cols * w->inc_x;
+        } else {
+            ty += w->sty;
+            int32_t lo = ty * S;
+            outside = ty < 0 || lo >= height;
+            int32_t rows = w->sty > 0 ? ((lo + m < height ? lo + m : height - 1) - lo + 1) : S;
+            ly = key + (int64_t)rows * w->inc_y;
+        }
+        if (outside)
+            break;
+        size_t d = (size_t)ty * (size_t)tiles_x + (size_t)tx;
+        if ((stop[d >> 5] >> (d & 31)) & 1u)
+            break;
+    }
+    /* the step with `key` enters the tile: before it, along x the steps
+     * whose keys are below (across y) or up to it, along y those at or
+     * below (across x) or up to it */
+    int64_t sx, sy;
+    if (across_x) {
+        sx = (key - w->kx) / w->inc_x + 1;
+        sy = w->ky > key ? 0 : (key - w->ky) / w->inc_y + 1;
+    } else {
+        sy = (key - w->ky) / w->inc_y + 1;
+        sx = w->kx >= key ? 0 : (key - w->kx - 1) / w->inc_x + 1;
+    }
+    if (sx + sy >= (int64_t)w->n)
+        return 0; /* that step would be the last (or past it) */
+    if (outside)
+        return -1;
     w->n -= (int32_t)(sx + sy);
     w->t_key = key;
     w->kx = w->inc_x ? w->kx + sx * w->inc_x : INT64_MAX;

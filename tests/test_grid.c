@@ -402,6 +402,81 @@ static void test_tile_jump_matches_steps(void **state)
     assert_true(jumps > 20000);
 }
 
+/* polyc__walk_skip_tiles puts a walk where its steps take it into the
+ * first stop tile of its path (same cell, keys and steps left), and says
+ * when instead its steps end first (the step into a stop tile, or out of
+ * the grid, would be the last) or leave the grid: random beams, along the
+ * axes and through tile corners too (ties), some ending outside the grid
+ * or exactly on cell boundaries, over random stop tiles on a grid whose
+ * last row and column of tiles are cut short. */
+static void test_tile_skip_matches_steps(void **state)
+{
+    (void)state;
+    enum { W = 300, H = 170, TX = (W + 31) / 32, TY = (H + 31) / 32 };
+    uint32_t stop[(TX * TY + 31) / 32];
+    uint32_t rng = 777u, count[3] = {0, 0, 0};
+    for (int k = 0; k < 30000; k++) {
+        if (k % 100 == 0) { /* new stop tiles, one in four */
+            memset(stop, 0, sizeof stop);
+            for (int32_t d = 0; d < TX * TY; d++) {
+                rng = rng * 1664525u + 1013904223u;
+                if ((rng >> 28) < 4u)
+                    stop[d / 32] |= 1u << (d % 32);
+            }
+        }
+        polyc__beam b;
+        b.sx = coord(&rng, (float)W);
+        b.sy = coord(&rng, (float)H);
+        b.ex = coord(&rng, (float)W + 40.0f) - 20.0f; /* some end outside the grid */
+        b.ey = coord(&rng, (float)H + 40.0f) - 20.0f;
+        if (k % 10 == 1) b.ey = b.sy; /* along x */
+        if (k % 10 == 2) b.ex = b.sx; /* along y */
+        if (k % 10 == 3) { /* on y = x: through tile corners */
+            b.sy = b.sx = coord(&rng, (float)H);
+            b.ey = b.ex = coord(&rng, (float)H + 40.0f) - 20.0f;
+        }
+        b.hit = 1;
+        b.miss_end = 1.0f;
+        polyc__walk a;
+        polyc__walk_start(&a, &b);
+        if (!polyc__walk_enter(&a, W, H))
+            continue;
+        polyc__walk try = a;
+        int got = polyc__walk_skip_tiles(&try, W, H, TX, stop);
+        /* the steps: ended (0) when a step leaves none, else out of the
+         * grid (-1), or in another tile that is a stop tile (1) */
+        int32_t t0 = (a.iy >> 5) * TX + (a.ix >> 5);
+        int want = 0;
+        while (a.n > 0) {
+            polyc__walk_step(&a);
+            if (a.n == 0)
+                break;
+            if (a.ix < 0 || a.iy < 0 || a.ix >= W || a.iy >= H) {
+                want = -1;
+                break;
+            }
+            int32_t d = (a.iy >> 5) * TX + (a.ix >> 5);
+            if (d != t0 && ((stop[d / 32] >> (d % 32)) & 1u)) {
+                want = 1;
+                break;
+            }
+        }
+        if (got != want)
+            fail_msg("beam %d: (%.3f, %.3f) -> (%.3f, %.3f): skip says %d, the steps %d", k,
+                     (double)b.sx, (double)b.sy, (double)b.ex, (double)b.ey, got, want);
+        count[want + 1]++;
+        if (want != 1)
+            continue;
+        assert_int_equal(try.ix, a.ix);
+        assert_int_equal(try.iy, a.iy);
+        assert_int_equal(try.n, a.n);
+        assert_true(try.kx == a.kx && try.ky == a.ky);
+        assert_true(try.t_key == a.t_key);
+    }
+    print_message("left the grid %u, ended %u, stopped %u\n", count[0], count[1], count[2]);
+    assert_true(count[0] > 1000 && count[1] > 1000 && count[2] > 5000);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -409,6 +484,7 @@ int main(void)
         cmocka_unit_test(test_saturation_matches_traversal),
         cmocka_unit_test(test_contour_without_bitmap),
         cmocka_unit_test(test_tile_jump_matches_steps),
+        cmocka_unit_test(test_tile_skip_matches_steps),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
