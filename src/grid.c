@@ -23,12 +23,18 @@ static size_t wanted_bytes(size_t dir_n)
     return polyc__bytes(dir_n / 32 + 1, sizeof(uint32_t));
 }
 
+size_t polyc__grid_dir_cap(const polyc_limits *lim)
+{
+    size_t tiles = ((size_t)lim->max_grid_cells + POLYC__TILE_CELLS - 1) / POLYC__TILE_CELLS;
+    /* one entry per tile of the bounding box; a bounding box up to 4x the
+     * tile budget (plus a small fixed part) fits */
+    return tiles * 4 + 64;
+}
+
 size_t polyc__grid_budget_bytes(const polyc_limits *lim)
 {
     size_t tiles = ((size_t)lim->max_grid_cells + POLYC__TILE_CELLS - 1) / POLYC__TILE_CELLS;
-    /* directory: one entry per tile of the bounding box; a bounding box up to
-     * 4x the tile budget (plus a small fixed part) fits */
-    size_t dir_n = tiles * 4 + 64;
+    size_t dir_n = polyc__grid_dir_cap(lim);
     size_t dir = polyc__add(polyc__bytes(dir_n, sizeof(uint32_t)), wanted_bytes(dir_n));
     /* the tiles and one more, the spill tile of count_beam */
     return polyc__add(polyc__bytes(tiles + 1, sizeof(polyc__tile)), dir);

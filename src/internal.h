@@ -309,6 +309,8 @@ typedef int (*polyc__cell_fn)(void *u, int32_t ix, int32_t iy, float t_enter, in
 void polyc__traverse(const polyc__beam *b, polyc__cell_fn visit, void *u);
 
 /* contour.c */
+/* entries the grid's tile directory may have under the limits */
+size_t polyc__grid_dir_cap(const polyc_limits *lim);
 size_t polyc__contour_bytes(const polyc_limits *lim);
 polyc_status polyc__contour_build(polyc_ctx *ctx);
 

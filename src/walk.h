@@ -7,8 +7,8 @@
  * per beam so that no product exceeds 2^62), and for each axis a key that
  * orders the boundary crossings exactly, the distance to the next boundary
  * along that axis times the beam's extent along the other one. A step adds
- * a constant to a key, so a walk can leave a whole tile in one move
- * (polyc__walk_leave_tile) and be where its steps would have taken it. */
+ * a constant to a key, so a walk can cross any number of tiles in one
+ * move (polyc__walk_skip_tiles) and be where its steps would have taken it. */
 #ifndef POLYC_WALK_H
 #define POLYC_WALK_H
 
@@ -131,38 +131,6 @@ static inline int polyc__walk_enter(polyc__walk *w, int32_t width, int32_t heigh
     w->idx = polyc__cell_index(w->ix, w->iy);
     w->left_x = w->stx > 0 ? ((w->ix | m) < width ? w->ix | m : width - 1) - w->ix : w->ix & m;
     w->left_y = w->sty > 0 ? ((w->iy | m) < height ? w->iy | m : height - 1) - w->iy : w->iy & m;
-    return 1;
-}
-
-/* Moves the walk into the first cell past the current tile, where its steps
- * would take it; 0 (and nothing moved) when the walk ends inside the tile.
- * Needs the counts of polyc__walk_enter. A step goes along x when its key
- * is below y's, so a walk that leaves across x has taken the y steps whose
- * keys are at or below that x step's, and one that leaves across y the x
- * steps whose keys are below. */
-static inline int polyc__walk_leave_tile(polyc__walk *w)
-{
-    int64_t last_x = w->inc_x ? w->kx + (int64_t)w->left_x * w->inc_x : INT64_MAX;
-    int64_t last_y = w->inc_y ? w->ky + (int64_t)w->left_y * w->inc_y : INT64_MAX;
-    int64_t sx, sy, key;
-    if (last_x < last_y) {
-        sx = (int64_t)w->left_x + 1;
-        sy = w->ky > last_x ? 0 : (last_x - w->ky) / w->inc_y + 1;
-        key = last_x;
-    } else {
-        sy = (int64_t)w->left_y + 1;
-        sx = w->kx >= last_y ? 0 : (last_y - w->kx - 1) / w->inc_x + 1;
-        key = last_y;
-    }
-    if (sx + sy > (int64_t)w->n)
-        return 0;
-    w->n -= (int32_t)(sx + sy);
-    w->t_key = key;
-    w->kx = w->inc_x ? w->kx + sx * w->inc_x : INT64_MAX;
-    w->ky = w->inc_y ? w->ky + sy * w->inc_y : INT64_MAX;
-    w->ix += w->stx * (int32_t)sx;
-    w->iy += w->sty * (int32_t)sy;
-    w->left_x = w->left_y = -1;
     return 1;
 }
 
