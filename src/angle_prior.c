@@ -83,7 +83,6 @@ static size_t cell_cap(const polyc_limits *lim)
     return tiles * 4 + 64;
 }
 
-
 /* The split-and-merge visits each endpoint several times: a scan of up to
  * this many beams has its endpoints computed once, into a scratch block that
  * is released after learning (a longer scan computes them on every visit,
@@ -438,13 +437,13 @@ static void smooth_table(polyc__prior *p, polyc__arena *a, size_t room)
                 if (neighbour(p, cx, cy, k, &nb, &w) && of[nb] == 0)
                     of[nb] = ++n;
         }
-    size_t used = polyc__bytes(cells, sizeof(uint32_t));
-    uint32_t *t = used <= room ? polyc__alloc(a, n, (BINS + 1) * sizeof(uint32_t)) : NULL;
-    if (!t || polyc__add(used, polyc__bytes(n, (BINS + 1) * sizeof(uint32_t))) > room) {
-        a->used = mark;
+    size_t need = polyc__add(polyc__bytes(cells, sizeof(uint32_t)),
+                             polyc__bytes(n, (BINS + 1) * sizeof(uint32_t)));
+    uint32_t *t = need <= room ? polyc__alloc_zero(a, n, (BINS + 1) * sizeof(uint32_t)) : NULL;
+    if (!t) {
+        a->used = mark; /* no table: queries sum the 3 x 3 cells */
         return;
     }
-    memset(t, 0, (size_t)n * (BINS + 1) * sizeof(uint32_t));
     for (int32_t cy = 0; cy < p->h; cy++)
         for (int32_t cx = 0; cx < p->w; cx++) {
             size_t c = (size_t)cy * (size_t)p->w + (size_t)cx, nb;
