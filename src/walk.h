@@ -181,15 +181,17 @@ static inline int polyc__walk_skip_tiles(polyc__walk *w, int32_t width, int32_t 
         if ((stop[d >> 5] >> (d & 31)) & 1u)
             break;
     }
-    /* the step with `key` enters the tile: before it, along x the steps
-     * whose keys are below (across y) or up to it, along y those at or
-     * below (across x) or up to it */
+    /* the step with `key` enters the tile: along its own axis the steps
+     * are the columns (rows) to the tile's edge; along the other, the steps
+     * whose keys are at or below it (across x) or below it (across y) */
     int64_t sx, sy;
     if (across_x) {
-        sx = (key - w->kx) / w->inc_x + 1;
+        int64_t to = (int64_t)tx * S < width ? (int64_t)tx * S : width; /* (out past a cut tile) */
+        sx = w->stx > 0 ? to - w->ix : (int64_t)w->ix - ((int64_t)tx * S + m);
         sy = w->ky > key ? 0 : (key - w->ky) / w->inc_y + 1;
     } else {
-        sy = (key - w->ky) / w->inc_y + 1;
+        int64_t to = (int64_t)ty * S < height ? (int64_t)ty * S : height;
+        sy = w->sty > 0 ? to - w->iy : (int64_t)w->iy - ((int64_t)ty * S + m);
         sx = w->kx >= key ? 0 : (key - w->kx - 1) / w->inc_x + 1;
     }
     if (sx + sy >= (int64_t)w->n)

@@ -5,8 +5,8 @@
  * reach them, with the same counters in every cell; the contour list is the
  * same, in the same order. Scenes: a room with clutter, no-return, short and
  * NaN ranges at several cell sizes; one pose seen 200 times (the sensor's
- * cell saturates); the contour with and without room for its bitmap; and
- * the walk's tile jump against its steps, beam by beam. */
+ * cell saturates); the contour within its budget; and the walk's skip
+ * over tiles against its steps, beam by beam. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
