@@ -539,6 +539,21 @@ int polyc__op_split(polyc__opt *o)
 
 /* ---- end trimming (part of C) ---- */
 
+/* Whether pulling end vertex v back to (x, y) on its segment loses a
+ * return the segment holds now (single scans only): on a segment that runs
+ * along the beams the farthest projection of its points can fall short of
+ * where the last beam crosses it (edmonton, infinite-corridor and csail
+ * each had a scan whose end beam then met the map metres behind its
+ * return). */
+static int trim_loses_returns(const polyc__opt *o, int32_t v, float x, float y)
+{
+    const polyc__vertex *V = o->s->v;
+    int32_t nb = V[v].prev != POLYC__NONE ? V[v].prev : V[v].next;
+    const float old_xy[4] = {V[v].x, V[v].y, V[nb].x, V[nb].y};
+    const float new_xy[4] = {x, y, V[nb].x, V[nb].y};
+    return polyc__loses_returns(&o->rays, old_xy, 1, new_xy, 1);
+}
+
 /* Nothing in the BIC holds an open end where the data stop: points beyond
  * it cost the same wherever it is. Each open end is pulled back to the
  * farthest projection of the points of its segment, plus half a beam
@@ -594,12 +609,12 @@ int polyc__op_trim_ends(polyc__opt *o)
         float tx = ax + keep_tail * (bx - ax), ty = ay + keep_tail * (by - ay);
         float hx = bx + keep_head * (ax - bx), hy = by + keep_head * (ay - by);
         if (s->v[w].next == POLYC__NONE && o->split_t[v] >= 0.0f && keep_tail != 1.0f &&
-            !(keep_tail > 1.0f && polyc__vertex_blocks(o, w, tx, ty))) {
+            !(keep_tail > 1.0f ? polyc__vertex_blocks(o, w, tx, ty) : trim_loses_returns(o, w, tx, ty))) {
             polyc__apply_move(o, w, tx, ty);
             changed++;
         }
         if (a->prev == POLYC__NONE && o->trim_head[v] >= 0.0f && keep_head != 1.0f &&
-            !(keep_head > 1.0f && polyc__vertex_blocks(o, v, hx, hy))) {
+            !(keep_head > 1.0f ? polyc__vertex_blocks(o, v, hx, hy) : trim_loses_returns(o, v, hx, hy))) {
             polyc__apply_move(o, v, hx, hy);
             changed++;
         }

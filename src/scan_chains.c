@@ -330,27 +330,49 @@ static int meet(const fitted *f, const fitted *g, float *x, float *y)
 /* The end of a chain on its fitted line f, at beam i's hit: where beam i
  * crosses the line, so that the beam meets the polyline (the hit's
  * projection can lie on the wrong side of the beam when the range noise is
- * as large as the beam spacing, as near the sensor); the projection if the
- * beam runs within 3 degrees of the line or crosses it more than 50 cm from
- * it. */
-static void end_on_line(const chains *c, const fitted *f, int32_t i, float *x, float *y)
+ * as large as the beam spacing, as near the sensor). Returns 0, with the
+ * projection, if the beam runs within 3 degrees of the line or crosses it
+ * more than 50 cm from it: there the beam does not meet the line near its
+ * hit at all. */
+static int end_on_line(const chains *c, const fitted *f, int32_t i, float *x, float *y)
 {
     const float *p = &c->xy[2 * i];
     project(f, p, x, y);
     float bx = p[0] - c->ox, by = p[1] - c->oy, r = sqrtf(bx * bx + by * by);
     if (r <= 0.0f)
-        return;
+        return 0;
     bx /= r;
     by /= r;
     float den = bx * f->dy - by * f->dx; /* sin(beam, line) */
     if (fabsf(den) < 0.05f)
-        return;
+        return 0;
     float t = ((f->cx - c->ox) * f->dy - (f->cy - c->oy) * f->dx) / den;
     float qx = c->ox + t * bx, qy = c->oy + t * by;
     if (t > 0.0f && (qx - *x) * (qx - *x) + (qy - *y) * (qy - *y) <= 0.25f) {
         *x = qx;
         *y = qy;
+        return 1;
     }
+    return 0;
+}
+
+/* A segment across beam i through its hit, half a beam spacing to each
+ * side: (sx, sy) on the side of (ix, iy), (ox, oy) on the other. */
+static void across(const chains *c, int32_t i, float ix, float iy, float *sx, float *sy,
+                   float *ox, float *oy)
+{
+    const float *p = &c->xy[2 * i];
+    float bx = p[0] - c->ox, by = p[1] - c->oy, r = sqrtf(bx * bx + by * by);
+    float h = half_spacing(c, i) / (r > 0.0f ? r : 1.0f);
+    float nx = -by * h, ny = bx * h; /* across the beam, half a spacing long */
+    if ((ix - p[0]) * nx + (iy - p[1]) * ny < 0.0f) {
+        nx = -nx;
+        ny = -ny;
+    }
+    *sx = p[0] + nx;
+    *sy = p[1] + ny;
+    *ox = p[0] - nx;
+    *oy = p[1] - ny;
 }
 
 /* (x, y) moved outwards from (ix, iy) by half a beam spacing at beam i */
@@ -390,11 +412,19 @@ static polyc_status emit(chains *c, int32_t a, int32_t b)
     while (!c->keep[j])
         j++;
     fit(c, i, j, &after);
-    float x, y, ex, ey;
-    end_on_line(c, &after, a, &x, &y);
+    float x, y, ex, ey, ox, oy;
+    polyc_status st;
     project(&after, &c->xy[2 * j], &ex, &ey);
-    extend(c, a, ex, ey, &x, &y);
-    polyc_status st = append(c, line, x, y);
+    if (end_on_line(c, &after, a, &x, &y)) {
+        extend(c, a, ex, ey, &x, &y);
+        st = append(c, line, x, y);
+    } else {
+        /* the end beam runs along the line: a stub across it holds its hit */
+        across(c, a, ex, ey, &x, &y, &ox, &oy);
+        st = append(c, line, ox, oy);
+        if (st == POLYC_OK)
+            st = append(c, line, x, y);
+    }
     while (st == POLYC_OK && j < b) {
         /* inner vertex j between spans [i, j] and [j, k] */
         int32_t k = j + 1;
@@ -418,10 +448,14 @@ static polyc_status emit(chains *c, int32_t a, int32_t b)
     }
     if (st != POLYC_OK)
         return st;
-    end_on_line(c, &after, b, &x, &y);
     project(&after, &c->xy[2 * i], &ex, &ey);
-    extend(c, b, ex, ey, &x, &y);
-    return append(c, line, x, y);
+    if (end_on_line(c, &after, b, &x, &y)) {
+        extend(c, b, ex, ey, &x, &y);
+        return append(c, line, x, y);
+    }
+    across(c, b, ex, ey, &x, &y, &ox, &oy);
+    st = append(c, line, x, y);
+    return st != POLYC_OK ? st : append(c, line, ox, oy);
 }
 
 /* An open chain. Its slot (1..MAX_OPEN) marks its beams in chain_of: a

@@ -1579,6 +1579,56 @@ static void test_trim_pulls_end_back_to_data(void **state)
     fx_close(&f);
 }
 
+/* A single scan's end segment that runs along the beams (2 degrees off):
+ * its points' farthest projection, plus the margin, falls short of where
+ * the last return's beam crosses it (6.7 cm past the return along the
+ * segment), so pulling the end back there would leave that beam to meet
+ * the map behind its return, or never. The end stays where its segment
+ * holds the return. (On edmonton, infinite-corridor and csail such beams
+ * met the map metres behind their returns, 200 single scans each.) */
+static void test_trim_keeps_grazing_return(void **state)
+{
+    (void)state;
+    static fixture f;
+    static ptlist p;
+    static float range[1];
+    fx_open_hand(&f, 0.0f);
+    p.n = 0;
+    pts_line(&p, 0.0f, 0.002f, 0.6f, 0.002f, 0.01f);
+    set_points(&f, p.xy, p.n);
+    clear_lines(&f.o);
+    const float xy[4] = {0.0f, 0.0f, 1.0f, 0.0f};
+    int32_t l = add_line(&f.o, xy, 2, 0);
+    rebuild(&f.o);
+    /* one beam, from (-1, 0.05) through the last point (0.6, 0.002) */
+    polyc__rays *r = &f.o.rays;
+    memset(r, 0, sizeof *r);
+    r->on = 1;
+    r->x = -1.0;
+    r->y = 0.05;
+    r->base = atan2(0.002 - 0.05, 1.6);
+    r->step = 0.001;
+    r->step_cos = cos(r->step);
+    r->step_sin = sin(r->step);
+    r->count = 1;
+    r->turn = (int32_t)lround(2.0 * PI_D / r->step);
+    range[0] = (float)hypot(1.6, 0.048);
+    r->range = range;
+    r->min_m = 0.05f;
+    r->max_m = 30.0f;
+    r->tol_m = POLYC__RAY_TOLERANCE_M;
+    r->own_m = 0.15;
+    const polyc__vertex *h = &f.o.s->v[f.o.s->l[l].head], *t = &f.o.s->v[f.o.s->l[l].tail];
+    assert_true(polyc__holds_returns(r, h->x, h->y, t->x, t->y));
+    polyc__op_trim_ends(&f.o);
+    check_books(&f.o, "trim along the beams");
+    h = &f.o.s->v[f.o.s->l[l].head];
+    t = &f.o.s->v[f.o.s->l[l].tail];
+    if (!polyc__holds_returns(r, h->x, h->y, t->x, t->y))
+        fail_msg("tail pulled back to (%.4f, %.4f): the return is lost", (double)t->x, (double)t->y);
+    fx_close(&f);
+}
+
 /* The beam spacing: with a few poses (here 3) the distance to the nearest
  * one is measured when asked; with more, a chamfer field over the tiles
  * holds it, within 1.5 tiles (a tile diagonal: the field knows the tiles
@@ -1808,6 +1858,7 @@ int main(void)
         cmocka_unit_test(test_corner_replaces_spike),
         cmocka_unit_test(test_corners_leave_clean_map),
         cmocka_unit_test(test_trim_pulls_end_back_to_data),
+        cmocka_unit_test(test_trim_keeps_grazing_return),
         cmocka_unit_test(test_spacing_direct_and_field),
         cmocka_unit_test(test_hash_matches_brute_force),
         cmocka_unit_test(test_hash_segment_leaving_area),

@@ -266,6 +266,69 @@ static void test_grazing_wall_is_one_chain(void **state)
     check_chains(corridor, 2);
 }
 
+/* A chain that runs outwards along the beams (returns at 0.55 m on four
+ * beams, then 0.95 and 1.25 m on the next two, 1 degree apart, as a chair
+ * or a door leaf seen edge-on): its fitted line runs within 3 degrees of
+ * the last beam, which crosses it far past the return. The chain ends in a
+ * stub across that beam through its return, so the beam meets the map
+ * there, before and after the optimiser (on edmonton's scan 283 that beam
+ * met the map 13.5 m behind its return). */
+static void test_chain_end_along_beams(void **state)
+{
+    (void)state;
+    enum { N = 180 };
+    float range[N];
+    const float near[6] = {0.55f, 0.55f, 0.55f, 0.55f, 0.95f, 1.25f};
+    for (int i = 0; i < N; i++)
+        range[i] = 50.0f;
+    for (int i = 0; i < 6; i++)
+        range[12 + i] = near[i];
+    polyc_scan scan;
+    memset(&scan, 0, sizeof scan);
+    scan.pose_theta_rad = 0.3;
+    scan.start_angle_rad = (float)(-PI / 2.0);
+    scan.angle_step_rad = (float)(PI / 180.0);
+    scan.min_range_m = 0.05f;
+    scan.max_range_m = 50.0f;
+    scan.beam_count = N;
+    scan.range_m = range;
+    for (int pass = 0; pass < 2; pass++) {
+        polyc_config c;
+        polyc_limits lim;
+        polyc_ctx *ctx;
+        polyc_config_default(&c);
+        if (pass == 0)
+            c.max_iterations = 0; /* the chains as traced */
+        assert_int_equal(polyc_limits_for_scans(&c, &scan, 1, &lim), POLYC_OK);
+        size_t size = polyc_memory_size(&c, &lim);
+        void *block = malloc(size);
+        assert_non_null(block);
+        assert_int_equal(polyc_init(block, size, &c, &lim, &ctx), POLYC_OK);
+        assert_int_equal(polyc_add_scan(ctx, &scan), POLYC_OK);
+        assert_int_equal(polyc_build(ctx, NULL, NULL), POLYC_OK);
+        uint32_t n = polyc_polyline_count(ctx);
+        polyc_polyline *lines = calloc(n ? n : 1u, sizeof *lines);
+        assert_non_null(lines);
+        for (uint32_t l = 0; l < n; l++)
+            assert_int_equal(polyc_get_polyline(ctx, l, &lines[l]), POLYC_OK);
+        gtscore_index map;
+        gtscore_index_init(&map);
+        assert_int_equal(gtscore_index_add_polylines(&map, lines, n), 0);
+        assert_int_equal(gtscore_index_build(&map, 0.1), 0);
+        for (int i = 12; i < 18; i++) {
+            double a = scan.pose_theta_rad + (double)scan.start_angle_rad +
+                       (double)i * (double)scan.angle_step_rad;
+            double r = gtscore_index_ray(&map, 0.0, 0.0, a, 50.0);
+            if (!(fabs(r - (double)range[i]) <= POLYC__RAY_TOLERANCE_M))
+                fail_msg("%s: beam %d meets the map at %.3f m, its return at %.3f m",
+                         pass ? "optimised" : "traced", i, r, (double)range[i]);
+        }
+        gtscore_index_free(&map);
+        free(lines);
+        free(block);
+    }
+}
+
 /* Initial chains drop the vertices Douglas-Peucker kept on range noise:
  * each corridor wall (1 cm noise, seen along 15 m) is one segment (it kept
  * 10 vertices a wall), and the room keeps its corners: two pieces of wall
@@ -509,6 +572,7 @@ int main(void)
         cmocka_unit_test(test_no_grazing_link_behind_occluders),
         cmocka_unit_test(test_chains_follow_the_beams),
         cmocka_unit_test(test_grazing_wall_is_one_chain),
+        cmocka_unit_test(test_chain_end_along_beams),
         cmocka_unit_test(test_chains_drop_noise_vertices),
         cmocka_unit_test(test_near_returns_leave_gaps),
         cmocka_unit_test(test_optimised_room),
