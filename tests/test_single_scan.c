@@ -197,6 +197,21 @@ static void test_occluders_do_not_break_chains(void **state)
     check_chains(posts, 9);
 }
 
+/* A context for one hand-made scan with config c, the scan added; the
+ * caller frees *block. */
+static polyc_ctx *open_one_scan(const polyc_scan *scan, const polyc_config *c, void **block)
+{
+    polyc_limits lim;
+    polyc_ctx *ctx;
+    assert_int_equal(polyc_limits_for_scans(c, scan, 1, &lim), POLYC_OK);
+    size_t size = polyc_memory_size(c, &lim);
+    *block = malloc(size);
+    assert_non_null(*block);
+    assert_int_equal(polyc_init(*block, size, c, &lim, &ctx), POLYC_OK);
+    assert_int_equal(polyc_add_scan(ctx, scan), POLYC_OK);
+    return ctx;
+}
+
 /* Hits receding along the beams behind a near object are not a wall seen at
  * a grazing angle: a 0.5-degree scan whose beam 79 returns at 2.4 m, beams
  * 80-86 at 0.9 m (the object), and beams 87 and 88 on the line from beam
@@ -230,15 +245,9 @@ static void test_no_grazing_link_behind_occluders(void **state)
     scan.beam_count = N;
     scan.range_m = range;
     polyc_config c;
-    polyc_limits lim;
-    polyc_ctx *ctx;
+    void *block;
     polyc_config_default(&c);
-    assert_int_equal(polyc_limits_for_scans(&c, &scan, 1, &lim), POLYC_OK);
-    size_t size = polyc_memory_size(&c, &lim);
-    void *block = malloc(size);
-    assert_non_null(block);
-    assert_int_equal(polyc_init(block, size, &c, &lim, &ctx), POLYC_OK);
-    assert_int_equal(polyc_add_scan(ctx, &scan), POLYC_OK);
+    polyc_ctx *ctx = open_one_scan(&scan, &c, &block);
     assert_int_equal(polyc_build_grid(ctx), POLYC_OK);
     assert_int_equal(polyc_trace(ctx), POLYC_OK);
     double bx = (double)range[88] * cos(start + 88 * step), by = (double)range[88] * sin(start + 88 * step);
@@ -294,17 +303,11 @@ static void test_chain_end_along_beams(void **state)
     scan.range_m = range;
     for (int pass = 0; pass < 2; pass++) {
         polyc_config c;
-        polyc_limits lim;
-        polyc_ctx *ctx;
+        void *block;
         polyc_config_default(&c);
         if (pass == 0)
             c.max_iterations = 0; /* the chains as traced */
-        assert_int_equal(polyc_limits_for_scans(&c, &scan, 1, &lim), POLYC_OK);
-        size_t size = polyc_memory_size(&c, &lim);
-        void *block = malloc(size);
-        assert_non_null(block);
-        assert_int_equal(polyc_init(block, size, &c, &lim, &ctx), POLYC_OK);
-        assert_int_equal(polyc_add_scan(ctx, &scan), POLYC_OK);
+        polyc_ctx *ctx = open_one_scan(&scan, &c, &block);
         assert_int_equal(polyc_build(ctx, NULL, NULL), POLYC_OK);
         uint32_t n = polyc_polyline_count(ctx);
         polyc_polyline *lines = calloc(n ? n : 1u, sizeof *lines);
