@@ -356,25 +356,6 @@ static int end_on_line(const chains *c, const fitted *f, int32_t i, float *x, fl
     return 0;
 }
 
-/* A segment across beam i through its hit, half a beam spacing to each
- * side: (sx, sy) on the side of (ix, iy), (ox, oy) on the other. */
-static void across(const chains *c, int32_t i, float ix, float iy, float *sx, float *sy,
-                   float *ox, float *oy)
-{
-    const float *p = &c->xy[2 * i];
-    float bx = p[0] - c->ox, by = p[1] - c->oy, r = sqrtf(bx * bx + by * by);
-    float h = half_spacing(c, i) / (r > 0.0f ? r : 1.0f);
-    float nx = -by * h, ny = bx * h; /* across the beam, half a spacing long */
-    if ((ix - p[0]) * nx + (iy - p[1]) * ny < 0.0f) {
-        nx = -nx;
-        ny = -ny;
-    }
-    *sx = p[0] + nx;
-    *sy = p[1] + ny;
-    *ox = p[0] - nx;
-    *oy = p[1] - ny;
-}
-
 /* (x, y) moved outwards from (ix, iy) by half a beam spacing at beam i */
 static void extend(const chains *c, int32_t i, float ix, float iy, float *x, float *y)
 {
@@ -384,6 +365,35 @@ static void extend(const chains *c, int32_t i, float ix, float iy, float *x, flo
     float m = half_spacing(c, i) / len;
     *x += dx * m;
     *y += dy * m;
+}
+
+/* The end of a chain at beam i on its fitted line f, (ix, iy) the chain's
+ * side of it: appended first (head) or last (tail). Where beam i meets the
+ * line near its hit, one vertex there, half a beam spacing further out.
+ * Where the beam runs along the line, a stub across the beam through its
+ * hit, half a spacing to each side: the line's end would stand where the
+ * beam passes it by. */
+static polyc_status append_end(chains *c, int32_t line, const fitted *f, int32_t i, float ix,
+                               float iy, int head)
+{
+    float x, y;
+    if (end_on_line(c, f, i, &x, &y)) {
+        extend(c, i, ix, iy, &x, &y);
+        return append(c, line, x, y);
+    }
+    const float *p = &c->xy[2 * i];
+    float bx = p[0] - c->ox, by = p[1] - c->oy, r = sqrtf(bx * bx + by * by);
+    float h = half_spacing(c, i) / (r > 0.0f ? r : 1.0f);
+    float nx = -by * h, ny = bx * h; /* across the beam, half a spacing long */
+    if ((ix - p[0]) * nx + (iy - p[1]) * ny < 0.0f) {
+        nx = -nx;
+        ny = -ny;
+    }
+    /* (p + n on the chain's side, p - n the stub's free end) */
+    polyc_status st = append(c, line, head ? p[0] - nx : p[0] + nx, head ? p[1] - ny : p[1] + ny);
+    if (st != POLYC_OK)
+        return st;
+    return append(c, line, head ? p[0] + nx : p[0] - nx, head ? p[1] + ny : p[1] - ny);
 }
 
 /* The chain of beams [a, b] (both hits) as a polyline: Douglas-Peucker
@@ -412,19 +422,9 @@ static polyc_status emit(chains *c, int32_t a, int32_t b)
     while (!c->keep[j])
         j++;
     fit(c, i, j, &after);
-    float x, y, ex, ey, ox, oy;
-    polyc_status st;
+    float x, y, ex, ey;
     project(&after, &c->xy[2 * j], &ex, &ey);
-    if (end_on_line(c, &after, a, &x, &y)) {
-        extend(c, a, ex, ey, &x, &y);
-        st = append(c, line, x, y);
-    } else {
-        /* the end beam runs along the line: a stub across it holds its hit */
-        across(c, a, ex, ey, &x, &y, &ox, &oy);
-        st = append(c, line, ox, oy);
-        if (st == POLYC_OK)
-            st = append(c, line, x, y);
-    }
+    polyc_status st = append_end(c, line, &after, a, ex, ey, 1);
     while (st == POLYC_OK && j < b) {
         /* inner vertex j between spans [i, j] and [j, k] */
         int32_t k = j + 1;
@@ -449,13 +449,7 @@ static polyc_status emit(chains *c, int32_t a, int32_t b)
     if (st != POLYC_OK)
         return st;
     project(&after, &c->xy[2 * i], &ex, &ey);
-    if (end_on_line(c, &after, b, &x, &y)) {
-        extend(c, b, ex, ey, &x, &y);
-        return append(c, line, x, y);
-    }
-    across(c, b, ex, ey, &x, &y, &ox, &oy);
-    st = append(c, line, x, y);
-    return st != POLYC_OK ? st : append(c, line, ox, oy);
+    return append_end(c, line, &after, b, ex, ey, 0);
 }
 
 /* An open chain. Its slot (1..MAX_OPEN) marks its beams in chain_of: a
