@@ -203,9 +203,9 @@ int polyc__hill_climb(polyc__opt *o, int32_t v)
         last = best_d;
         moved = 1;
     }
-    /* a single scan: no climb may put a segment in front of a return (unless
-     * the vertex already stood so) */
-    if (!moved || (o->rays.on && polyc__vertex_blocks(o, v, x, y) && !polyc__vertex_blocks(o, v, x0, y0)))
+    /* a single scan: no climb may put a segment in front of a return it
+     * did not stand in front of before */
+    if (!moved || polyc__vertex_blocks(o, v, x, y))
         return 0;
     commit_move(o, v, x, y);
     return optimum && !cut ? 1 : 2;

@@ -225,7 +225,8 @@ static inline void polyc__split_due_pt(polyc__opt *o, int32_t from, int32_t to)
 /* ray_check.c: single-scan mode (rays.on) only, else every answer is 0.
  * blocks_beams: segment a-b stands in front of a return, or behind one of
  * its own, by more than the tolerance; vertex_blocks: v at (x, y) makes one
- * of its segments do so; holds_returns: some beam meets a-b within the
+ * of its segments do so where none of them does now, or loses a return
+ * they hold; holds_returns: some beam meets a-b within the
  * tolerance of its return (the map would lose that return without it) */
 void polyc__rays_init(polyc__rays *rays, const polyc_ctx *ctx);
 /* old_xy: the n_old segments (x0 y0 x1 y1 each) the edit replaces; a

@@ -1629,6 +1629,48 @@ static void test_trim_keeps_grazing_return(void **state)
     fx_close(&f);
 }
 
+/* A vertex whose segment already stands in front of a return (12 cm in
+ * front of beam 1's, as ends near the sensor do within the range noise)
+ * may move along it, but not across another beam that saw through: the
+ * climb's check used to let any move of such a vertex pass, and one put a
+ * segment 5.3 m in front of a csail return. */
+static void test_vertex_blocks_only_new_beams(void **state)
+{
+    (void)state;
+    static fixture f;
+    static float range[3] = {2.0f, 1.0f, 5.0f};
+    fx_open_hand(&f, 0.0f);
+    clear_lines(&f.o);
+    const float xy[4] = {0.88f, -0.05f, 0.88f, 0.05f};
+    int32_t l = add_line(&f.o, xy, 2, 0);
+    rebuild(&f.o);
+    /* three beams from the origin, at -0.2, 0 and 0.2 rad */
+    polyc__rays *r = &f.o.rays;
+    memset(r, 0, sizeof *r);
+    r->on = 1;
+    r->base = -0.2;
+    r->step = 0.2;
+    r->step_cos = cos(r->step);
+    r->step_sin = sin(r->step);
+    r->count = 3;
+    r->turn = (int32_t)lround(2.0 * PI_D / r->step);
+    r->range = range;
+    r->min_m = 0.05f;
+    r->max_m = 30.0f;
+    r->tol_m = POLYC__RAY_TOLERANCE_M;
+    r->own_m = 0.15;
+    int32_t v = f.o.s->l[l].tail;
+    const polyc__vertex *t = &f.o.s->v[v];
+    assert_true(polyc__blocks_beams(r, f.o.s->v[f.o.s->l[l].head].x, f.o.s->v[f.o.s->l[l].head].y,
+                                    t->x, t->y, NULL, 0));
+    /* along beam 1's block: nothing new */
+    assert_false(polyc__vertex_blocks(&f.o, v, 0.89f, 0.06f));
+    /* across beam 2, 4.1 m in front of its return */
+    if (!polyc__vertex_blocks(&f.o, v, 0.88f, 0.25f))
+        fail_msg("the tail at (0.88, 0.25) stands 4.1 m in front of beam 2's return, and passed");
+    fx_close(&f);
+}
+
 /* The beam spacing: with a few poses (here 3) the distance to the nearest
  * one is measured when asked; with more, a chamfer field over the tiles
  * holds it, within 1.5 tiles (a tile diagonal: the field knows the tiles
@@ -1859,6 +1901,7 @@ int main(void)
         cmocka_unit_test(test_corners_leave_clean_map),
         cmocka_unit_test(test_trim_pulls_end_back_to_data),
         cmocka_unit_test(test_trim_keeps_grazing_return),
+        cmocka_unit_test(test_vertex_blocks_only_new_beams),
         cmocka_unit_test(test_spacing_direct_and_field),
         cmocka_unit_test(test_hash_matches_brute_force),
         cmocka_unit_test(test_hash_segment_leaving_area),
