@@ -1579,6 +1579,30 @@ static void test_trim_pulls_end_back_to_data(void **state)
     fx_close(&f);
 }
 
+/* Hand-made beams on the fixture's optimiser, as a single scan would set
+ * them: `count` beams from (x, y), the first at `base` rad, `step` apart. */
+static polyc__rays *set_rays(polyc__opt *o, double x, double y, double base, double step,
+                             const float *range, int32_t count)
+{
+    polyc__rays *r = &o->rays;
+    memset(r, 0, sizeof *r);
+    r->on = 1;
+    r->x = x;
+    r->y = y;
+    r->base = base;
+    r->step = step;
+    r->step_cos = cos(step);
+    r->step_sin = sin(step);
+    r->count = count;
+    r->turn = (int32_t)lround(2.0 * PI_D / step);
+    r->range = range;
+    r->min_m = 0.05f;
+    r->max_m = 30.0f;
+    r->tol_m = POLYC__RAY_TOLERANCE_M;
+    r->own_m = 0.15;
+    return r;
+}
+
 /* A single scan's end segment that runs along the beams (2 degrees off):
  * its points' farthest projection, plus the margin, falls short of where
  * the last return's beam crosses it (6.7 cm past the return along the
@@ -1601,23 +1625,8 @@ static void test_trim_keeps_grazing_return(void **state)
     int32_t l = add_line(&f.o, xy, 2, 0);
     rebuild(&f.o);
     /* one beam, from (-1, 0.05) through the last point (0.6, 0.002) */
-    polyc__rays *r = &f.o.rays;
-    memset(r, 0, sizeof *r);
-    r->on = 1;
-    r->x = -1.0;
-    r->y = 0.05;
-    r->base = atan2(0.002 - 0.05, 1.6);
-    r->step = 0.001;
-    r->step_cos = cos(r->step);
-    r->step_sin = sin(r->step);
-    r->count = 1;
-    r->turn = (int32_t)lround(2.0 * PI_D / r->step);
     range[0] = (float)hypot(1.6, 0.048);
-    r->range = range;
-    r->min_m = 0.05f;
-    r->max_m = 30.0f;
-    r->tol_m = POLYC__RAY_TOLERANCE_M;
-    r->own_m = 0.15;
+    polyc__rays *r = set_rays(&f.o, -1.0, 0.05, atan2(0.002 - 0.05, 1.6), 0.001, range, 1);
     const polyc__vertex *h = &f.o.s->v[f.o.s->l[l].head], *t = &f.o.s->v[f.o.s->l[l].tail];
     assert_true(polyc__holds_returns(r, h->x, h->y, t->x, t->y));
     polyc__op_trim_ends(&f.o);
@@ -1645,20 +1654,7 @@ static void test_vertex_blocks_only_new_beams(void **state)
     int32_t l = add_line(&f.o, xy, 2, 0);
     rebuild(&f.o);
     /* three beams from the origin, at -0.2, 0 and 0.2 rad */
-    polyc__rays *r = &f.o.rays;
-    memset(r, 0, sizeof *r);
-    r->on = 1;
-    r->base = -0.2;
-    r->step = 0.2;
-    r->step_cos = cos(r->step);
-    r->step_sin = sin(r->step);
-    r->count = 3;
-    r->turn = (int32_t)lround(2.0 * PI_D / r->step);
-    r->range = range;
-    r->min_m = 0.05f;
-    r->max_m = 30.0f;
-    r->tol_m = POLYC__RAY_TOLERANCE_M;
-    r->own_m = 0.15;
+    polyc__rays *r = set_rays(&f.o, 0.0, 0.0, -0.2, 0.2, range, 3);
     int32_t v = f.o.s->l[l].tail;
     const polyc__vertex *t = &f.o.s->v[v];
     assert_true(polyc__blocks_beams(r, f.o.s->v[f.o.s->l[l].head].x, f.o.s->v[f.o.s->l[l].head].y,
