@@ -246,7 +246,7 @@ int polyc__op_adjust(polyc__opt *o, int max_rounds, uint32_t since)
              * on the 10 slowest freiburg-campus scans four climbs in five
              * come from the first adjustment, and over 200 scans a log the
              * re-climbs of neighbours lowered the ray RMSE by at most
-             * 0.5 mm for 5-16 % of the time (docs/performance.md) */
+             * 0.5 mm for 3-16 % of the time (docs/performance.md) */
             if (o->rays.on)
                 continue;
             int32_t nb[4] = {s->v[v].prev, s->v[v].next, POLYC__NONE, POLYC__NONE};
