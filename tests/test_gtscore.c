@@ -276,6 +276,61 @@ static void test_line_floor(void **state)
     gtscore_truth_free(&t);
 }
 
+/* The ideal-map fit: one wall seen in two runs whose endpoints sit 1 cm and
+ * 3 cm off it (as two rooms' pose errors would put them) gives the RMS of
+ * those offsets over the runs' seen samples; a run under 20 cm and
+ * endpoints beside every run do not count; without seen samples, none. */
+static void test_ideal_fit(void **state)
+{
+    (void)state;
+    char text[8192];
+    size_t len = (size_t)snprintf(text, sizeof text, "ideal 4\nwall open 0 2 4 2\n");
+    int seen_a = 0, seen_b = 0;
+    for (int i = 0; i <= 50; i++, seen_a++) /* run A: x 0.5 .. 1.5 */
+        len += (size_t)snprintf(text + len, sizeof text - len, "seen %.2f 2\n", 0.5 + 0.02 * i);
+    for (int i = 0; i <= 50; i++, seen_b++) /* run B: x 2.5 .. 3.5 */
+        len += (size_t)snprintf(text + len, sizeof text - len, "seen %.2f 2\n", 2.5 + 0.02 * i);
+    for (int i = 0; i <= 5; i++) /* run C: 10 cm, too short */
+        len += (size_t)snprintf(text + len, sizeof text - len, "seen %.2f 2\n", 3.8 + 0.02 * i);
+    assert_true(len < sizeof text);
+    gtscore_truth t;
+    truth_from_text(&t, text);
+    /* one beam a scan, straight up from (x, 0): A at 1 cm, B at 3 cm, C and
+     * the unseen stretch between A and B at 5 cm */
+    enum { N = 64 };
+    polyc_scan scans[N];
+    float range[N];
+    int n = 0;
+    for (int i = 0; i <= 20; i++, n++) {
+        memset(&scans[n], 0, sizeof scans[n]);
+        scans[n].pose_x_m = i < 11 ? 0.5 + 0.1 * i : 2.5 + 0.1 * (i - 11);
+        range[n] = i < 11 ? 1.99f : 1.97f;
+    }
+    double extra_x[] = {2.0, 2.2, 3.85, 3.9};
+    for (int i = 0; i < 4; i++, n++) {
+        memset(&scans[n], 0, sizeof scans[n]);
+        scans[n].pose_x_m = extra_x[i];
+        range[n] = 1.95f;
+    }
+    for (int i = 0; i < n; i++) {
+        scans[i].start_angle_rad = (float)(0.5 * 3.14159265358979);
+        scans[i].min_range_m = 0.02f;
+        scans[i].max_range_m = 8.0f;
+        scans[i].beam_count = 1;
+        scans[i].range_m = &range[i];
+    }
+    double fit_m = -2.0;
+    assert_int_equal(gtscore_ideal_fit(&t, scans, (uint32_t)n, &fit_m), 0);
+    double want = sqrt((seen_a * 1e-4 + seen_b * 9e-4) / (seen_a + seen_b));
+    assert_near(fit_m, want, 1e-5);
+    gtscore_truth_free(&t);
+
+    truth_from_text(&t, "ideal 2\nwall open 0 2 4 2\n");
+    assert_int_equal(gtscore_ideal_fit(&t, scans, (uint32_t)n, &fit_m), 0);
+    assert_true(fit_m < 0.0);
+    gtscore_truth_free(&t);
+}
+
 /* The grid index against brute force on random segments, points (some far
  * outside the grid) and rays. */
 static void test_index_vs_brute_force(void **state)
@@ -375,6 +430,7 @@ int main(void)
         cmocka_unit_test(test_single_scan),
         cmocka_unit_test(test_index_vs_brute_force),
         cmocka_unit_test(test_line_floor),
+        cmocka_unit_test(test_ideal_fit),
         cmocka_unit_test(test_reader_errors),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -52,6 +52,8 @@ static const char usage_text[] =
     "size of the process so far. Accuracy (shared/data/README.md): sim scenes\n"
     "precision RMS / p95 in mm, the line-fit floor (the precision straight lines\n"
     "fitted to each seen wall side's endpoints would score, tools/gtfloor.c),\n"
+    "the ideal fit (the precision of the ideal map, one segment per seen run of\n"
+    "each wall side, fitted to that run's endpoints),\n"
     "completeness, vertices / ideal; real logs the\n"
     "share of scan endpoints within 5 cm of the map (end5). Single scans: mean\n"
     "f, pooled ray RMSE, vertices, the mean and the slowest of the scans' median\n"
@@ -343,14 +345,14 @@ static void print_header(const options *o)
            polyc_version() / 100u % 100u, polyc_version() % 100u, o->runs,
            o->runs == 1 ? "" : "s", o->data);
     printf("%-24s %6s %8s | %7s %6s %7s %7s %7s %8s %6s %8s | %8s %8s %7s | %6s %7s %6s "
-           "%5s | %6s %6s %6s %6s %6s\n",
+           "%5s | %6s %6s %6s %6s %6s %6s\n",
            "scene", "scans", "beams", "parse", "add", "grid", "contour", "trace", "optimise",
            "output", "total", "blockMiB", "usedMiB", "rssMiB", "lines", "verts", "ideal", "x",
-           "rms", "p95", "floor", "compl", "end5");
+           "rms", "p95", "floor", "fit", "compl", "end5");
     printf("%-24s %6s %8s | %7s %6s %7s %7s %7s %8s %6s %8s | %8s %8s %7s | %6s %7s %6s "
-           "%5s | %6s %6s %6s %6s %6s\n",
+           "%5s | %6s %6s %6s %6s %6s %6s\n",
            "", "", "", "ms", "ms", "ms", "ms", "ms", "ms", "ms", "ms", "", "", "", "", "", "",
-           "", "mm", "mm", "mm", "", "");
+           "", "mm", "mm", "mm", "mm", "", "");
 }
 
 typedef struct row_accuracy {
@@ -358,6 +360,7 @@ typedef struct row_accuracy {
     gtscore_map_score score;
     double end5;               /* < 0: not computed */
     double floor_m;            /* line-fit floor (sim scenes), < 0: none */
+    double fit_m;              /* ideal-map fit (sim scenes), < 0: none */
     uint32_t lines, vertices;
 } row_accuracy;
 
@@ -368,6 +371,7 @@ static void accuracy(const scene *s, const scanlog *log, const polyc_polyline *l
     memset(acc, 0, sizeof *acc);
     acc->end5 = -1.0;
     acc->floor_m = -1.0;
+    acc->fit_m = -1.0;
     acc->lines = count;
     for (i = 0; i < count; i++)
         acc->vertices += lines[i].point_count;
@@ -379,6 +383,8 @@ static void accuracy(const scene *s, const scanlog *log, const polyc_polyline *l
             acc->has_truth = 1;
             if (gtscore_line_floor(&truth, log->scans, log->count, &acc->floor_m) != 0)
                 acc->floor_m = -1.0;
+            if (gtscore_ideal_fit(&truth, log->scans, log->count, &acc->fit_m) != 0)
+                acc->fit_m = -1.0;
         } else
             fprintf(stderr, "bench: %s: no score: %s\n", s->name, err);
         gtscore_truth_free(&truth);
@@ -458,16 +464,19 @@ static int bench_scene(const options *o, const scene *s)
            med[ST_TOTAL], mib(stats.memory_size_bytes), mib(stats.memory_used_bytes),
            peak_rss_mib(), acc.lines, acc.vertices);
     if (acc.has_truth) {
-        char floor_mm[16] = "-";
+        char floor_mm[16] = "-", fit_mm[16] = "-";
         if (acc.floor_m >= 0.0)
             snprintf(floor_mm, sizeof floor_mm, "%.1f", 1e3 * acc.floor_m);
-        printf("%6u %5.2f | %6.1f %6.1f %6s %6.4f %6s\n", acc.score.ideal,
+        if (acc.fit_m >= 0.0)
+            snprintf(fit_mm, sizeof fit_mm, "%.1f", 1e3 * acc.fit_m);
+        printf("%6u %5.2f | %6.1f %6.1f %6s %6s %6.4f %6s\n", acc.score.ideal,
                acc.score.vertex_ratio, 1e3 * acc.score.precision_rms_m,
-               1e3 * acc.score.precision_p95_m, floor_mm, acc.score.completeness, "-");
+               1e3 * acc.score.precision_p95_m, floor_mm, fit_mm, acc.score.completeness, "-");
     } else if (acc.end5 >= 0.0) {
-        printf("%6s %5s | %6s %6s %6s %6s %6.4f\n", "-", "-", "-", "-", "-", "-", acc.end5);
+        printf("%6s %5s | %6s %6s %6s %6s %6s %6.4f\n", "-", "-", "-", "-", "-", "-", "-",
+               acc.end5);
     } else {
-        printf("%6s %5s | %6s %6s %6s %6s %6s\n", "-", "-", "-", "-", "-", "-", "-");
+        printf("%6s %5s | %6s %6s %6s %6s %6s %6s\n", "-", "-", "-", "-", "-", "-", "-", "-");
     }
     fflush(stdout);
     free(lines);

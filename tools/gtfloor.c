@@ -59,6 +59,61 @@ static uint32_t collect_segments(const gtscore_truth *truth, wall_seg *out)
     return n;
 }
 
+/* The endpoint of a reflected beam; 0 for a beam without return. */
+static int endpoint_xy(const polyc_scan *sc, uint32_t i, double *x, double *y)
+{
+    if (!gtscore_beam_reflected(sc, i))
+        return 0;
+    double a = sc->pose_theta_rad + (double)sc->start_angle_rad +
+               (double)i * (double)sc->angle_step_rad;
+    *x = sc->pose_x_m + (double)sc->range_m[i] * cos(a);
+    *y = sc->pose_y_m + (double)sc->range_m[i] * sin(a);
+    return 1;
+}
+
+/* The nearest wall segment within near_m whose interior (x, y) projects
+ * onto, with the position along it and the signed offset across it;
+ * UINT32_MAX if none. */
+static uint32_t face_of(const gtscore_truth *truth, const wall_seg *segs, uint32_t ns, double x,
+                        double y, double near_m, double *t_out, double *off_out)
+{
+    if (gtscore_index_distance(&truth->index, x, y, near_m) > near_m)
+        return UINT32_MAX;
+    double best = near_m;
+    uint32_t best_s = UINT32_MAX;
+    for (uint32_t s = 0; s < ns; s++) {
+        const wall_seg *g = &segs[s];
+        double px = x - g->ax, py = y - g->ay;
+        double t = px * g->ux + py * g->uy, off = py * g->ux - px * g->uy;
+        if (t < 0.0 || t > g->len || fabs(off) > best)
+            continue;
+        best = fabs(off);
+        *t_out = t;
+        *off_out = off;
+        best_s = s;
+    }
+    return best_s;
+}
+
+static void fit_add(side_fit *f, double t, double off)
+{
+    f->n += 1.0;
+    f->st += t;
+    f->ss += off;
+    f->stt += t * t;
+    f->sts += t * off;
+}
+
+/* The least-squares line's offset at position t (its mean offset when the
+ * positions do not spread). */
+static double fitted_offset(const side_fit *f, double t)
+{
+    double mt = f->st / f->n, ms = f->ss / f->n;
+    double var = f->stt / f->n - mt * mt;
+    double slope = var > 1e-12 ? (f->sts / f->n - mt * ms) / var : 0.0;
+    return ms + slope * (t - mt);
+}
+
 int gtscore_line_floor(const gtscore_truth *truth, const polyc_scan *scans, uint32_t scan_count,
                        double *floor_m)
 {
@@ -89,39 +144,17 @@ int gtscore_line_floor(const gtscore_truth *truth, const polyc_scan *scans, uint
     for (uint32_t k = 0; k < scan_count; k++) {
         const polyc_scan *sc = &scans[k];
         for (uint32_t i = 0; i < sc->beam_count; i++) {
-            if (!gtscore_beam_reflected(sc, i))
+            double x, y, best_t = 0.0, best_off = 0.0;
+            if (!endpoint_xy(sc, i, &x, &y))
                 continue;
-            double a = sc->pose_theta_rad + (double)sc->start_angle_rad +
-                       (double)i * (double)sc->angle_step_rad;
-            double x = sc->pose_x_m + (double)sc->range_m[i] * cos(a);
-            double y = sc->pose_y_m + (double)sc->range_m[i] * sin(a);
-            if (gtscore_index_distance(&truth->index, x, y, FLOOR_NEAR_M) > FLOOR_NEAR_M)
-                continue;
-            /* the nearest segment whose interior the endpoint projects onto */
-            double best = FLOOR_NEAR_M, best_t = 0.0, best_off = 0.0;
-            uint32_t best_s = UINT32_MAX;
-            for (uint32_t s = 0; s < ns; s++) {
-                const wall_seg *g = &segs[s];
-                double px = x - g->ax, py = y - g->ay;
-                double t = px * g->ux + py * g->uy, off = py * g->ux - px * g->uy;
-                if (t < 0.0 || t > g->len || fabs(off) > best)
-                    continue;
-                best = fabs(off);
-                best_t = t;
-                best_off = off;
-                best_s = s;
-            }
+            uint32_t best_s = face_of(truth, segs, ns, x, y, FLOOR_NEAR_M, &best_t, &best_off);
             if (best_s == UINT32_MAX)
                 continue;
             const wall_seg *g = &segs[best_s];
             double sx = sc->pose_x_m - g->ax, sy = sc->pose_y_m - g->ay;
             int side = sy * g->ux - sx * g->uy > 0.0;
             side_fit *f = &fits[2 * best_s + (uint32_t)side];
-            f->n += 1.0;
-            f->st += best_t;
-            f->ss += best_off;
-            f->stt += best_t * best_t;
-            f->sts += best_t * best_off;
+            fit_add(f, best_t, best_off);
             seen[f->first_bin + (uint32_t)(best_t / FLOOR_BIN_M)] = 1;
         }
     }
@@ -131,15 +164,11 @@ int gtscore_line_floor(const gtscore_truth *truth, const polyc_scan *scans, uint
             const side_fit *f = &fits[2 * s + (uint32_t)side];
             if (f->n < FLOOR_MIN_POINTS)
                 continue;
-            double mt = f->st / f->n, ms = f->ss / f->n;
-            double var = f->stt / f->n - mt * mt;
-            double slope = var > 1e-12 ? (f->sts / f->n - mt * ms) / var : 0.0;
             uint32_t nb = (uint32_t)(segs[s].len / FLOOR_BIN_M) + 1;
             for (uint32_t b = 0; b < nb; b++) {
                 if (!seen[f->first_bin + b])
                     continue;
-                double t = ((double)b + 0.5) * FLOOR_BIN_M;
-                double e = ms + slope * (t - mt);
+                double e = fitted_offset(f, ((double)b + 0.5) * FLOOR_BIN_M);
                 sum += e * e;
                 count += 1.0;
             }
@@ -148,5 +177,116 @@ int gtscore_line_floor(const gtscore_truth *truth, const polyc_scan *scans, uint
     free(seen);
     free(fits);
     free(segs);
+    return 0;
+}
+
+/* ---- the ideal map fitted to the data ------------------------------------ */
+
+#define IDEAL_ON_M 0.005   /* a seen sample lies on the wall it was taken from */
+#define IDEAL_GAP_M 0.03   /* seen samples are <= 2 cm apart within a run */
+#define IDEAL_RUN_M 0.20   /* shorter runs are not in `ideal` (scansim_io.c) */
+#define IDEAL_SLACK_M 0.01 /* endpoints this far past a run's ends are its own */
+
+typedef struct seen_on_face {
+    uint32_t face;
+    double t;
+} seen_on_face;
+
+typedef struct seen_run {
+    uint32_t face, first, count; /* samples first..first+count-1 of the sorted list */
+    double t0, t1;
+    side_fit fit;
+} seen_run;
+
+static int by_face_then_t(const void *pa, const void *pb)
+{
+    const seen_on_face *a = pa, *b = pb;
+    if (a->face != b->face)
+        return a->face < b->face ? -1 : 1;
+    return (a->t > b->t) - (a->t < b->t);
+}
+
+/* The run of face `face` (runs sorted by face, then position) that holds
+ * position t, or NULL. */
+static seen_run *run_at(seen_run *runs, uint32_t nr, uint32_t face, double t)
+{
+    uint32_t lo = 0, hi = nr;
+    while (lo < hi) { /* the first run of this face */
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (runs[mid].face < face)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    for (uint32_t r = lo; r < nr && runs[r].face == face; r++)
+        if (t >= runs[r].t0 - IDEAL_SLACK_M && t <= runs[r].t1 + IDEAL_SLACK_M)
+            return &runs[r];
+    return NULL;
+}
+
+int gtscore_ideal_fit(const gtscore_truth *truth, const polyc_scan *scans, uint32_t scan_count,
+                      double *fit_m)
+{
+    uint32_t ns = collect_segments(truth, NULL), n = 0, nr = 0;
+    *fit_m = -1.0;
+    if (ns == 0 || truth->seen_count == 0)
+        return 0;
+    wall_seg *segs = calloc(ns, sizeof *segs);
+    seen_on_face *on = calloc(truth->seen_count, sizeof *on);
+    seen_run *runs = calloc(truth->seen_count, sizeof *runs);
+    if (!segs || !on || !runs) {
+        free(segs);
+        free(on);
+        free(runs);
+        return -1;
+    }
+    collect_segments(truth, segs);
+    for (uint32_t i = 0; i < truth->seen_count; i++) {
+        double off = 0.0;
+        on[n].face = face_of(truth, segs, ns, truth->seen_xy_m[2u * i],
+                             truth->seen_xy_m[2u * i + 1u], IDEAL_ON_M, &on[n].t, &off);
+        if (on[n].face != UINT32_MAX)
+            n++;
+    }
+    qsort(on, n, sizeof *on, by_face_then_t);
+    for (uint32_t i = 0; i < n; i++) {
+        seen_run *r = nr ? &runs[nr - 1] : NULL;
+        if (r && r->face == on[i].face && on[i].t - r->t1 <= IDEAL_GAP_M) {
+            r->t1 = on[i].t;
+            r->count++;
+            continue;
+        }
+        r = &runs[nr++];
+        r->face = on[i].face;
+        r->first = i;
+        r->count = 1;
+        r->t0 = r->t1 = on[i].t;
+    }
+    for (uint32_t k = 0; k < scan_count; k++) {
+        const polyc_scan *sc = &scans[k];
+        for (uint32_t i = 0; i < sc->beam_count; i++) {
+            double x, y, t = 0.0, off = 0.0;
+            if (!endpoint_xy(sc, i, &x, &y))
+                continue;
+            uint32_t s = face_of(truth, segs, ns, x, y, FLOOR_NEAR_M, &t, &off);
+            seen_run *r = s == UINT32_MAX ? NULL : run_at(runs, nr, s, t);
+            if (r)
+                fit_add(&r->fit, t, off);
+        }
+    }
+    double sum = 0.0, count = 0.0;
+    for (uint32_t r = 0; r < nr; r++) {
+        if (runs[r].t1 - runs[r].t0 < IDEAL_RUN_M || runs[r].fit.n < 1.0)
+            continue;
+        for (uint32_t i = runs[r].first; i < runs[r].first + runs[r].count; i++) {
+            double e = fitted_offset(&runs[r].fit, on[i].t);
+            sum += e * e;
+            count += 1.0;
+        }
+    }
+    *fit_m = count > 0.0 ? sqrt(sum / count) : -1.0;
+    free(segs);
+    free(on);
+    free(runs);
     return 0;
 }

@@ -154,6 +154,16 @@ void gtscore_endpoints_within(const gtscore_index *map, const polyc_scan *scans,
 int gtscore_line_floor(const gtscore_truth *truth, const polyc_scan *scans, uint32_t scan_count,
                        double *floor_m);
 
+/* The ideal-map fit of a simulated scene (tools/gtfloor.c): the precision
+ * RMS of the map `ideal` counts, one straight segment per run of seen
+ * samples (>= 20 cm) on each true wall segment, each fitted by least
+ * squares to the endpoints within 6 cm of its stretch, measured at the
+ * run's seen samples. Unlike the line-fit floor, no line spans two runs (a
+ * wall seen from two rooms is two runs, each with the pose errors of the
+ * scans that saw it). *fit_m < 0 if no run qualifies (the circles).
+ * Returns -1 when out of memory. */
+int gtscore_ideal_fit(const gtscore_truth *truth, const polyc_scan *scans, uint32_t scan_count,
+                      double *fit_m);
 /* True if the beam is reflected (see the definition above). */
 int gtscore_beam_reflected(const polyc_scan *scan, uint32_t beam);
 
