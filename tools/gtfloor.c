@@ -1,5 +1,5 @@
 /* gtfloor.c - the precision the data themselves allow: the "line-fit floor"
- * of a simulated scene (gtscore.h).
+ * and the "ideal fit" of a simulated scene (gtscore.h).
  *
  * The scenes' poses carry small alignment errors that persist over runs of
  * scans, so the endpoints along a wall can sit a centimetre or two off the
@@ -11,7 +11,13 @@
  * wall as a linear function of the position along it); the floor is the RMS,
  * over the 2 cm stretches of wall that hold endpoints, of that line's
  * distance to the true wall. A perfect map of straight walls fitted to the
- * data would score about this precision.
+ * data would score about this precision, if it knew that the stretches of a
+ * wall seen from different rooms lie on one line.
+ *
+ * The ideal fit does not assume that: the map `ideal` counts, one segment
+ * per run of seen samples on each wall side, each fitted by least squares to
+ * its own run's endpoints and measured at the run's seen samples. Where
+ * each room's scans carry their own pose errors (office), it is the higher.
  *
  * SPDX-License-Identifier: MIT
  */
