@@ -164,6 +164,7 @@ int gtscore_line_floor(const gtscore_truth *truth, const polyc_scan *scans, uint
  * Returns -1 when out of memory. */
 int gtscore_ideal_fit(const gtscore_truth *truth, const polyc_scan *scans, uint32_t scan_count,
                       double *fit_m);
+
 /* True if the beam is reflected (see the definition above). */
 int gtscore_beam_reflected(const polyc_scan *scan, uint32_t beam);
 
