@@ -337,8 +337,8 @@ int polyc__op_merge(polyc__opt *o)
                 continue;
             int32_t e = side ? ln->tail : ln->head;
             int32_t f = nearest_end(o, e, lim2);
-            if (f == POLYC__NONE)
-                continue;
+            if (f == POLYC__NONE || polyc__link_crosses(o, e, f))
+                continue; /* (a link through a wall would be cut again) */
             polyc__chg_begin(o);
             int32_t le = s->v[e].line, lf = s->v[f].line;
             if (le == lf) {
@@ -434,10 +434,23 @@ static int no_gap_over(const float *t, int32_t n, float len, float gap)
     return 1;
 }
 
+/* Whether data point i lies within POLYC__SUPPORT_M of segment sg: a
+ * point farther away is nearest to it only for want of a better segment
+ * (clutter, the far side of a wall band) and holds no stretch of it. */
+static int supports(const polyc__opt *o, int32_t i, int32_t sg)
+{
+    const polyc__vertex *a = &o->s->v[sg], *b = &o->s->v[a->next];
+    float lim = POLYC__SUPPORT_M;
+    return seg_dist2(o->pts[i].x, o->pts[i].y, a->x, a->y, b->x, b->y) <= lim * lim;
+}
+
 /* A segment with a stretch longer than split_gap_m (or 2.5 beam spacings
- * where the data are sparser than that), plus the span of a weighted point,
- * onto which no data point projects is cut there: the polyline ends on
- * either side of the gap. Only the segments split_due are looked at: one
+ * where the data are sparser than that, up to split_gap_m plus half the
+ * support distance: past that a stretch between two points would be
+ * without data within POLYC__SUPPORT_M over more than split_gap_m), plus
+ * the span of a weighted point, onto which no data point within
+ * POLYC__SUPPORT_M projects is cut there: the polyline ends on either side
+ * of the gap. Only the segments split_due are looked at: one
  * whose ends and points are what they were when it was last found whole
  * is whole still (the search calls this several times an iteration, and
  * between two calls most segments did not change). */
@@ -452,7 +465,7 @@ int polyc__op_split(polyc__opt *o)
         off[v] = 0;
     for (int32_t i = 0; i < o->np; i++) {
         int32_t sg = o->pt_seg[i];
-        if (sg != POLYC__NONE && due[sg])
+        if (sg != POLYC__NONE && due[sg] && supports(o, i, sg))
             off[sg + 1]++;
     }
     for (int32_t v = 0; v < nv; v++)
@@ -460,7 +473,7 @@ int polyc__op_split(polyc__opt *o)
     /* fill: positions along the segment, metres */
     for (int32_t i = 0; i < o->np; i++) {
         int32_t sg = o->pt_seg[i];
-        if (sg == POLYC__NONE || !due[sg])
+        if (sg == POLYC__NONE || !due[sg] || !supports(o, i, sg))
             continue;
         const polyc__vertex *a = &s->v[sg], *b = &s->v[a->next];
         float dx = b->x - a->x, dy = b->y - a->y;
@@ -502,8 +515,9 @@ int polyc__op_split(polyc__opt *o)
          * spacings between neighbouring points: those are no gaps */
         float gx = a->x + (b->x - a->x) * (g0 + 0.5f * best) / len;
         float gy = a->y + (b->y - a->y) * (g0 + 0.5f * best) / len;
-        float need = polyc__maxf(gap_min, 2.5f * polyc__spacing_at(&o->spacing, gx, gy)) +
-                     o->point_span_m;
+        float sparse = polyc__minf(2.5f * polyc__spacing_at(&o->spacing, gx, gy),
+                                   gap_min + 0.5f * POLYC__SUPPORT_M);
+        float need = polyc__maxf(gap_min, sparse) + 0.5f * o->point_span_m;
         if (best > need && n_cut < o->cut_cap) {
             o->cut_seg[n_cut] = v;
             o->cut_next[n_cut] = a->next;
@@ -556,8 +570,9 @@ static int trim_loses_returns(const polyc__opt *o, int32_t v, float x, float y)
 
 /* Nothing in the BIC holds an open end where the data stop: points beyond
  * it cost the same wherever it is. Each open end is pulled back to the
- * farthest projection of the points of its segment, plus half a beam
- * spacing (at least 1 cm). */
+ * farthest projection of the points of its segment that lie within
+ * POLYC__SUPPORT_M of it (of all its points in a single scan, whose beams
+ * place its ends), plus half a beam spacing (at least 1 cm). */
 int polyc__op_trim_ends(polyc__opt *o)
 {
     polyc__store *s = o->s;
@@ -567,7 +582,7 @@ int polyc__op_trim_ends(polyc__opt *o)
         o->split_t[v] = o->trim_head[v] = -1.0f;
     for (int32_t i = 0; i < o->np; i++) {
         int32_t sg = o->pt_seg[i];
-        if (sg == POLYC__NONE)
+        if (sg == POLYC__NONE || (!o->rays.on && !supports(o, i, sg)))
             continue;
         const polyc__vertex *a = &s->v[sg], *b = &s->v[a->next];
         int head_end = a->prev == POLYC__NONE, tail_end = b->next == POLYC__NONE;

@@ -172,6 +172,22 @@ static polyc_status restore_best(polyc__opt *o, polyc_status st)
     return st;
 }
 
+/* The best map once more through merging, vertex removal and the
+ * topology operators: the last edits of the search (cuts at crossings,
+ * zipped stretches) can leave two ends a centimetre apart that the next
+ * iteration would have joined. Kept if its BIC is no higher; 1 if the
+ * store was changed back to the best map (the scores need a rebuild). */
+static int polish(polyc__opt *o, double best)
+{
+    polyc__op_merge(o);
+    polyc__op_remove_vertices(o, 0);
+    polyc__op_zip(o);
+    polyc__op_untangle(o);
+    if (polyc__bic(o) <= best)
+        return 0;
+    return polyc__store_from_flat(o->s, &o->best) == POLYC_OK;
+}
+
 polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *user)
 {
     polyc__opt o;
@@ -234,7 +250,10 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
                 break;
             polyc__op_adjust(&o, ADJUST_ROUNDS, mark);
         }
-        polyc__op_trim_ends(&o); /* last: moves could push ends past the data */
+        polyc__op_trim_ends(&o); /* moves could push ends past the data */
+        if (!o.rays.on)
+            polyc__op_zip(&o);   /* one piece of map per wall */
+        polyc__op_untangle(&o);  /* last: the map judged has no crossing */
         if (o.h.out_of_entries)
             return restore_best(&o, polyc__fail(ctx, POLYC_ERR_NOMEM, "spatial hash full"));
         double bic = polyc__bic(&o);
@@ -288,6 +307,8 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room to restore the best map");
     ctx->opt_result_valid = 1;
     if ((st = polyc__rebuild(&o)) != POLYC_OK)
+        return st;
+    if (!o.rays.on && result == POLYC_OK && polish(&o, best) && (st = polyc__rebuild(&o)) != POLYC_OK)
         return st;
     fill_stats(&o);
     return result;

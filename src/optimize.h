@@ -114,6 +114,9 @@ typedef struct polyc__opt {
 } polyc__opt;
 
 #define POLYC__CAND_MAX 48
+/* a data point supports the stretch of map within this distance of it:
+ * splits and end trimming count only such points (not in the paper) */
+#define POLYC__SUPPORT_M 0.05f
 /* listed points copied by field for the trials (intel: all but 170 of
  * 524,000 trials list fewer) */
 #define POLYC__LOC_SOA 256
@@ -207,6 +210,12 @@ int polyc__op_adjust(polyc__opt *o, int max_rounds, uint32_t since);
 int polyc__op_zigzag(polyc__opt *o);
 int polyc__op_corners(polyc__opt *o, uint32_t since);
 int polyc__op_trim_ends(polyc__opt *o);
+/* topology.c: every crossing of two segments resolved (not in the paper) */
+int polyc__op_untangle(polyc__opt *o);
+/* whether a segment from vertex a to vertex b would cross the map */
+int polyc__link_crosses(const polyc__opt *o, int32_t a, int32_t b);
+/* topology.c: stretches of map along another piece of map cut out */
+int polyc__op_zip(polyc__opt *o);
 void polyc__op_noise(polyc__opt *o, double sigma_m);
 int polyc__op_remove_vertices(polyc__opt *o, uint32_t since);
 /* the change of the BIC if v is removed when that is below `bound`, else

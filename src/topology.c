@@ -1,0 +1,413 @@
+/* topology.c - walls do not pass through each other (not in the paper).
+ * Takes: the optimiser state. Gives: a map in which no two segments that
+ * do not share a vertex cross. The paper's error term measures only how
+ * far the data lie from the map, so nothing in the BIC keeps a hairpin
+ * that explains clutter from passing through a wall, or an end from
+ * overshooting the wall it meets. Each crossing is resolved by the edit
+ * that raises the BIC least among those that remove it and create none:
+ * one of the four vertices of the two segments removed, or one segment cut
+ * short just before the crossing, the arm beyond it gone (at an open end
+ * that is a trim; inside a polyline it splits it there). Likewise two
+ * pieces of map along one wall: a stretch of a segment that runs within
+ * overlap_m of another piece of the map (not its neighbours) for more than
+ * ZIP_RUN_M is cut out of one of the two, the one whose loss raises the BIC
+ * least, until no such stretch is left. */
+#include "optimize.h"
+
+#include <math.h>
+
+#define CROSS_END_M 0.002f  /* a crossing this near a segment end is a junction */
+#define CUT_BACK_M 0.002f   /* a cut arm ends this short of the other segment */
+#define FIXES_PER_SEGMENT 16 /* bounds the work per segment in one pass */
+#define LOSES_RETURNS 1e6   /* single scans: an edit that loses returns comes last */
+#define ZIP_STEP_M 0.02f    /* samples along a segment for the double-cover test */
+#define ZIP_RUN_M 0.15f     /* a doubly covered stretch longer than this goes */
+#define ZIP_SNAP_M 0.03f    /* a stretch this near a segment end reaches it */
+
+/* Whether segments p0-p1 and q0-q1 cross with the crossing at least
+ * CROSS_END_M from all four ends; *t and *u: its position along each. */
+static int proper_cross(float p0x, float p0y, float p1x, float p1y, float q0x, float q0y,
+                        float q1x, float q1y, float *t, float *u)
+{
+    double rx = (double)p1x - (double)p0x, ry = (double)p1y - (double)p0y;
+    double sx = (double)q1x - (double)q0x, sy = (double)q1y - (double)q0y;
+    double den = rx * sy - ry * sx;
+    if (den == 0.0)
+        return 0;
+    double wx = (double)q0x - (double)p0x, wy = (double)q0y - (double)p0y;
+    double tt = (wx * sy - wy * sx) / den, uu = (wx * ry - wy * rx) / den;
+    double lp = sqrt(rx * rx + ry * ry), lq = sqrt(sx * sx + sy * sy);
+    double e = (double)CROSS_END_M;
+    if (tt * lp < e || (1.0 - tt) * lp < e || uu * lq < e || (1.0 - uu) * lq < e)
+        return 0;
+    *t = (float)tt;
+    *u = (float)uu;
+    return 1;
+}
+
+/* Does segment sg share vertex a or b (NONE: a new point)? */
+static int touches(const polyc__store *s, int32_t sg, int32_t a, int32_t b)
+{
+    int32_t e = s->v[sg].next;
+    return (a != POLYC__NONE && (sg == a || e == a)) || (b != POLYC__NONE && (sg == b || e == b));
+}
+
+/* The first segment of the map that crosses x0-x1 (ends a and b as vertex
+ * numbers, NONE for a point that is no vertex; segments touching them do
+ * not count), or NONE. Every segment is in each bucket its path crosses, so
+ * two crossing segments share the bucket of the crossing, and that bucket
+ * lies in x0-x1's bounding box of buckets. */
+static int32_t first_crossing(const polyc__opt *o, const float *xy, int32_t a, int32_t b,
+                              float *t, float *u)
+{
+    const polyc__hash *h = &o->h;
+    const polyc__store *s = o->s;
+    int32_t ix0, iy0, ix1, iy1;
+    polyc__bucket_xy(h, polyc__minf(xy[0], xy[2]), polyc__minf(xy[1], xy[3]), &ix0, &iy0);
+    polyc__bucket_xy(h, polyc__maxf(xy[0], xy[2]), polyc__maxf(xy[1], xy[3]), &ix1, &iy1);
+    for (int32_t iy = iy0; iy <= iy1; iy++)
+        for (int32_t ix = ix0; ix <= ix1; ix++)
+            for (int32_t e = h->seg_head[iy * h->bx + ix]; e != POLYC__NONE; e = h->entries[e].next) {
+                int32_t sg = h->entries[e].seg;
+                if (touches(s, sg, a, b))
+                    continue;
+                const polyc__vertex *c = &s->v[sg], *d = &s->v[c->next];
+                if (proper_cross(xy[0], xy[1], xy[2], xy[3], c->x, c->y, d->x, d->y, t, u))
+                    return sg;
+            }
+    return POLYC__NONE;
+}
+
+int polyc__link_crosses(const polyc__opt *o, int32_t a, int32_t b)
+{
+    const polyc__vertex *V = o->s->v;
+    const float xy[4] = {V[a].x, V[a].y, V[b].x, V[b].y};
+    float t, u;
+    return first_crossing(o, xy, a, b, &t, &u) != POLYC__NONE;
+}
+
+/* One way to remove a crossing. */
+typedef struct fix {
+    int kind;          /* 0 none, 1 remove vertex v, 2 keep v's side of segment seg up to (x, y) */
+    int32_t v, seg;
+    float x, y;
+    double delta;      /* change of the BIC */
+} fix;
+
+static void consider(fix *best, const fix *f)
+{
+    if (f->kind != 0 && (best->kind == 0 || f->delta < best->delta))
+        *best = *f;
+}
+
+/* Removing vertex v, if the segment that replaces its two crosses nothing. */
+static void try_remove(polyc__opt *o, int32_t v, fix *best)
+{
+    const polyc__vertex *V = o->s->v;
+    int32_t p = V[v].prev, n = V[v].next;
+    if (p != POLYC__NONE && n != POLYC__NONE && p != n) {
+        const float xy[4] = {V[p].x, V[p].y, V[n].x, V[n].y};
+        float t, u;
+        if (first_crossing(o, xy, p, n, &t, &u) != POLYC__NONE)
+            return;
+    }
+    double d = polyc__removal_delta_below(o, v, INFINITY);
+    if (isinf(d))
+        return; /* a single scan's return would go */
+    fix f = {1, v, POLYC__NONE, 0.0f, 0.0f, d};
+    consider(best, &f);
+}
+
+/* Cutting segment seg (a -> b) at position t, keeping the side of `keep`
+ * (a or b): the kept piece ends CUT_BACK_M short of the crossing. */
+static void try_cut(polyc__opt *o, int32_t seg, float t, int32_t keep, fix *best)
+{
+    const polyc__vertex *V = o->s->v;
+    int32_t a = seg, b = V[seg].next;
+    float dx = V[b].x - V[a].x, dy = V[b].y - V[a].y;
+    float len = sqrtf(dx * dx + dy * dy);
+    if (!(len > 0.0f))
+        return;
+    float back = CUT_BACK_M / len;
+    float tc = keep == a ? t - back : t + back;
+    if (tc <= 0.0f || tc >= 1.0f)
+        return;
+    float x = V[a].x + tc * dx, y = V[a].y + tc * dy;
+    int32_t gone = keep == a ? b : a; /* the vertex on the far side */
+    const float old_xy[4] = {V[a].x, V[a].y, V[b].x, V[b].y};
+    float new_xy[4] = {V[keep].x, V[keep].y, x, y};
+    double derr = polyc__local_delta(o, &seg, 1, new_xy, 1, INFINITY);
+    double dk = 0.0, dangle = 0.0;
+    int end = keep == a ? V[b].next == POLYC__NONE : V[a].prev == POLYC__NONE;
+    if (!end) {
+        dk = 1.0;                  /* the cut adds the vertex at the cut */
+        dangle = -o->acost[gone];  /* and the far vertex becomes an end */
+    }
+    double d = (double)o->cfg->alpha * (derr + (double)o->cfg->gamma * dangle) + dk * o->log_n;
+    if (o->rays.on && polyc__loses_returns(&o->rays, old_xy, 1, new_xy, 1))
+        d += LOSES_RETURNS;
+    fix f = {2, keep, seg, x, y, d};
+    consider(best, &f);
+}
+
+/* Applies a fix; 0 if there was no room for it. */
+static int apply(polyc__opt *o, const fix *f)
+{
+    polyc__store *s = o->s;
+    if (f->kind == 1) {
+        polyc__apply_remove(o, f->v);
+        return 1;
+    }
+    int32_t a = f->seg, b = s->v[a].next, keep = f->v;
+    int32_t gone = keep == a ? b : a;
+    int end = keep == a ? s->v[b].next == POLYC__NONE : s->v[a].prev == POLYC__NONE;
+    if (end) {
+        polyc__apply_move(o, gone, f->x, f->y); /* the open end is pulled back */
+        return 1;
+    }
+    polyc__chg_begin(o);
+    int32_t c = polyc__op_insert_after(o, a, f->x, f->y);
+    if (c != POLYC__NONE)
+        polyc__op_cut(o, keep == a ? c : a); /* the link on the far side goes */
+    polyc__chg_commit(o);
+    return c != POLYC__NONE;
+}
+
+int polyc__op_untangle(polyc__opt *o)
+{
+    polyc__store *s = o->s;
+    int fixed = 0;
+    for (int32_t v = 0; v < s->v_high; v++) {
+        for (int k = 0; k < FIXES_PER_SEGMENT; k++) {
+            if (s->v[v].line == POLYC__NONE || s->v[v].next == POLYC__NONE)
+                break;
+            int32_t w = s->v[v].next;
+            const float xy[4] = {s->v[v].x, s->v[v].y, s->v[w].x, s->v[w].y};
+            float t, u;
+            int32_t other = first_crossing(o, xy, v, w, &t, &u);
+            if (other == POLYC__NONE)
+                break;
+            int32_t ends[4] = {v, w, other, s->v[other].next};
+            fix best = {0, POLYC__NONE, POLYC__NONE, 0.0f, 0.0f, 0.0};
+            for (int e = 0; e < 4; e++)
+                try_remove(o, ends[e], &best);
+            try_cut(o, v, t, v, &best);
+            try_cut(o, v, t, w, &best);
+            try_cut(o, other, u, ends[2], &best);
+            try_cut(o, other, u, ends[3], &best);
+            if (best.kind == 0 || !apply(o, &best))
+                break;
+            fixed++;
+        }
+    }
+    return fixed;
+}
+
+/* ---- double cover ---- */
+
+/* The nearest segment to (x, y) that does not touch a or b (within the
+ * 3 x 3 buckets around it), or NONE. */
+static int32_t nearest_other(const polyc__opt *o, float x, float y, int32_t a, int32_t b);
+
+static float dist2_seg(float px, float py, float ax, float ay, float bx, float by)
+{
+    float dx = bx - ax, dy = by - ay, mx = px - ax, my = py - ay;
+    float l2 = dx * dx + dy * dy;
+    float t = l2 > 0.0f ? (mx * dx + my * dy) / l2 : 0.0f;
+    t = t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
+    float ex = mx - t * dx, ey = my - t * dy;
+    return ex * ex + ey * ey;
+}
+
+/* Is (x, y) within lim of a segment that does not touch a or b? */
+static int covered(const polyc__opt *o, float x, float y, int32_t a, int32_t b, float lim2)
+{
+    const polyc__hash *h = &o->h;
+    const polyc__store *s = o->s;
+    int32_t bx, by;
+    polyc__bucket_xy(h, x, y, &bx, &by);
+    for (int32_t yy = by - 1; yy <= by + 1; yy++)
+        for (int32_t xx = bx - 1; xx <= bx + 1; xx++) {
+            if (xx < 0 || yy < 0 || xx >= h->bx || yy >= h->by)
+                continue;
+            for (int32_t e = h->seg_head[yy * h->bx + xx]; e != POLYC__NONE; e = h->entries[e].next) {
+                int32_t sg = h->entries[e].seg;
+                if (touches(s, sg, a, b))
+                    continue;
+                const polyc__vertex *c = &s->v[sg], *d = &s->v[c->next];
+                if (dist2_seg(x, y, c->x, c->y, d->x, d->y) <= lim2)
+                    return 1;
+            }
+        }
+    return 0;
+}
+
+/* The longest doubly covered stretch of segment v, as fractions [*t0, *t1]
+ * along it; 0 if none is longer than ZIP_RUN_M. */
+static int covered_run(const polyc__opt *o, int32_t v, float *t0, float *t1)
+{
+    const polyc__vertex *V = o->s->v;
+    int32_t w = V[v].next;
+    float ax = V[v].x, ay = V[v].y, dx = V[w].x - ax, dy = V[w].y - ay;
+    float len = sqrtf(dx * dx + dy * dy);
+    if (!(len > ZIP_RUN_M))
+        return 0;
+    float lim = o->cfg->overlap_m, lim2 = lim * lim;
+    int32_t n = (int32_t)ceilf(len / ZIP_STEP_M);
+    int32_t run0 = -1, best0 = 0, best1 = -1;
+    for (int32_t k = 0; k <= n + 1; k++) {
+        int c = 0;
+        if (k <= n) {
+            float t = (float)k / (float)n;
+            c = covered(o, ax + t * dx, ay + t * dy, v, w, lim2);
+        }
+        if (c && run0 < 0)
+            run0 = k;
+        if (!c && run0 >= 0) {
+            if (k - 1 - run0 > best1 - best0) {
+                best0 = run0;
+                best1 = k - 1;
+            }
+            run0 = -1;
+        }
+    }
+    if (best1 < 0 || (float)(best1 - best0) * len / (float)n <= ZIP_RUN_M)
+        return 0;
+    *t0 = (float)best0 / (float)n;
+    *t1 = (float)best1 / (float)n;
+    float snap = ZIP_SNAP_M / len;
+    if (*t0 < snap)
+        *t0 = 0.0f;
+    if (*t1 > 1.0f - snap)
+        *t1 = 1.0f;
+    return 1;
+}
+
+/* The change of the BIC if stretch [t0, t1] of segment v goes. */
+static double drop_delta(polyc__opt *o, int32_t v, float t0, float t1)
+{
+    const polyc__vertex *V = o->s->v;
+    int32_t w = V[v].next;
+    float ax = V[v].x, ay = V[v].y, dx = V[w].x - ax, dy = V[w].y - ay;
+    float xy[8];
+    int n_new = 0;
+    double dk = 0.0, dangle = 0.0;
+    if (t0 > 0.0f) {
+        xy[4 * n_new] = ax;
+        xy[4 * n_new + 1] = ay;
+        xy[4 * n_new + 2] = ax + t0 * dx;
+        xy[4 * n_new + 3] = ay + t0 * dy;
+        n_new++;
+        dk += V[w].next == POLYC__NONE && t1 >= 1.0f ? 0.0 : 1.0;
+    } else if (V[v].prev == POLYC__NONE) {
+        dk -= t1 >= 1.0f ? 1.0 : 0.0; /* the head goes, or moves to t1 */
+    } else {
+        dangle -= o->acost[v];        /* v becomes an end */
+    }
+    if (t1 < 1.0f) {
+        xy[4 * n_new] = ax + t1 * dx;
+        xy[4 * n_new + 1] = ay + t1 * dy;
+        xy[4 * n_new + 2] = V[w].x;
+        xy[4 * n_new + 3] = V[w].y;
+        n_new++;
+        dk += V[v].prev == POLYC__NONE && t0 <= 0.0f ? 0.0 : 1.0;
+    } else if (V[w].next == POLYC__NONE) {
+        dk -= t0 <= 0.0f ? 1.0 : 0.0;
+    } else {
+        dangle -= o->acost[w];
+    }
+    double derr = polyc__local_delta(o, &v, 1, xy, n_new, INFINITY);
+    return (double)o->cfg->alpha * (derr + (double)o->cfg->gamma * dangle) + dk * o->log_n;
+}
+
+/* Cuts stretch [t0, t1] out of segment v; 0 if there was no room. */
+static int drop_stretch(polyc__opt *o, int32_t v, float t0, float t1)
+{
+    polyc__store *s = o->s;
+    int32_t w = s->v[v].next;
+    float ax = s->v[v].x, ay = s->v[v].y, dx = s->v[w].x - ax, dy = s->v[w].y - ay;
+    int head = s->v[v].prev == POLYC__NONE, tail = s->v[w].next == POLYC__NONE;
+    if (t0 <= 0.0f && head && t1 < 1.0f) {
+        polyc__apply_move(o, v, ax + t1 * dx, ay + t1 * dy);
+        return 1;
+    }
+    if (t1 >= 1.0f && tail && t0 > 0.0f) {
+        polyc__apply_move(o, w, ax + t0 * dx, ay + t0 * dy);
+        return 1;
+    }
+    polyc__chg_begin(o);
+    int32_t c0 = v, c1;
+    int ok = 1;
+    if (t0 > 0.0f && (c0 = polyc__op_insert_after(o, v, ax + t0 * dx, ay + t0 * dy)) == POLYC__NONE)
+        ok = 0;
+    c1 = ok ? s->v[c0].next : POLYC__NONE;
+    if (ok && t1 < 1.0f &&
+        (c1 = polyc__op_insert_after(o, c0, ax + t1 * dx, ay + t1 * dy)) == POLYC__NONE)
+        ok = 0;
+    if (ok)
+        polyc__op_cut(o, c0); /* the link c0 -> c1 goes; a lone end with it */
+    polyc__chg_commit(o);
+    (void)c1;
+    return ok;
+}
+
+int polyc__op_zip(polyc__opt *o)
+{
+    polyc__store *s = o->s;
+    int zipped = 0;
+    if (!(o->cfg->overlap_m > 0.0f))
+        return 0;
+    for (int32_t v = 0; v < s->v_high; v++) {
+        for (int k = 0; k < FIXES_PER_SEGMENT; k++) {
+            if (s->v[v].line == POLYC__NONE || s->v[v].next == POLYC__NONE)
+                break;
+            float t0, t1;
+            if (!covered_run(o, v, &t0, &t1))
+                break;
+            /* the stretch goes from this segment or from the piece of map
+             * along it (its own run there), whichever costs less */
+            const polyc__vertex *V = s->v;
+            int32_t w = V[v].next;
+            float mx = V[v].x + 0.5f * (t0 + t1) * (V[w].x - V[v].x);
+            float my = V[v].y + 0.5f * (t0 + t1) * (V[w].y - V[v].y);
+            int32_t q = nearest_other(o, mx, my, v, w);
+            float u0, u1;
+            double d_here = drop_delta(o, v, t0, t1);
+            if (q != POLYC__NONE && covered_run(o, q, &u0, &u1) &&
+                drop_delta(o, q, u0, u1) < d_here) {
+                if (!drop_stretch(o, q, u0, u1))
+                    break;
+            } else if (!drop_stretch(o, v, t0, t1)) {
+                break;
+            }
+            zipped++;
+        }
+    }
+    return zipped;
+}
+
+static int32_t nearest_other(const polyc__opt *o, float x, float y, int32_t a, int32_t b)
+{
+    const polyc__hash *h = &o->h;
+    const polyc__store *s = o->s;
+    int32_t bx, by, best = POLYC__NONE;
+    float best_d = 1e30f;
+    polyc__bucket_xy(h, x, y, &bx, &by);
+    for (int32_t yy = by - 1; yy <= by + 1; yy++)
+        for (int32_t xx = bx - 1; xx <= bx + 1; xx++) {
+            if (xx < 0 || yy < 0 || xx >= h->bx || yy >= h->by)
+                continue;
+            for (int32_t e = h->seg_head[yy * h->bx + xx]; e != POLYC__NONE; e = h->entries[e].next) {
+                int32_t sg = h->entries[e].seg;
+                if (touches(s, sg, a, b))
+                    continue;
+                const polyc__vertex *c = &s->v[sg], *d = &s->v[c->next];
+                float dd = dist2_seg(x, y, c->x, c->y, d->x, d->y);
+                if (dd < best_d) {
+                    best_d = dd;
+                    best = sg;
+                }
+            }
+        }
+    return best;
+}
