@@ -5,7 +5,8 @@
  * Takes DATA_DIR/sim/NAME.log (+ NAME.gt.txt ground truth) and
  * DATA_DIR/carmen/NAME.log. Prints one table: per scene the input size, the
  * median time of each stage over N runs, memory, and accuracy (scored by
- * tools/gtscore), then a single-scan section on the real logs. Logs are read
+ * tools/gtscore), a second table of topology figures (tools/gttopo), then a
+ * single-scan section on the real logs. Logs are read
  * with tools/scanlog, the same reader as the CLI. Exit codes: 0 ok, 1 some
  * scene failed, 2 usage or no data directory.
  */
@@ -19,6 +20,7 @@
 #include <time.h>
 
 #include "gtscore.h"
+#include "gttopo.h"
 #include "mapout.h"
 #include "polyc.h"
 #include "scanlog.h"
@@ -27,6 +29,7 @@
 #define EXIT_USAGE 2
 #define MAX_RUNS 99
 #define NEAR_M 0.05 /* "share of endpoints within 5 cm of the map" */
+#define CORE_M 0.5 /* core precision: the map samples within 0.5 m of a true wall */
 #define SCAN_BUDGET_MS 2.0 /* issue 4: one 360-beam scan within 2 ms; `over` counts the scans above */
 
 static const char usage_text[] =
@@ -57,7 +60,16 @@ static const char usage_text[] =
     "completeness, vertices / ideal; real logs the\n"
     "share of scan endpoints within 5 cm of the map (end5). Single scans: mean\n"
     "f, pooled ray RMSE, vertices, the mean and the slowest of the scans' median\n"
-    "times, and how many scans took over 2 ms (issue 4's budget for one scan).\n"
+    "times, and how many scans took over 2 ms (issue 4's budget for one scan);\n"
+    "cross = crossings summed over the scan maps, maps = scan maps with one or\n"
+    "more, uns20 = unsupported runs over 20 cm summed (each against its scan).\n"
+    "Topology (second table, tools/gttopo.h, against the log's scan endpoints):\n"
+    "len = map length (m); dcov = doubly covered length in runs over 20 cm (m,\n"
+    "and % of len); cross = pairs of segments crossing; uns20, uns10 = runs of\n"
+    "map over 20 / 10 cm with no endpoint within 5 cm; loose = open ends 3-15 cm\n"
+    "from another part of the map; sim scenes: rms = precision RMS, core = the\n"
+    "precision RMS of the samples within 0.5 m of a true wall (mm); ms = the\n"
+    "topology scorers' time.\n"
     "Exit: 0 ok; 1 a scene failed (its row says why); 2 usage error, or\n"
     "DATA_DIR missing: 'bench: data directory DIR not found (pass DATA=path)'.\n";
 
@@ -355,6 +367,15 @@ static void print_header(const options *o)
            "", "mm", "mm", "mm", "mm", "", "");
 }
 
+/* One row of the topology table, kept until the first table is done. */
+typedef struct topo_row {
+    char label[160];
+    int ok;                    /* 0: the scene failed or the scorer ran out of memory */
+    gttopo_score score;
+    double rms_m, core_m;      /* sim scenes; < 0: none */
+    double ms;                 /* the scorers' time, points included */
+} topo_row;
+
 typedef struct row_accuracy {
     int has_truth;
     gtscore_map_score score;
@@ -364,8 +385,27 @@ typedef struct row_accuracy {
     uint32_t lines, vertices;
 } row_accuracy;
 
+/* The topology figures of a whole log's map against its scan endpoints,
+ * and the core precision of a simulated scene. */
+static void topology(const scanlog *log, const polyc_polyline *lines, uint32_t count,
+                     const gtscore_truth *truth, const row_accuracy *acc, topo_row *row)
+{
+    double t0 = now_ms(), *xy = NULL;
+    uint64_t n = 0;
+    row->rms_m = row->core_m = -1.0;
+    row->ok = gttopo_scan_points(log->scans, log->count, &xy, &n) == 0 &&
+              gttopo_score_map(lines, count, xy, n, &row->score) == 0;
+    free(xy);
+    row->ms = now_ms() - t0;
+    if (row->ok && truth) {
+        row->rms_m = acc->score.precision_rms_m;
+        if (gtscore_core_precision(truth, lines, count, CORE_M, &row->core_m) != 0)
+            row->core_m = -1.0;
+    }
+}
+
 static void accuracy(const scene *s, const scanlog *log, const polyc_polyline *lines,
-                     uint32_t count, row_accuracy *acc)
+                     uint32_t count, row_accuracy *acc, topo_row *row)
 {
     uint32_t i;
     memset(acc, 0, sizeof *acc);
@@ -385,6 +425,7 @@ static void accuracy(const scene *s, const scanlog *log, const polyc_polyline *l
                 acc->floor_m = -1.0;
             if (gtscore_ideal_fit(&truth, log->scans, log->count, &acc->fit_m) != 0)
                 acc->fit_m = -1.0;
+            topology(log, lines, count, &truth, acc, row);
         } else
             fprintf(stderr, "bench: %s: no score: %s\n", s->name, err);
         gtscore_truth_free(&truth);
@@ -398,10 +439,11 @@ static void accuracy(const scene *s, const scanlog *log, const polyc_polyline *l
             acc->end5 = total ? (double)within / (double)total : 0.0;
         }
         gtscore_index_free(&map);
+        topology(log, lines, count, NULL, acc, row);
     }
 }
 
-static int bench_scene(const options *o, const scene *s)
+static int bench_scene(const options *o, const scene *s, topo_row *row)
 {
     double times[MAX_RUNS][ST_COUNT], column[MAX_RUNS], med[ST_COUNT];
     scanlog log;
@@ -415,6 +457,8 @@ static int bench_scene(const options *o, const scene *s)
     int ok = 0;
 
     snprintf(label, sizeof label, "%s/%s", s->kind, s->name);
+    memset(row, 0, sizeof *row);
+    snprintf(row->label, sizeof row->label, "%s", label);
     memset(times, 0, sizeof times);
     memset(&log, 0, sizeof log);
     for (r = 0; r < o->runs; r++) {
@@ -455,7 +499,7 @@ static int bench_scene(const options *o, const scene *s)
         med[k] = median(column, o->runs);
     }
     polyc_get_stats(p.ctx, &stats);
-    accuracy(s, &log, lines, count, &acc);
+    accuracy(s, &log, lines, count, &acc, row);
 
     printf("%-24s %6u %8llu | %7.1f %6.1f %7.1f %7.1f %7.1f %8.1f %6.1f %8.1f | %8.2f %8.2f "
            "%7.1f | %6u %7u ",
@@ -485,6 +529,38 @@ static int bench_scene(const options *o, const scene *s)
     return 0;
 }
 
+static void print_topology(const topo_row *rows, size_t count)
+{
+    size_t i;
+    printf("\ntopology (tools/gttopo.h): the map against its log's scan endpoints; "
+           "rms and core (the\nsamples within 0.5 m of a true wall) are precision RMS, "
+           "sim scenes only\n");
+    printf("%-24s %9s %8s %6s %6s %6s %6s %6s | %6s %6s | %7s\n", "scene", "len", "dcov",
+           "dcov%", "cross", "uns20", "uns10", "loose", "rms", "core", "topo");
+    printf("%-24s %9s %8s %6s %6s %6s %6s %6s | %6s %6s | %7s\n", "", "m", "m", "", "", "",
+           "", "", "mm", "mm", "ms");
+    for (i = 0; i < count; i++) {
+        const topo_row *r = &rows[i];
+        const gttopo_score *t = &r->score;
+        char rms[16] = "-", core[16] = "-";
+        if (!r->ok) {
+            if (r->label[0])
+                printf("%-24s %9s\n", r->label, "-");
+            continue;
+        }
+        if (r->rms_m >= 0.0)
+            snprintf(rms, sizeof rms, "%.1f", 1e3 * r->rms_m);
+        if (r->core_m >= 0.0)
+            snprintf(core, sizeof core, "%.1f", 1e3 * r->core_m);
+        printf("%-24s %9.1f %8.2f %6.2f %6u %6u %6u %6u | %6s %6s | %7.1f\n", r->label,
+               t->map_length_m, t->double_cover_m,
+               t->map_length_m > 0.0 ? 100.0 * t->double_cover_m / t->map_length_m : 0.0,
+               t->crossings, t->unsupported_20, t->unsupported_10, t->loose_ends, rms, core,
+               r->ms);
+    }
+    fflush(stdout);
+}
+
 /* ---- single scans of the real logs ---------------------------------------- */
 
 static int single_scans(const options *o, const scene *s)
@@ -494,8 +570,8 @@ static int single_scans(const options *o, const scene *s)
     double vertices = 0.0;
     uint64_t beams = 0;
     double stage_sum[ST_COUNT] = {0};
-    uint64_t hits = 0;
-    unsigned k, done = 0, over = 0;
+    uint64_t hits = 0, crossings = 0, unsupported = 0;
+    unsigned k, done = 0, over = 0, crossed = 0;
     char label[160];
 
     snprintf(label, sizeof label, "%s/%s", s->kind, s->name);
@@ -554,6 +630,18 @@ static int single_scans(const options *o, const scene *s)
             gtscore_index_build(&map, 0.1) == 0)
             gtscore_score_scan(&map, scan, &acc);
         gtscore_index_free(&map);
+        {
+            double *xy = NULL;
+            uint64_t n = 0;
+            gttopo_score topo;
+            if (gttopo_scan_points(scan, 1, &xy, &n) == 0 &&
+                gttopo_score_map(lines, count, xy, n, &topo) == 0) {
+                crossings += topo.crossings;
+                crossed += topo.crossings > 0;
+                unsupported += topo.unsupported_20;
+            }
+            free(xy);
+        }
         f_sum += acc.f;
         beams += scan->beam_count;
         sum_sq += acc.sum_sq_m2;
@@ -563,11 +651,13 @@ static int single_scans(const options *o, const scene *s)
         pipeline_close(&p);
     }
     if (done)
-        printf("%-24s %6u %8.4f %9.1f %9.1f %9.1f %9.2f %7.2f %6u %6.2f | %6.2f %7.2f %6.2f %8.2f\n",
+        printf("%-24s %6u %8.4f %9.1f %9.1f %9.1f %9.2f %7.2f %6u %6.2f | %6.2f %7.2f %6.2f %8.2f"
+               " | %6llu %6u %6llu\n",
                label, done, f_sum / done, hits ? 1e3 * sqrt(sum_sq / (double)hits) : 0.0,
                vertices / done, beams ? 180.0 * vertices / (double)beams : 0.0, ms_sum / done,
                ms_max, over, cold_sum / done, stage_sum[ST_GRID] / done, stage_sum[ST_CONTOUR] / done,
-               stage_sum[ST_TRACE] / done, stage_sum[ST_OPT] / done);
+               stage_sum[ST_TRACE] / done, stage_sum[ST_OPT] / done,
+               (unsigned long long)crossings, crossed, (unsigned long long)unsupported);
     fflush(stdout);
     scanlog_free(&log);
     return done ? 0 : -1;
@@ -645,6 +735,7 @@ int main(int argc, char **argv)
 {
     options o;
     scene *list = NULL;
+    topo_row *rows;
     size_t count = 0, cap = 0, i, reals = 0;
     DIR *dir;
     int failed = 0;
@@ -667,21 +758,30 @@ int main(int argc, char **argv)
         free(list);
         return EXIT_USAGE;
     }
+    rows = calloc(count, sizeof *rows);
+    if (!rows) {
+        fprintf(stderr, "bench: out of memory\n");
+        free(list);
+        return EXIT_FAILED;
+    }
     print_header(&o);
     for (i = 0; i < count; i++) {
-        if (bench_scene(&o, &list[i]) != 0)
+        if (bench_scene(&o, &list[i], &rows[i]) != 0)
             failed = 1;
         reals += strcmp(list[i].kind, "carmen") == 0;
     }
+    print_topology(rows, count);
+    free(rows);
     if (o.single > 0 && reals > 0) {
         printf("\nsingle scans: a map from one scan; f = share of reflected beams whose ray "
                "meets the map,\nray RMSE = measured minus map range over those beams "
                "(tools/gtscore.h)\n");
-        printf("%-24s %6s %8s %9s %9s %9s %9s %7s %6s %6s | %6s %7s %6s %8s\n", "log", "scans",
-               "mean f", "rayRMSE", "verts", "verts", "ms/scan", "slowest", "over", "cold",
-               "grid", "contour", "trace", "optimise");
-        printf("%-24s %6s %8s %9s %9s %9s %9s %7s %6s %6s | %6s %7s %6s %8s\n", "", "", "", "mm",
-               "/scan", "/180 b.", "median", "ms", "2 ms", "ms", "ms", "ms", "ms", "ms");
+        printf("%-24s %6s %8s %9s %9s %9s %9s %7s %6s %6s | %6s %7s %6s %8s | %6s %6s %6s\n",
+               "log", "scans", "mean f", "rayRMSE", "verts", "verts", "ms/scan", "slowest",
+               "over", "cold", "grid", "contour", "trace", "optimise", "cross", "maps", "uns20");
+        printf("%-24s %6s %8s %9s %9s %9s %9s %7s %6s %6s | %6s %7s %6s %8s | %6s %6s %6s\n",
+               "", "", "", "mm", "/scan", "/180 b.", "median", "ms", "2 ms", "ms", "ms", "ms",
+               "ms", "ms", "sum", "w/ any", "sum");
         for (i = 0; i < count; i++)
             if (strcmp(list[i].kind, "carmen") == 0 && single_scans(&o, &list[i]) != 0)
                 failed = 1;

@@ -100,8 +100,7 @@ int gtscore_index_add_polylines(gtscore_index *index, const polyc_polyline *line
     return 0;
 }
 
-/* Squared distance from (px, py) to segment s (4 doubles). */
-static double segment_distance2(const double *s, double px, double py)
+double gtscore_segment_distance2(const double *s, double px, double py)
 {
     double ex = s[2] - s[0], ey = s[3] - s[1];
     double wx = px - s[0], wy = py - s[1];
@@ -144,7 +143,7 @@ static void bin_segment(gtscore_index *index, uint32_t s, uint32_t *cursor, int 
             size_t c = (size_t)y * index->width + x;
             double cx = index->origin_x_m + ((double)x + 0.5) * cell;
             double cy = index->origin_y_m + ((double)y + 0.5) * cell;
-            if (segment_distance2(g, cx, cy) > reach * reach)
+            if (gtscore_segment_distance2(g, cx, cy) > reach * reach)
                 continue;
             if (fill)
                 index->cell_seg[cursor[c]++] = s;
@@ -230,11 +229,30 @@ static double cell_distance2(const gtscore_index *index, int64_t x, int64_t y, d
     size_t c = (size_t)y * index->width + (size_t)x;
     uint32_t k;
     for (k = index->cell_start[c]; k < index->cell_start[c + 1u]; k++) {
-        double d2 = segment_distance2(&index->seg_m[4u * index->cell_seg[k]], px, py);
+        double d2 = gtscore_segment_distance2(&index->seg_m[4u * index->cell_seg[k]], px, py);
         if (d2 < best2)
             best2 = d2;
     }
     return best2;
+}
+
+int gtscore_index_box(const gtscore_index *index, double x_m, double y_m, double r_m,
+                      uint32_t cells[4])
+{
+    double fx0, fx1, fy0, fy1;
+    if (!index->cell_start || !isfinite(x_m) || !isfinite(y_m) || !(r_m >= 0.0))
+        return 0;
+    fx0 = floor((x_m - r_m - index->origin_x_m) / index->cell_m);
+    fx1 = floor((x_m + r_m - index->origin_x_m) / index->cell_m);
+    fy0 = floor((y_m - r_m - index->origin_y_m) / index->cell_m);
+    fy1 = floor((y_m + r_m - index->origin_y_m) / index->cell_m);
+    if (fx1 < 0.0 || fy1 < 0.0 || fx0 >= (double)index->width || fy0 >= (double)index->height)
+        return 0;
+    cells[0] = fx0 < 0.0 ? 0u : (uint32_t)fx0;
+    cells[1] = fy0 < 0.0 ? 0u : (uint32_t)fy0;
+    cells[2] = fx1 >= (double)index->width ? index->width - 1u : (uint32_t)fx1;
+    cells[3] = fy1 >= (double)index->height ? index->height - 1u : (uint32_t)fy1;
+    return 1;
 }
 
 /* A short-limit query: only the cells that meet the square of half-side
@@ -242,19 +260,11 @@ static double cell_distance2(const gtscore_index *index, int64_t x, int64_t y, d
 static double box_distance(const gtscore_index *index, double x_m, double y_m, double limit_m)
 {
     double best2 = HUGE_VAL;
-    double fx0 = floor((x_m - limit_m - index->origin_x_m) / index->cell_m);
-    double fx1 = floor((x_m + limit_m - index->origin_x_m) / index->cell_m);
-    double fy0 = floor((y_m - limit_m - index->origin_y_m) / index->cell_m);
-    double fy1 = floor((y_m + limit_m - index->origin_y_m) / index->cell_m);
-    int64_t x, y, x0, x1, y0, y1;
-    if (fx1 < 0.0 || fy1 < 0.0 || fx0 >= (double)index->width || fy0 >= (double)index->height)
+    uint32_t box[4], x, y;
+    if (!gtscore_index_box(index, x_m, y_m, limit_m, box))
         return HUGE_VAL;
-    x0 = fx0 < 0.0 ? 0 : (int64_t)fx0;
-    y0 = fy0 < 0.0 ? 0 : (int64_t)fy0;
-    x1 = fx1 >= (double)index->width ? (int64_t)index->width - 1 : (int64_t)fx1;
-    y1 = fy1 >= (double)index->height ? (int64_t)index->height - 1 : (int64_t)fy1;
-    for (y = y0; y <= y1; y++)
-        for (x = x0; x <= x1; x++)
+    for (y = box[1]; y <= box[3]; y++)
+        for (x = box[0]; x <= box[2]; x++)
             best2 = cell_distance2(index, x, y, x_m, y_m, best2);
     return sqrt(best2);
 }

@@ -259,12 +259,15 @@ static int sample_segment(const gtscore_truth *truth, const float *a, const floa
     return 0;
 }
 
-static int precision(const gtscore_truth *truth, const polyc_polyline *lines, uint32_t count,
-                     gtscore_map_score *out)
+/* The distances to the truth of the map's 1 cm samples: *dist (malloc'ed,
+ * NULL if none) gets *n of them. */
+static int sample_distances(const gtscore_truth *truth, const polyc_polyline *lines,
+                            uint32_t count, double **dist, size_t *n)
 {
-    double *dist = NULL, sum_sq = 0.0;
-    size_t n = 0, cap = 0, i;
+    size_t cap = 0;
     uint32_t l, j;
+    *dist = NULL;
+    *n = 0;
     for (l = 0; l < count; l++) {
         const polyc_polyline *pl = &lines[l];
         uint32_t m = pl->point_count, segs;
@@ -272,15 +275,30 @@ static int precision(const gtscore_truth *truth, const polyc_polyline *lines, ui
             continue;
         segs = pl->closed && m > 2u ? m : m - 1u;
         for (j = 0; j < segs; j++)
-            if (sample_segment(truth, &pl->xy_m[2u * j], &pl->xy_m[2u * ((j + 1u) % m)], &dist,
-                               &n, &cap) != 0)
+            if (sample_segment(truth, &pl->xy_m[2u * j], &pl->xy_m[2u * ((j + 1u) % m)], dist,
+                               n, &cap) != 0)
                 goto fail;
         if (!(pl->closed && m > 2u)) { /* the open end (or a lone point) */
             const float *e = &pl->xy_m[2u * (m - 1u)];
-            if (sample_segment(truth, e, e, &dist, &n, &cap) != 0)
+            if (sample_segment(truth, e, e, dist, n, &cap) != 0)
                 goto fail;
         }
     }
+    return 0;
+fail:
+    free(*dist);
+    *dist = NULL;
+    *n = 0;
+    return -1;
+}
+
+static int precision(const gtscore_truth *truth, const polyc_polyline *lines, uint32_t count,
+                     gtscore_map_score *out)
+{
+    double *dist, sum_sq = 0.0;
+    size_t n, i;
+    if (sample_distances(truth, lines, count, &dist, &n) != 0)
+        return -1;
     out->precision_samples = n;
     if (n > 0) {
         for (i = 0; i < n; i++)
@@ -293,9 +311,32 @@ static int precision(const gtscore_truth *truth, const polyc_polyline *lines, ui
     }
     free(dist);
     return 0;
-fail:
+}
+
+int gtscore_core_precision(const gtscore_truth *truth, const polyc_polyline *lines,
+                           uint32_t count, double core_m, double *rms_m)
+{
+    double *dist, sum_sq = 0.0;
+    size_t n, i, kept = 0;
+    uint32_t l;
+    if (!rms_m)
+        return -1;
+    *rms_m = 0.0;
+    if (!truth || (!lines && count) || !(core_m >= 0.0))
+        return -1;
+    for (l = 0; l < count; l++)
+        if (lines[l].point_count && !lines[l].xy_m)
+            return -1;
+    if (sample_distances(truth, lines, count, &dist, &n) != 0)
+        return -1;
+    for (i = 0; i < n; i++)
+        if (dist[i] <= core_m) {
+            sum_sq += dist[i] * dist[i];
+            kept++;
+        }
+    *rms_m = kept ? sqrt(sum_sq / (double)kept) : 0.0;
     free(dist);
-    return -1;
+    return 0;
 }
 
 int gtscore_score_map(const gtscore_truth *truth, const polyc_polyline *lines,

@@ -19,6 +19,8 @@
  *                 only near the measured range). f = hits / reflected beams;
  *                 ray error = measured range - r_map of the FIRST segment
  *                 met; ray RMSE = sqrt(mean of ray error^2 over the hits).
+ *   core precision the precision RMS over the samples within a given
+ *                 distance of a true wall (the bench uses 0.5 m).
  *   points        share of scan endpoints (reflected beams) within D of a
  *                 map, for whole real logs without ground truth.
  *
@@ -73,6 +75,16 @@ int gtscore_index_build(gtscore_index *index, double cell_m);
  * limit_m = INFINITY asks for the exact distance however far. */
 double gtscore_index_distance(const gtscore_index *index, double x_m, double y_m,
                               double limit_m);
+/* The cells [cells[0], cells[2]] x [cells[1], cells[3]] (x, then y) that
+ * meet the square of half-side r_m around (x, y): every segment within r_m
+ * of the point is listed in one of them (a segment may be listed in
+ * several). Returns 0, cells untouched, when the square misses the grid. */
+int gtscore_index_box(const gtscore_index *index, double x_m, double y_m, double r_m,
+                      uint32_t cells[4]);
+
+/* Squared distance from (x, y) to the segment seg_m (x0 y0 x1 y1). */
+double gtscore_segment_distance2(const double *seg_m, double x_m, double y_m);
+
 /* Range to the first segment met by the ray from (x, y) at angle_rad,
  * within (0, max_range_m]; INFINITY if none. */
 double gtscore_index_ray(const gtscore_index *index, double x_m, double y_m, double angle_rad,
@@ -124,6 +136,13 @@ typedef struct gtscore_map_score {
 
 int gtscore_score_map(const gtscore_truth *truth, const polyc_polyline *lines,
                       uint32_t count, gtscore_map_score *out);
+
+/* Core precision: the precision RMS over only the map's samples (as above)
+ * that lie within core_m (<=) of a true wall, so that a map of data that
+ * are no wall (a person who stood still, furniture not in the truth) does
+ * not weigh on it. *rms_m = 0 when no sample is that near. */
+int gtscore_core_precision(const gtscore_truth *truth, const polyc_polyline *lines,
+                           uint32_t count, double core_m, double *rms_m);
 
 /* ---- single-scan scores --------------------------------------------------- */
 
