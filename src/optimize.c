@@ -172,20 +172,30 @@ static polyc_status restore_best(polyc__opt *o, polyc_status st)
     return st;
 }
 
-/* The best map once more through merging, vertex removal and the
- * topology operators: the last edits of the search (cuts at crossings,
+/* The best map once more through merging and vertex removal, kept if its
+ * BIC is no higher: the last edits of the search (cuts at crossings,
  * zipped stretches) can leave two ends a centimetre apart that the next
- * iteration would have joined. Kept if its BIC is no higher; 1 if the
- * store was changed back to the best map (the scores need a rebuild). */
-static int polish(polyc__opt *o, double best)
+ * iteration would have joined. Then the rules the map must keep whatever
+ * its BIC: every data gap split (a pass cuts one gap a segment), ends
+ * trimmed, no double cover, no crossing. Returns a status (the store holds
+ * the result, scored). */
+static polyc_status polish(polyc__opt *o, double best)
 {
+    polyc_status st;
     polyc__op_merge(o);
     polyc__op_remove_vertices(o, 0);
+    if (polyc__bic(o) > best) {
+        if (polyc__store_from_flat(o->s, &o->best) != POLYC_OK)
+            return polyc__fail(o->ctx, POLYC_ERR_NOMEM, "no room to restore the best map");
+        if ((st = polyc__rebuild(o)) != POLYC_OK)
+            return st;
+    }
+    for (int k = 0; k < 8 && polyc__op_split(o) > 0; k++)
+        ;
+    polyc__op_trim_ends(o);
     polyc__op_zip(o);
     polyc__op_untangle(o);
-    if (polyc__bic(o) <= best)
-        return 0;
-    return polyc__store_from_flat(o->s, &o->best) == POLYC_OK;
+    return POLYC_OK;
 }
 
 polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *user)
@@ -308,7 +318,7 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
     ctx->opt_result_valid = 1;
     if ((st = polyc__rebuild(&o)) != POLYC_OK)
         return st;
-    if (!o.rays.on && result == POLYC_OK && polish(&o, best) && (st = polyc__rebuild(&o)) != POLYC_OK)
+    if (!o.rays.on && (st = polish(&o, best)) != POLYC_OK)
         return st;
     fill_stats(&o);
     return result;
