@@ -232,7 +232,7 @@ int polyc__op_adjust(polyc__opt *o, int max_rounds, uint32_t since)
             /* a single scan's ends are placed by end trimming (where the
              * end return's beam crosses the end segment's line), so a climb
              * could only turn the end segment about its neighbour: on 100
-             * freiburg-campus scans that was a third of the climbs' trials
+             * freiburg-campus scans that is a third of the climbs' trials
              * for a tenth of their gain */
             if (o->rays.on && (s->v[v].prev == POLYC__NONE || s->v[v].next == POLYC__NONE))
                 continue;

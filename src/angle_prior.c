@@ -50,7 +50,7 @@
  * of 18 uint16 counters (p->hist) and a uint32 total per cell with evidence,
  * rows handed out in the order cells get their first observation. The budget
  * is a row for every cell; what is not used is given back to the block after
- * learning. (Dense rows for every cell were zeroed, summed and smoothed
+ * learning. (Dense rows for every cell would be zeroed, summed and smoothed
  * cell by cell: 13,000 cells for a freiburg-campus scan whose returns touch
  * 100, 4 % of its time.) The prior grid is the tile grid; if that grid has
  * more cells than polyc__prior_bytes allows for (a long diagonal extent

@@ -231,9 +231,9 @@ static float other_dist2(const polyc__opt *o, float x, float y, int32_t v)
  * all lie within overlap_m of segments of other polylines (or of its own,
  * away from it). The ends alone are not enough: a wall between two corners
  * traced as separate polylines has both ends within reach of them. On
- * intel that test took segments of up to 3.3 m (median 1.3 m) bridging two
- * other polylines for overlaps, and zipping them away raised the BIC by
- * 4,000 to 14,000 an iteration, which the rest of the iteration had to win
+ * intel that test takes segments of up to 3.3 m (median 1.3 m) bridging two
+ * other polylines for overlaps, and zipping them away raises the BIC by
+ * 4,000 to 14,000 an iteration, which the rest of the iteration has to win
  * back. */
 static int runs_along(const polyc__opt *o, int32_t e, int32_t e2, float lim)
 {
@@ -556,9 +556,9 @@ int polyc__op_split(polyc__opt *o)
 /* Whether pulling end vertex v back to (x, y) on its segment loses a
  * return the segment holds now (single scans only): on a segment that runs
  * along the beams the farthest projection of its points can fall short of
- * where the last beam crosses it (edmonton, infinite-corridor and csail
- * each had a scan whose end beam then met the map metres behind its
- * return). */
+ * where the last beam crosses it (without this test edmonton,
+ * infinite-corridor and csail each have a scan whose end beam then meets
+ * the map metres behind its return). */
 static int trim_loses_returns(const polyc__opt *o, int32_t v, float x, float y)
 {
     const polyc__vertex *V = o->s->v;

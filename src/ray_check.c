@@ -113,8 +113,8 @@ static int met_by_any(const polyc__rays *rays, double c, double sn, float r, con
 /* Beam i against the query's segment: 1 if the segment stands in front of
  * its return, or behind it while the return is its own: near its line, or
  * met within the tolerance by a segment the edit replaces. Without the
- * second rule a removal on a wall seen at a grazing angle could leave a
- * return 15-20 cm off the new line, and its beam then met the map metres
+ * second rule a removal on a wall seen at a grazing angle can leave a
+ * return 15-20 cm off the new line, and its beam then meets the map metres
  * behind it (freiburg-079: one beam 2 m off made most of the ray RMSE). */
 static int beam_blocked(const polyc__rays *rays, int32_t i, double c, double sn,
                         const beam_query *q)
@@ -141,13 +141,12 @@ static int beam_blocked(const polyc__rays *rays, int32_t i, double c, double sn,
 }
 
 /* Beam i meets segment a-b within the tolerance of its return: a return
- * the segment holds. (Until the rule on the returns of replaced segments,
- * beam_blocked, only beams within 10 m and at 15 degrees or more to the
- * segment held one: holding far or flat ones then raised acapulco's ray
- * RMSE from 115 to 188 mm, with ends kept decimetres off along beams 25-40 m
- * long. With that rule, and polyc__loses_returns, holding every return
- * keeps every reflected beam on the map at no ray error: measured on 10
- * scans of each real log, f >= 0.999 and ray RMSE <= 29 mm everywhere.) */
+ * the segment holds, at any range and incidence. Together with the rule on
+ * the returns of replaced segments (beam_blocked) and polyc__loses_returns
+ * that keeps every reflected beam on the map at no ray error: on 10 scans
+ * of each real log, f >= 0.999 and ray RMSE <= 34 mm. (Without beam_blocked's
+ * rule, holding far or flat returns raised acapulco's ray RMSE from 115 to
+ * 188 mm, with ends kept decimetres off along beams 25-40 m long.) */
 static int beam_own(const polyc__rays *rays, int32_t i, double c, double sn, const beam_query *q)
 {
     float ax = q->ax, ay = q->ay, bx = q->bx, by = q->by;
@@ -162,7 +161,7 @@ typedef int (*beam_test)(const polyc__rays *rays, int32_t i, double c, double sn
                          const beam_query *q);
 
 /* The direction of (x, y) in (-pi, pi], to within 2e-6 rad (polyc__turn_rad:
- * libm's atan2 was a tenth of the ray checks' time) */
+ * libm's atan2 would take a tenth of the ray checks' time) */
 static double angle_of(double x, double y)
 {
     double a = (double)polyc__turn_rad((float)y, (float)x);
@@ -242,9 +241,9 @@ static int beam_newly_blocked(const polyc__rays *rays, int32_t i, double c, doub
  * its segments as they stand do not block, or loses a return they hold
  * (the store still holds v where it is). A vertex that already blocks a
  * beam (an end near the sensor, where the range noise is as large as the
- * beam spacing) may still move, but not onto other beams: until the
- * seventeenth session any move of such a vertex was allowed, and one climb
- * on csail put a segment 5.3 m in front of a return. */
+ * beam spacing) may still move, but not onto other beams: with any move of
+ * such a vertex allowed, one climb on csail put a segment 5.3 m in front of
+ * a return. */
 int polyc__vertex_blocks(const polyc__opt *o, int32_t v, float x, float y)
 {
     if (!o->rays.on)

@@ -197,8 +197,7 @@ static void check_optimised(const char *name)
     }
     run_free(&r);
     if (bad)
-        fail_msg("%s: optimised map misses the targets (expected until the optimiser lands)",
-                 name);
+        fail_msg("%s: optimised map misses the targets", name);
 }
 
 static void test_optimised_square(void **state)

@@ -865,12 +865,12 @@ static void test_trial_costs_by_field_match(void **state)
     fx_close(&f);
 }
 
-/* ---- two bugs the random edits found (fixed in b8dcafa), on minimal cases ---- */
+/* ---- two cases the random edits found, made minimal ---- */
 
 /* Merging two heads reverses one polyline: all its segments go out and come
  * back in one change. With more than ADDED_CAP of them the list of added
- * segments overflowed, and the link segment made by the same change was not
- * offered to the points near it whose own segment did not change. */
+ * segments must not overflow, and the link segment made by the same change
+ * must be offered to the points near it whose own segment did not change. */
 static void test_merge_reversing_long_line_rescores_link(void **state)
 {
     (void)state;
@@ -903,8 +903,9 @@ static void test_merge_reversing_long_line_rescores_link(void **state)
 }
 
 /* A vertex removed and another inserted in the same change: the insertion
- * recycles the removed vertex's slot; it used to reset v_dirty and list the
- * slot as dirty a second time, so chg_commit added its angle cost twice. */
+ * recycles the removed vertex's slot, and must not reset v_dirty and list
+ * the slot as dirty a second time (chg_commit would add its angle cost
+ * twice). */
 static void test_insert_recycling_removed_vertex_angle(void **state)
 {
     (void)state;
@@ -1875,9 +1876,9 @@ static void test_trim_keeps_grazing_return(void **state)
 
 /* A vertex whose segment already stands in front of a return (12 cm in
  * front of beam 1's, as ends near the sensor do within the range noise)
- * may move along it, but not across another beam that saw through: the
- * climb's check used to let any move of such a vertex pass, and one put a
- * segment 5.3 m in front of a csail return. */
+ * may move along it, but not across another beam that saw through: a
+ * check that lets any move of such a vertex pass let one csail climb put a
+ * segment 5.3 m in front of a return. */
 static void test_vertex_blocks_only_new_beams(void **state)
 {
     (void)state;

@@ -332,12 +332,13 @@ static void test_chain_end_along_beams(void **state)
     }
 }
 
-/* Initial chains drop the vertices Douglas-Peucker kept on range noise:
- * each corridor wall (1 cm noise, seen along 15 m) is one segment (it kept
- * 10 vertices a wall), and the room keeps its corners: two pieces of wall
- * around the box's shadow with a corner each (6 vertices), the box's near
- * face (2), and its other face, seen edge-on, as 3 cm of a chain of its own
- * (2; 1 if the faces come as one chain). Every return stays on the map. */
+/* Initial chains drop the vertices Douglas-Peucker keeps on range noise:
+ * each corridor wall (1 cm noise, seen along 15 m) is one segment
+ * (Douglas-Peucker alone keeps 10 vertices a wall), and the room keeps its
+ * corners: two pieces of wall around the box's shadow with a corner each
+ * (6 vertices), the box's near face (2), and its other face, seen edge-on,
+ * as 3 cm of a chain of its own (2; 1 if the faces come as one chain).
+ * Every return stays on the map. */
 static void test_chains_drop_noise_vertices(void **state)
 {
     (void)state;
