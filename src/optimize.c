@@ -318,7 +318,7 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
     ctx->opt_result_valid = 1;
     if ((st = polyc__rebuild(&o)) != POLYC_OK)
         return st;
-    if (!o.rays.on && (st = polish(&o, best)) != POLYC_OK)
+    if (!o.rays.on && result == POLYC_OK && (st = polish(&o, best)) != POLYC_OK)
         return st;
     fill_stats(&o);
     return result;
