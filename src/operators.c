@@ -444,6 +444,48 @@ static int supports(const polyc__opt *o, int32_t i, int32_t sg)
     return seg_dist2(o->pts[i].x, o->pts[i].y, a->x, a->y, b->x, b->y) <= lim * lim;
 }
 
+/* The length a stretch without data must exceed at (x, y) to be cut.
+ * Sparse data (far from every pose) have gaps of a few beam spacings
+ * between neighbouring points: those are no gaps. */
+static float gap_needed(const polyc__opt *o, float x, float y)
+{
+    float gap_min = o->cfg->split_gap_m;
+    float sparse = polyc__minf(2.5f * polyc__spacing_at(&o->spacing, x, y),
+                               gap_min + 0.5f * POLYC__SUPPORT_M);
+    return polyc__maxf(gap_min, sparse) + 0.5f * o->point_span_m;
+}
+
+/* Cuts out the stretch around vertex v from gap_tail[p] before it (p its
+ * predecessor) to gap_head[v] after it, where neither segment has data:
+ * the tip of a spike. 0 if there was no room. */
+static int cut_around(polyc__opt *o, int32_t v)
+{
+    polyc__store *s = o->s;
+    int32_t p = s->v[v].prev, n = s->v[v].next;
+    float px = s->v[p].x, py = s->v[p].y, vx = s->v[v].x, vy = s->v[v].y;
+    float nx = s->v[n].x, ny = s->v[n].y;
+    float lp = sqrtf((vx - px) * (vx - px) + (vy - py) * (vy - py));
+    float ln = sqrtf((nx - vx) * (nx - vx) + (ny - vy) * (ny - vy));
+    float ta = lp > 0.0f ? 1.0f - o->gap_tail[p] / lp : 0.0f; /* along p -> v */
+    float tb = ln > 0.0f ? o->gap_head[v] / ln : 1.0f;        /* along v -> n */
+    polyc__chg_begin(o);
+    int32_t a = p, b = n;
+    int ok = 1;
+    if (ta > 1e-3f && (a = polyc__op_insert_after(o, p, px + ta * (vx - px), py + ta * (vy - py))) == POLYC__NONE)
+        ok = 0;
+    if (ok && tb < 1.0f - 1e-3f &&
+        (b = polyc__op_insert_after(o, v, vx + tb * (nx - vx), vy + tb * (ny - vy))) == POLYC__NONE)
+        ok = 0;
+    if (ok) {
+        polyc__op_remove(o, v); /* a -> b */
+        if (s->v[a].line != POLYC__NONE && s->v[a].next == b)
+            polyc__op_cut(o, a);
+    }
+    polyc__chg_commit(o);
+    (void)b;
+    return ok;
+}
+
 /* A segment with a stretch longer than split_gap_m (or 2.5 beam spacings
  * where the data are sparser than that, up to split_gap_m plus half the
  * support distance: past that a stretch between two points would be
@@ -496,9 +538,18 @@ int polyc__op_split(polyc__opt *o)
         /* looked at: due again only when it or its points change (a cut
          * changes them; one left for the next pass stays due) */
         o->split_due[v] = 0;
+        int32_t lo = off[v], hi = off[v + 1];
+        /* how far each end of it lies from its nearest data (for the gaps
+         * across a vertex, below) */
+        float t_min = len, t_max = 0.0f;
+        for (int32_t k = lo; k < hi; k++) {
+            t_min = polyc__minf(t_min, t[k]);
+            t_max = polyc__maxf(t_max, t[k]);
+        }
+        o->gap_head[v] = t_min;
+        o->gap_tail[v] = hi > lo ? len - t_max : len;
         if (len <= gap_min)
             continue;
-        int32_t lo = off[v], hi = off[v + 1];
         if (no_gap_over(t + lo, hi - lo, len, gap_min))
             continue;
         sort_floats(t + lo, hi - lo);
@@ -511,13 +562,9 @@ int polyc__op_split(polyc__opt *o)
             }
             prev = cur;
         }
-        /* sparse data (far from every pose) has gaps of a few beam
-         * spacings between neighbouring points: those are no gaps */
         float gx = a->x + (b->x - a->x) * (g0 + 0.5f * best) / len;
         float gy = a->y + (b->y - a->y) * (g0 + 0.5f * best) / len;
-        float sparse = polyc__minf(2.5f * polyc__spacing_at(&o->spacing, gx, gy),
-                                   gap_min + 0.5f * POLYC__SUPPORT_M);
-        float need = polyc__maxf(gap_min, sparse) + 0.5f * o->point_span_m;
+        float need = gap_needed(o, gx, gy);
         if (best > need && n_cut < o->cut_cap) {
             o->cut_seg[n_cut] = v;
             o->cut_next[n_cut] = a->next;
@@ -547,6 +594,26 @@ int polyc__op_split(polyc__opt *o)
         else
             o->split_due[u] = 1; /* no room for a vertex: try again next pass */
         polyc__chg_commit(o);
+    }
+    /* a stretch without data across a vertex: the ends of its two segments
+     * (neither changed in this pass) together longer than the gap */
+    for (int32_t v = 0; v < nv; v++) {
+        const polyc__vertex *c = &s->v[v];
+        if (c->line == POLYC__NONE || c->prev == POLYC__NONE || c->next == POLYC__NONE)
+            continue;
+        int32_t p = c->prev;
+        if (due[p] || due[v] || s->l[c->line].count < 3)
+            continue;
+        if (!(o->gap_tail[p] + o->gap_head[v] > gap_needed(o, c->x, c->y)))
+            continue;
+        /* only a spike (the polyline turns back by more than 120 degrees):
+         * at a corner of a wall seen from one side the data stop short of
+         * the corner on the unseen face, and the corner is real */
+        const polyc__vertex *a = &s->v[p], *b = &s->v[c->next];
+        float ux = c->x - a->x, uy = c->y - a->y, wx = b->x - c->x, wy = b->y - c->y;
+        if (ux * wx + uy * wy < -0.5f * sqrtf((ux * ux + uy * uy) * (wx * wx + wy * wy)) &&
+            cut_around(o, v))
+            n_cut++;
     }
     return n_cut;
 }

@@ -37,7 +37,7 @@ size_t polyc__optimizer_bytes(const polyc_config *cfg, const polyc_limits *lim)
     n = polyc__add(n, polyc__bytes(POLYC__CAND_MAX, sizeof(int32_t) + 4 * sizeof(float))); /* cand */
     n = polyc__add(n, polyc__bytes((size_t)loc_soa_cap(lim), 7 * sizeof(double))); /* lsoa */
     n = polyc__add(n, polyc__bytes(P + V, sizeof(float)));        /* split_t */
-    n = polyc__add(n, polyc__bytes(V, sizeof(float)));            /* trim_head */
+    n = polyc__add(n, polyc__bytes(V, 3 * sizeof(float)));        /* trim_head, gap_head, gap_tail */
     n = polyc__add(n, polyc__bytes(V + 1, sizeof(int32_t)));      /* split_off */
     n = polyc__add(n, polyc__bytes(V / 4 + 64, 2 * sizeof(float) + 2 * sizeof(int32_t))); /* cuts */
     n = polyc__add(n, polyc__bytes(V, sizeof(double) + 3 * sizeof(float))); /* acost, seg stats */
@@ -102,6 +102,10 @@ polyc_status polyc__opt_setup(polyc_ctx *ctx, polyc__opt *o)
     o->agg_cap = P;
     ALLOC(o->split_t, P > V ? P : V);
     ALLOC(o->trim_head, V);
+    ALLOC(o->gap_head, V);
+    ALLOC(o->gap_tail, V);
+    memset(o->gap_head, 0, (size_t)V * sizeof(float));
+    memset(o->gap_tail, 0, (size_t)V * sizeof(float));
     ALLOC(o->split_off, V + 1);
     /* cuts per pass (more wait for the next pass) */
     ALLOC(o->cut_seg, V / 4 + 64);

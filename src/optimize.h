@@ -97,6 +97,8 @@ typedef struct polyc__opt {
     int32_t *cut_seg, *cut_next, cut_cap;
     float *cut_t0, *cut_t1;
     float *trim_head;              /* end trimming: farthest point from the head side */
+    float *gap_head, *gap_tail;    /* per segment: its ends' distance to its nearest data
+                                    * (split, valid while it is not split_due) */
 
     /* model size scratch: per segment sums, farthest point; removal heap */
     float *seg_sum, *seg_w, *seg_far_d;
