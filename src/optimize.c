@@ -197,7 +197,13 @@ static polyc_status polish(polyc__opt *o, double best)
     for (int k = 0; k < 8 && polyc__op_split(o) > 0; k++)
         ;
     polyc__op_trim_ends(o);
-    polyc__op_zip(o);
+    uint32_t mark = ++o->touch_stamp;
+    if (polyc__op_zip(o) > 0) {
+        /* what is left of a zipped pair moves onto the data of both */
+        polyc__op_adjust(o, ADJUST_ROUNDS, mark);
+        polyc__op_trim_ends(o);
+        polyc__op_zip(o);
+    }
     polyc__op_untangle(o);
     return POLYC_OK;
 }
