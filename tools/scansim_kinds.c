@@ -9,7 +9,8 @@
  * is kept only if it stays PATH_CLEAR_M off the path and clear of every
  * wall, a person only if they stay in free space, in view of the robot and
  * away from it. The whole scene is then turned by a random angle and
- * shifted, as the fixed scenes are.
+ * shifted, as the fixed scenes are. (Random draws are never two arguments
+ * of one call: C leaves their order to the compiler.)
  */
 #include "scansim.h"
 
@@ -201,8 +202,9 @@ static int scatter_boxes(layout *L, uint32_t count, const double *w_range,
         double w = urange(&L->rng, w_range[0], w_range[1]);
         double h = urange(&L->rng, h_range[0], h_range[1]);
         double a = angle_rad < 0.0 ? urange(&L->rng, 0.0, PI) : angle_rad;
+        double cx = urange(&L->rng, x0, x1), cy = urange(&L->rng, y0, y1);
         int rc;
-        rect_xy(xy, urange(&L->rng, x0, x1), urange(&L->rng, y0, y1), w, h, a);
+        rect_xy(xy, cx, cy, w, h, a);
         rc = try_add(L, xy, 4u, gap_m);
         if (rc < 0)
             return -1;
@@ -579,17 +581,15 @@ int scansim_kind_flat(scansim_scene *s)
         for (tries = 0; placed < pieces && tries < 60u; tries++) {
             double kind = scansim_rng_uniform(&L.rng);
             int got;
-            if (kind < 0.35)
-                got = against_wall(&L, r->x0, r->y0, r->x1, r->y1, urange(&L.rng, 1.9, 2.1),
-                                   urange(&L.rng, 0.9, 1.6)); /* bed */
-            else if (kind < 0.7)
-                got = against_wall(&L, r->x0, r->y0, r->x1, r->y1, urange(&L.rng, 0.8, 2.0),
-                                   urange(&L.rng, 0.5, 0.65)); /* cupboard */
-            else {
-                double xy[8];
-                rect_xy(xy, urange(&L.rng, r->x0 + 0.5, r->x1 - 0.5),
-                        urange(&L.rng, r->y0 + 0.5, r->y1 - 0.5), urange(&L.rng, 1.0, 1.8),
-                        urange(&L.rng, 0.7, 0.9), urange(&L.rng, -0.3, 0.3));
+            if (kind < 0.7) { /* a bed or a cupboard */
+                double along = kind < 0.35 ? urange(&L.rng, 1.9, 2.1) : urange(&L.rng, 0.8, 2.0);
+                double depth = kind < 0.35 ? urange(&L.rng, 0.9, 1.6) : urange(&L.rng, 0.5, 0.65);
+                got = against_wall(&L, r->x0, r->y0, r->x1, r->y1, along, depth);
+            } else {
+                double xy[8], tx = urange(&L.rng, r->x0 + 0.5, r->x1 - 0.5);
+                double ty = urange(&L.rng, r->y0 + 0.5, r->y1 - 0.5);
+                double tw = urange(&L.rng, 1.0, 1.8), th = urange(&L.rng, 0.7, 0.9);
+                rect_xy(xy, tx, ty, tw, th, urange(&L.rng, -0.3, 0.3));
                 got = try_add(&L, xy, 4u, 0.3); /* table */
             }
             if (got < 0)
