@@ -315,9 +315,47 @@ static int inside_wall(const scansim_scene *s, uint32_t w, double x, double y)
     return in;
 }
 
+static double cross3(const double *o, const double *a, const double *b)
+{
+    return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
+}
+
+/* Do segments ab and cd cross at a point inside both, each pair of ends
+ * more than 1 um from the other's line on either side? (touching is not
+ * crossing: the flat's wall boxes meet, furniture stands flush) */
+static int segments_cross(const double *a, const double *b, const double *c, const double *d)
+{
+    double lab = hypot(b[0] - a[0], b[1] - a[1]), lcd = hypot(d[0] - c[0], d[1] - c[1]);
+    double d1 = cross3(a, b, c) / lab, d2 = cross3(a, b, d) / lab;
+    double d3 = cross3(c, d, a) / lcd, d4 = cross3(c, d, b) / lcd;
+    return ((d1 > 1e-6 && d2 < -1e-6) || (d1 < -1e-6 && d2 > 1e-6)) &&
+           ((d3 > 1e-6 && d4 < -1e-6) || (d3 < -1e-6 && d4 > 1e-6));
+}
+
+/* The first pair of walls that cross each other, or -1. */
+static int32_t walls_crossing(const scansim_scene *s)
+{
+    uint32_t v, w, i, j;
+    for (v = 0; v < s->wall_count; v++)
+        for (w = v + 1u; w < s->wall_count; w++) {
+            const scansim_wall *p = &s->walls[v], *q = &s->walls[w];
+            uint32_t np = p->closed ? p->point_count : p->point_count - 1u;
+            uint32_t nq = q->closed ? q->point_count : q->point_count - 1u;
+            for (i = 0; i < np; i++)
+                for (j = 0; j < nq; j++)
+                    if (segments_cross(&s->wall_xy_m[2u * (p->first_point + i)],
+                                       &s->wall_xy_m[2u * (p->first_point + (i + 1u) % p->point_count)],
+                                       &s->wall_xy_m[2u * (q->first_point + j)],
+                                       &s->wall_xy_m[2u * (q->first_point + (j + 1u) % q->point_count)]))
+                        return (int32_t)v;
+        }
+    return -1;
+}
+
 /* Every kind, seeds 0-5, without simulating: a few hundred to 1,500 poses,
  * the robot never within 0.25 m of a wall nor inside a box (a closed wall
- * holds either every pose, the hall round them, or none), people present,
+ * holds either every pose, the hall round them, or none), no wall crossing
+ * another (furniture does not stand in a wall), people present,
  * some of them standing still for 20 scans or more, each clear of the walls
  * and of the robot; and each seed a different layout. */
 static void test_kinds_layouts(void **state)
@@ -347,6 +385,9 @@ static void test_kinds_layouts(void **state)
                     fail_msg("%s seed %u: %u poses inside wall %u", kinds[k], (unsigned)seed, in,
                              w);
             }
+            if (walls_crossing(&s) >= 0)
+                fail_msg("%s seed %u: wall %d crosses another", kinds[k], (unsigned)seed,
+                         (int)walls_crossing(&s));
             assert_true(s.person_count >= 2u);
             for (i = 0; i < s.person_count; i++) {
                 const scansim_person *p = &s.people[i];

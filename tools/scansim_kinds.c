@@ -20,7 +20,7 @@
 #define PI 3.14159265358979323846
 #define PATH_CLEAR_M 0.5     /* furniture keeps this far from the path */
 #define OBJECT_GAP_M 0.3     /* and this far from other furniture */
-#define AGAINST_WALL_M 0.02  /* a cupboard or a bed stands this far off its wall */
+#define FLUSH_CHECK_M 0.01  /* a piece flush with a wall keeps this off the others */
 #define ARC_STEP_M 0.10      /* side of the polygons that stand for curves */
 #define PLACE_TRIES 400u
 #define MAX_WAY 256u         /* waypoints of one path */
@@ -180,14 +180,21 @@ static int fits(const layout *L, const double *poly, uint32_t n, double gap_m)
     return 1;
 }
 
-/* Adds the polygon if it fits; 1 added, 0 not, -1 out of memory. */
-static int try_add(layout *L, const double *poly, uint32_t n, double gap_m)
+/* Adds the polygon if `check` (the polygon itself, or a copy of it moved
+ * off the wall it stands against) fits; 1 added, 0 not, -1 out of memory. */
+static int try_add_checked(layout *L, const double *poly, const double *check, uint32_t n,
+                           double gap_m)
 {
     if (L->first_object == UINT32_MAX)
         L->first_object = L->s->wall_count;
-    if (!fits(L, poly, n, gap_m))
+    if (!fits(L, check, n, gap_m))
         return 0;
     return scansim_add_wall(L->s, poly, n, 1) == 0 ? 1 : -1;
+}
+
+static int try_add(layout *L, const double *poly, uint32_t n, double gap_m)
+{
+    return try_add_checked(L, poly, poly, n, gap_m);
 }
 
 /* Up to `count` w x h boxes (sizes drawn per box from the ranges) at random
@@ -213,29 +220,35 @@ static int scatter_boxes(layout *L, uint32_t count, const double *w_range,
     return 0;
 }
 
-/* A box of w along the wall and depth d into the room, standing
- * AGAINST_WALL_M off one of the four inner faces of the room
- * [x0, x1] x [y0, y1] (side 0..3: south, east, north, west), at a random
- * place along it. 1 added, 0 not, -1 out of memory. */
+/* A box of w along the wall and depth d into the room, flush with one of
+ * the four inner faces of the room [x0, x1] x [y0, y1] (side 0..3: south,
+ * east, north, west) and 0.3 m or more from the room's corners, as
+ * cupboards, beds and crates stand: no slot behind it for a beam to look
+ * into. The box is checked moved FLUSH_CHECK_M off its wall, so that it may
+ * touch that wall but keeps FLUSH_CHECK_M from every other one (and the
+ * usual distances from the path and the furniture). 1 added, 0 not, -1 out
+ * of memory. */
 static int against_wall(layout *L, double x0, double y0, double x1, double y1, double w,
                         double d)
 {
     uint32_t side = upick(&L->rng, 0u, 3u);
-    double g = AGAINST_WALL_M, cx, cy, xy[8];
+    double along, xy[8], check[8], off = 2.0 * FLUSH_CHECK_M;
     if (side == 0u || side == 2u) {
-        if (x1 - x0 < w + 2.0 * g)
+        double cy = side == 0u ? y0 + d / 2.0 : y1 - d / 2.0;
+        if (x1 - x0 < w + 0.6)
             return 0;
-        cx = urange(&L->rng, x0 + g + w / 2.0, x1 - g - w / 2.0);
-        cy = side == 0u ? y0 + g + d / 2.0 : y1 - g - d / 2.0;
-        rect_xy(xy, cx, cy, w, d, 0.0);
+        along = urange(&L->rng, x0 + 0.3 + w / 2.0, x1 - 0.3 - w / 2.0);
+        rect_xy(xy, along, cy, w, d, 0.0);
+        rect_xy(check, along, side == 0u ? cy + off : cy - off, w, d, 0.0);
     } else {
-        if (y1 - y0 < w + 2.0 * g)
+        double cx = side == 3u ? x0 + d / 2.0 : x1 - d / 2.0;
+        if (y1 - y0 < w + 0.6)
             return 0;
-        cy = urange(&L->rng, y0 + g + w / 2.0, y1 - g - w / 2.0);
-        cx = side == 3u ? x0 + g + d / 2.0 : x1 - g - d / 2.0;
-        rect_xy(xy, cx, cy, d, w, 0.0);
+        along = urange(&L->rng, y0 + 0.3 + w / 2.0, y1 - 0.3 - w / 2.0);
+        rect_xy(xy, cx, along, d, w, 0.0);
+        rect_xy(check, side == 3u ? cx + off : cx - off, along, d, w, 0.0);
     }
-    return try_add(L, xy, 4u, g / 2.0);
+    return try_add_checked(L, xy, check, 4u, FLUSH_CHECK_M);
 }
 
 /* The smallest distance from the segment ab to any wall. */
@@ -321,7 +334,8 @@ static int lay_path(layout *L, double target)
     double len = 0.0, spacing;
     uint32_t i;
     for (i = 0; i + 1u < L->way_count; i++)
-        len += hypot(L->way[2u * i + 2u] - L->way[2u * i], L->way[2u * i + 3u] - L->way[2u * i + 1u]);
+        len += hypot(L->way[2u * i + 2u] - L->way[2u * i],
+                     L->way[2u * i + 3u] - L->way[2u * i + 1u]);
     spacing = fmin(0.20, fmax(0.05, len / target));
     return scansim_add_path(L->s, L->way, L->way_count, spacing);
 }
@@ -381,7 +395,8 @@ int scansim_kind_hall(scansim_scene *s)
     L.first_object = s->wall_count;
     for (gx = ox; gx < w - 1.5 && rc == 0; gx += grid)
         for (gy = oy; gy < h - 1.5 && rc == 0; gy += grid) {
-            double xy[64], cx = gx + urange(&L.rng, -0.3, 0.3), cy = gy + urange(&L.rng, -0.3, 0.3);
+            double xy[64], cx = gx + urange(&L.rng, -0.3, 0.3);
+            double cy = gy + urange(&L.rng, -0.3, 0.3);
             uint32_t n = 4u, k;
             if (scansim_rng_uniform(&L.rng) < 0.5) {
                 double side = urange(&L.rng, 0.4, 0.8);
@@ -461,9 +476,16 @@ int scansim_kind_shelves(scansim_scene *s)
     }
     rc |= lay_path(&L, 900.0);
     {
-        static const double crate_w[2] = {0.6, 1.2}, crate_h[2] = {0.4, 0.8};
-        rc |= scatter_boxes(&L, upick(&L.rng, 1u, 4u), crate_w, crate_h, 0.0, 0.3, 0.3,
-                            x_end - 0.3, y - 0.3, AGAINST_WALL_M);
+        uint32_t crates = upick(&L.rng, 1u, 4u), placed = 0, tries;
+        L.first_object = s->wall_count;
+        for (tries = 0; placed < crates && tries < PLACE_TRIES && rc == 0; tries++) {
+            double along = urange(&L.rng, 0.6, 1.2), depth = urange(&L.rng, 0.4, 0.8);
+            int got = against_wall(&L, 0.0, 0.0, x_end, y, along, depth);
+            if (got < 0)
+                rc = -1;
+            else
+                placed += (uint32_t)got;
+        }
     }
     rc |= add_people(&L, 2u, 2u);
     if (rc != 0)
