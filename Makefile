@@ -1,5 +1,6 @@
 # libpolyc - see README.md. `make` builds the library and the tool,
-# `make test` runs every test suite, `make bench DATA=../shared/data` measures.
+# `make test` runs every test suite, `make bench DATA=../shared/data` measures,
+# `make sweep` maps and scores simulated scenes of every kind over seeds 1-6.
 CC      ?= cc
 BUILD   ?= build
 OPT     ?= -O2 -g
@@ -12,11 +13,11 @@ LDLIBS  = -lm
 LIB_SRC  = $(wildcard src/*.c)
 LIB_OBJ  = $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
 # tools/ modules shared by the CLI, the tests and the benchmark
-TOOL_MOD = $(filter-out tools/polyc.c tools/bench.c,$(wildcard tools/*.c))
+TOOL_MOD = $(filter-out tools/polyc.c tools/bench.c tools/sweep.c,$(wildcard tools/*.c))
 TOOL_OBJ = $(TOOL_MOD:tools/%.c=$(BUILD)/tobj/%.o)
 TOOL_CFLAGS = $(WARN) $(OPT) $(CFLAGS) -Iinclude -Itools -D_POSIX_C_SOURCE=200809L
 
-.PHONY: all lib test unit bench clean install cross deps check test-cxx test-install test-python test-embedded
+.PHONY: all lib test unit bench sweep clean install cross deps check test-cxx test-install test-python test-embedded
 .PHONY: test-cli test-fuzz-replay test-asan test-valgrind fuzz fuzz-merge
 all: $(BUILD)/libpolyc.a $(BUILD)/libpolyc.so $(BUILD)/polyc
 
@@ -216,6 +217,16 @@ bench:
 	$(MAKE) BUILD=build-bench OPT='-O3 -march=native -DNDEBUG' build-bench/bench
 	build-bench/bench $(BENCH_ARGS) $(DATA)
 $(BUILD)/bench: tools/bench.c $(TOOL_OBJ) $(BUILD)/libpolyc.a
+	$(CC) $(TOOL_CFLAGS) $^ -o $@ $(LDLIBS)
+
+# Simulated scenes of every kind over several seeds, each scored against its
+# own ground truth (docs/evaluation.md). `make sweep SWEEP_ARGS='--seeds 1-20
+# --kinds hall,flat --svg /tmp/svg'`; needs no data directory.
+SWEEP_ARGS ?=
+sweep:
+	$(MAKE) BUILD=build-bench OPT='-O3 -march=native -DNDEBUG' build-bench/sweep
+	build-bench/sweep $(SWEEP_ARGS)
+$(BUILD)/sweep: tools/sweep.c $(TOOL_OBJ) $(BUILD)/libpolyc.a
 	$(CC) $(TOOL_CFLAGS) $^ -o $@ $(LDLIBS)
 
 # Regenerate the bundled example (examples/office.*) with the simulator

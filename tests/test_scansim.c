@@ -1,6 +1,7 @@
 /* test_scansim.c - the laser simulator: determinism, geometry, noise,
- * people, dropout, and its log and ground-truth files read back by
- * scanlog and gtscore. */
+ * people, dropout, its log and ground-truth files read back by scanlog and
+ * gtscore, and the randomised scene kinds (layouts per seed, a path clear
+ * of every wall, people in free space). */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -179,8 +180,12 @@ static void test_builtins_sane(void **state)
     for (; *names; names++) {
         gtscore_index walls;
         uint32_t i, w;
-        run_builtin(&s, *names, 11);
-        assert_true(s.scan_count <= 400u);
+        /* the randomised kinds run 300-1,000 scans: every 20th of them here */
+        assert_int_equal(scansim_scene_builtin(&s, *names, 11), 0);
+        if (s.pose_count > 400u)
+            assert_int_equal(scansim_keep_every(&s, 20u), 0);
+        assert_int_equal(scansim_run(&s), 0);
+        assert_true(s.scan_count > 0 && s.scan_count <= 400u);
         assert_true(scansim_seen_count(&s) > 0);
         /* every seen sample lies on a true wall */
         gtscore_index_init(&walls);
@@ -292,6 +297,223 @@ static void test_path_spacing(void **state)
     scansim_scene_free(&s);
 }
 
+
+static const char *const kinds[] = {"hall", "shelves", "flat", "curved", "thinwalls"};
+#define KIND_COUNT (sizeof kinds / sizeof kinds[0])
+
+/* Is (x, y) inside the closed wall w? (even-odd rule) */
+static int inside_wall(const scansim_scene *s, uint32_t w, double x, double y)
+{
+    const double *xy = &s->wall_xy_m[2u * s->walls[w].first_point];
+    uint32_t i, j, n = s->walls[w].point_count;
+    int in = 0;
+    for (i = 0, j = n - 1u; i < n; j = i++)
+        if ((xy[2u * i + 1u] > y) != (xy[2u * j + 1u] > y) &&
+            x < xy[2u * j] + (xy[2u * i] - xy[2u * j]) * (y - xy[2u * j + 1u]) /
+                                 (xy[2u * i + 1u] - xy[2u * j + 1u]))
+            in = !in;
+    return in;
+}
+
+static double cross3(const double *o, const double *a, const double *b)
+{
+    return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
+}
+
+/* Do segments ab and cd cross at a point inside both, each pair of ends
+ * more than 1 um from the other's line on either side? (touching is not
+ * crossing: the flat's wall boxes meet, furniture stands flush) */
+static int segments_cross(const double *a, const double *b, const double *c, const double *d)
+{
+    double lab = hypot(b[0] - a[0], b[1] - a[1]), lcd = hypot(d[0] - c[0], d[1] - c[1]);
+    double d1 = cross3(a, b, c) / lab, d2 = cross3(a, b, d) / lab;
+    double d3 = cross3(c, d, a) / lcd, d4 = cross3(c, d, b) / lcd;
+    return ((d1 > 1e-6 && d2 < -1e-6) || (d1 < -1e-6 && d2 > 1e-6)) &&
+           ((d3 > 1e-6 && d4 < -1e-6) || (d3 < -1e-6 && d4 > 1e-6));
+}
+
+/* The first pair of walls that cross each other, or -1. */
+static int32_t walls_crossing(const scansim_scene *s)
+{
+    uint32_t v, w, i, j;
+    for (v = 0; v < s->wall_count; v++)
+        for (w = v + 1u; w < s->wall_count; w++) {
+            const scansim_wall *p = &s->walls[v], *q = &s->walls[w];
+            uint32_t np = p->closed ? p->point_count : p->point_count - 1u;
+            uint32_t nq = q->closed ? q->point_count : q->point_count - 1u;
+            for (i = 0; i < np; i++)
+                for (j = 0; j < nq; j++)
+                    if (segments_cross(&s->wall_xy_m[2u * (p->first_point + i)],
+                                       &s->wall_xy_m[2u * (p->first_point + (i + 1u) % p->point_count)],
+                                       &s->wall_xy_m[2u * (q->first_point + j)],
+                                       &s->wall_xy_m[2u * (q->first_point + (j + 1u) % q->point_count)]))
+                        return (int32_t)v;
+        }
+    return -1;
+}
+
+/* Every kind, seeds 0-5, without simulating: a few hundred to 1,500 poses,
+ * the robot never within 0.25 m of a wall nor inside a box (a closed wall
+ * holds either every pose, the hall round them, or none), no wall crossing
+ * another (furniture does not stand in a wall), people present,
+ * some of them standing still for 20 scans or more, each clear of the walls
+ * and of the robot; and each seed a different layout. */
+static void test_kinds_layouts(void **state)
+{
+    uint32_t k, w, i;
+    uint64_t seed;
+    (void)state;
+    for (k = 0; k < KIND_COUNT; k++) {
+        uint32_t prev_points = 0;
+        double prev_x = 0.0;
+        for (seed = 0; seed < 6u; seed++) {
+            scansim_scene s;
+            uint32_t standing = 0;
+            assert_int_equal(scansim_scene_builtin(&s, kinds[k], seed), 0);
+            if (s.pose_count < 300u || s.pose_count > 1500u)
+                fail_msg("%s seed %u: %u poses", kinds[k], (unsigned)seed, s.pose_count);
+            if (scansim_path_clearance(&s) < 0.25)
+                fail_msg("%s seed %u: the path comes %.3f m from a wall", kinds[k],
+                         (unsigned)seed, scansim_path_clearance(&s));
+            for (w = 0; w < s.wall_count; w++) {
+                uint32_t in = 0;
+                if (!s.walls[w].closed)
+                    continue;
+                for (i = 0; i < s.pose_count; i++)
+                    in += (uint32_t)inside_wall(&s, w, s.poses[i].x_m, s.poses[i].y_m);
+                if (in != 0 && in != s.pose_count)
+                    fail_msg("%s seed %u: %u poses inside wall %u", kinds[k], (unsigned)seed, in,
+                             w);
+            }
+            if (walls_crossing(&s) >= 0)
+                fail_msg("%s seed %u: wall %d crosses another", kinds[k], (unsigned)seed,
+                         (int)walls_crossing(&s));
+            assert_true(s.person_count >= 2u);
+            for (i = 0; i < s.person_count; i++) {
+                const scansim_person *p = &s.people[i];
+                uint32_t scan;
+                assert_true(p->last_scan < s.pose_count);
+                if (p->from_x_m == p->to_x_m && p->from_y_m == p->to_y_m &&
+                    p->last_scan - p->first_scan >= 20u)
+                    standing++;
+                for (scan = p->first_scan; scan <= p->last_scan; scan++) {
+                    double f = p->last_scan > p->first_scan
+                                   ? (double)(scan - p->first_scan) /
+                                         (double)(p->last_scan - p->first_scan)
+                                   : 0.0;
+                    double x = p->from_x_m + (p->to_x_m - p->from_x_m) * f;
+                    double y = p->from_y_m + (p->to_y_m - p->from_y_m) * f;
+                    assert_true(hypot(x - s.poses[scan].x_m, y - s.poses[scan].y_m) >
+                                p->radius_m + 0.25);
+                }
+            }
+            assert_true(standing >= 1u);
+            /* another seed, another layout */
+            if (seed > 0)
+                assert_true(s.wall_point_count != prev_points || s.wall_xy_m[0] != prev_x);
+            prev_points = s.wall_point_count;
+            prev_x = s.wall_xy_m[0];
+            scansim_scene_free(&s);
+        }
+    }
+}
+
+/* Every kind simulated (every 25th pose, seeds 0-2): the same seed gives the
+ * same scans, walls and samples; another seed other walls; ideal and the
+ * seen samples are there and most beams return. */
+static void test_kinds_run(void **state)
+{
+    uint32_t k;
+    uint64_t seed;
+    (void)state;
+    for (k = 0; k < KIND_COUNT; k++)
+        for (seed = 0; seed < 3u; seed++) {
+            scansim_scene a, b, c;
+            size_t n;
+            assert_int_equal(scansim_scene_builtin(&a, kinds[k], seed), 0);
+            assert_int_equal(scansim_scene_builtin(&b, kinds[k], seed), 0);
+            assert_int_equal(scansim_scene_builtin(&c, kinds[k], seed + 100u), 0);
+            assert_int_equal(scansim_keep_every(&a, 25u), 0);
+            assert_int_equal(scansim_keep_every(&b, 25u), 0);
+            assert_int_equal(scansim_run(&a), 0);
+            assert_int_equal(scansim_run(&b), 0);
+            assert_true(a.scan_count >= 12u);
+            assert_int_equal(a.wall_point_count, b.wall_point_count);
+            assert_memory_equal(a.wall_xy_m, b.wall_xy_m, 2u * a.wall_point_count * sizeof(double));
+            n = (size_t)a.scan_count * a.laser.beam_count;
+            assert_memory_equal(a.range_m, b.range_m, n * sizeof(float));
+            assert_int_equal(scansim_seen_count(&a), scansim_seen_count(&b));
+            assert_true(c.wall_point_count != a.wall_point_count ||
+                        memcmp(c.wall_xy_m, a.wall_xy_m,
+                               2u * a.wall_point_count * sizeof(double)) != 0);
+            assert_true(scansim_ideal_vertices(&a) > 0u);
+            assert_true(scansim_seen_count(&a) > 0u);
+            assert_true(a.hit_count > n / 2u);
+            scansim_scene_free(&a);
+            scansim_scene_free(&b);
+            scansim_scene_free(&c);
+        }
+}
+
+/* The hall's scanner: 361 beams over 180 degrees, 30 m; its 32-gon columns
+ * seen all round count each corner in ideal. */
+static void test_hall_scanner(void **state)
+{
+    scansim_scene s;
+    uint32_t w, polygons = 0;
+    (void)state;
+    assert_int_equal(scansim_scene_builtin(&s, "hall", 4), 0);
+    assert_int_equal(s.laser.beam_count, 361);
+    assert_near(s.laser.max_range_m, 30.0, 1e-6);
+    assert_near((double)s.laser.angle_step_rad * 360.0, 3.14159265358979323846, 1e-6);
+    for (w = 0; w < s.wall_count; w++)
+        polygons += s.walls[w].point_count == 32u;
+    assert_true(polygons > 0u);
+    scansim_scene_free(&s);
+}
+
+/* Keeping every third pose keeps poses 0, 3, 6 and moves the people with
+ * them. */
+static void test_keep_every(void **state)
+{
+    scansim_scene s;
+    scansim_person p;
+    uint32_t i;
+    (void)state;
+    scansim_scene_init(&s, "thin", 1);
+    for (i = 0; i < 8u; i++)
+        assert_int_equal(scansim_add_pose(&s, (double)i, 0.0, 0.0), 0);
+    memset(&p, 0, sizeof p);
+    p.radius_m = 0.2;
+    p.first_scan = 3u;
+    p.last_scan = 7u;
+    assert_int_equal(scansim_add_person(&s, &p), 0);
+    assert_int_equal(scansim_keep_every(&s, 0u), -1);
+    assert_int_equal(scansim_keep_every(&s, 3u), 0);
+    assert_int_equal(s.pose_count, 3);
+    assert_near(s.poses[1].x_m, 3.0, 0.0);
+    assert_near(s.poses[2].x_m, 6.0, 0.0);
+    assert_int_equal(s.people[0].first_scan, 1);
+    assert_int_equal(s.people[0].last_scan, 2);
+    scansim_scene_free(&s);
+}
+
+/* The clearance is the nearest approach of a pose to a wall segment. */
+static void test_path_clearance(void **state)
+{
+    static const double wall[] = {0.0, 1.0, 4.0, 1.0};
+    scansim_scene s;
+    (void)state;
+    scansim_scene_init(&s, "clear", 1);
+    assert_true(isinf(scansim_path_clearance(&s)));
+    assert_int_equal(scansim_add_wall(&s, wall, 2u, 0), 0);
+    assert_int_equal(scansim_add_pose(&s, 2.0, 0.0, 0.0), 0);
+    assert_int_equal(scansim_add_pose(&s, 5.0, 1.0, 0.0), 0);
+    assert_int_equal(scansim_add_pose(&s, 1.0, 0.7, 0.0), 0);
+    assert_near(scansim_path_clearance(&s), 0.3, 1e-12);
+    scansim_scene_free(&s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -305,6 +527,11 @@ int main(void)
         cmocka_unit_test(test_gt_round_trip),
         cmocka_unit_test(test_log_round_trip),
         cmocka_unit_test(test_path_spacing),
+        cmocka_unit_test(test_kinds_layouts),
+        cmocka_unit_test(test_kinds_run),
+        cmocka_unit_test(test_hall_scanner),
+        cmocka_unit_test(test_keep_every),
+        cmocka_unit_test(test_path_clearance),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

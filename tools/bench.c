@@ -22,6 +22,7 @@
 #include "gtscore.h"
 #include "gttopo.h"
 #include "mapout.h"
+#include "pipeline.h"
 #include "polyc.h"
 #include "scanlog.h"
 
@@ -73,8 +74,10 @@ static const char usage_text[] =
     "Exit: 0 ok; 1 a scene failed (its row says why); 2 usage error, or\n"
     "DATA_DIR missing: 'bench: data directory DIR not found (pass DATA=path)'.\n";
 
+/* ST_ADD..ST_OPT in the order of pipeline.h's stages: pipeline_run fills them */
 enum stage { ST_PARSE, ST_ADD, ST_GRID, ST_CONTOUR, ST_TRACE, ST_OPT, ST_OUT, ST_TOTAL,
              ST_COUNT };
+typedef char stage_order_check[ST_OPT - ST_ADD == PIPELINE_OPTIMIZE ? 1 : -1];
 
 typedef struct options {
     unsigned runs;
@@ -210,125 +213,33 @@ static int read_log(const char *path, scanlog *log, double *ms)
     return rc;
 }
 
-/* ---- one pipeline run ---------------------------------------------------- */
+/* ---- one pipeline run (tools/pipeline.h) --------------------------------- */
 
-typedef struct pipeline {
-    polyc_config config;
-    polyc_limits limits;
-    void *block;
-    size_t block_size;
-    polyc_ctx *ctx;
-    const char *failed_at;     /* the call that failed, NULL if none */
-    polyc_status status;
-} pipeline;
-
-static int step(pipeline *p, polyc_status st, const char *what)
+/* The library's configuration with the options' overrides. */
+static void bench_config(const options *o, polyc_config *c)
 {
-    if (st == POLYC_OK)
-        return 0;
-    p->status = st;
-    p->failed_at = what;
-    return -1;
-}
-
-static int pipeline_open(pipeline *p, const options *o, const polyc_scan *scans, uint32_t n)
-{
-    memset(p, 0, sizeof *p);
-    polyc_config_default(&p->config);
+    polyc_config_default(c);
     if (o->iterations >= 0)
-        p->config.max_iterations = (uint32_t)o->iterations;
+        c->max_iterations = (uint32_t)o->iterations;
     if (o->alpha > 0.0)
-        p->config.alpha = (float)o->alpha;
+        c->alpha = (float)o->alpha;
     if (o->gamma >= 0.0)
-        p->config.gamma = (float)o->gamma;
+        c->gamma = (float)o->gamma;
     if (o->cell > 0.0)
-        p->config.cell_m = (float)o->cell;
+        c->cell_m = (float)o->cell;
     if (o->grazing >= 0.0)
-        p->config.grazing_cells = (float)o->grazing;
+        c->grazing_cells = (float)o->grazing;
     if (o->data_min >= 0.0)
-        p->config.data_min_m = (float)o->data_min;
+        c->data_min_m = (float)o->data_min;
     if (o->seed >= 0)
-        p->config.seed = (uint64_t)o->seed;
-    if (step(p, polyc_limits_for_scans(&p->config, scans, n, &p->limits),
-             "polyc_limits_for_scans"))
-        return -1;
-    p->block_size = polyc_memory_size(&p->config, &p->limits);
-    if (p->block_size == 0)
-        return step(p, POLYC_ERR_CONFIG, "polyc_memory_size");
-    p->block = malloc(p->block_size);
-    if (!p->block)
-        return step(p, POLYC_ERR_NOMEM, "malloc of the block");
-    return 0;
+        c->seed = (uint64_t)o->seed;
 }
 
-static void pipeline_close(pipeline *p)
+static int open_pipeline(pipeline *p, const options *o, const polyc_scan *scans, uint32_t n)
 {
-    free(p->block);
-    p->block = NULL;
-}
-
-/* polyc_limits_for_scans sizes vertices and points for a usual map; as
- * the polyc tool does, a map that needs more runs again with the worst case. */
-static int pipeline_grow(pipeline *p)
-{
-    if (p->status != POLYC_ERR_NOMEM || (!p->limits.max_vertices && !p->limits.max_points))
-        return -1;
-    p->limits.max_vertices = p->limits.max_points = 0;
-    free(p->block);
-    p->block_size = polyc_memory_size(&p->config, &p->limits);
-    p->block = p->block_size ? malloc(p->block_size) : NULL;
-    if (!p->block)
-        return -1;
-    p->failed_at = NULL;
-    p->status = POLYC_OK;
-    return 0;
-}
-
-/* init, add, grid, contour, trace, optimise; times[] gets each stage. */
-static int pipeline_run(pipeline *p, const polyc_scan *scans, uint32_t n, double *times)
-{
-    double t = now_ms(), t1;
-    uint32_t i;
-    if (step(p, polyc_init(p->block, p->block_size, &p->config, &p->limits, &p->ctx),
-             "polyc_init"))
-        return -1;
-    for (i = 0; i < n; i++)
-        if (step(p, polyc_add_scan(p->ctx, &scans[i]), "polyc_add_scan"))
-            return -1;
-    t1 = now_ms(); times[ST_ADD] = t1 - t; t = t1;
-    if (step(p, polyc_build_grid(p->ctx), "polyc_build_grid"))
-        return -1;
-    t1 = now_ms(); times[ST_GRID] = t1 - t; t = t1;
-    /* (a single scan's polylines come from its beam order: polyc_build
-     * skips the contour, and so does this) */
-    if (n > 1 && step(p, polyc_extract_contour(p->ctx), "polyc_extract_contour"))
-        return -1;
-    t1 = now_ms(); times[ST_CONTOUR] = t1 - t; t = t1;
-    if (step(p, polyc_trace(p->ctx), "polyc_trace"))
-        return pipeline_grow(p) ? -1 : pipeline_run(p, scans, n, times);
-    t1 = now_ms(); times[ST_TRACE] = t1 - t; t = t1;
-    if (p->config.max_iterations > 0 &&
-        step(p, polyc_optimize(p->ctx, NULL, NULL), "polyc_optimize"))
-        return pipeline_grow(p) ? -1 : pipeline_run(p, scans, n, times);
-    times[ST_OPT] = now_ms() - t;
-    return 0;
-}
-
-/* The current map as an array of polylines (malloc'ed, NULL if empty). */
-static polyc_polyline *get_lines(pipeline *p, uint32_t *count)
-{
-    uint32_t i, n = polyc_polyline_count(p->ctx);
-    polyc_polyline *lines = calloc(n ? n : 1u, sizeof *lines);
-    *count = 0;
-    if (!lines)
-        return NULL;
-    for (i = 0; i < n; i++)
-        if (step(p, polyc_get_polyline(p->ctx, i, &lines[i]), "polyc_get_polyline")) {
-            free(lines);
-            return NULL;
-        }
-    *count = n;
-    return lines;
+    polyc_config config;
+    bench_config(o, &config);
+    return pipeline_open(p, &config, scans, n);
 }
 
 static double write_output(const pipeline *p, const polyc_polyline *lines, uint32_t count)
@@ -469,13 +380,13 @@ static int bench_scene(const options *o, const scene *s, topo_row *row)
             return -1;
         }
     }
-    if (pipeline_open(&p, o, log.scans, log.count) == 0) {
+    if (open_pipeline(&p, o, log.scans, log.count) == 0) {
         for (r = 0; r < o->runs && p.failed_at == NULL; r++) {
             free(lines);
             lines = NULL;
-            if (pipeline_run(&p, log.scans, log.count, times[r]) != 0)
+            if (pipeline_run(&p, log.scans, log.count, &times[r][ST_ADD]) != 0)
                 break;
-            lines = get_lines(&p, &count);
+            lines = pipeline_lines(&p, &count);
             if (!lines)
                 break;
             times[r][ST_OUT] = write_output(&p, lines, count);
@@ -486,7 +397,7 @@ static int bench_scene(const options *o, const scene *s, topo_row *row)
     }
     if (!ok) {
         printf("%-24s %6u %8llu | error in %s: %s (%s)\n", label, log.count,
-               (unsigned long long)log.beams, p.failed_at ? p.failed_at : "get_lines",
+               (unsigned long long)log.beams, p.failed_at ? p.failed_at : "pipeline_lines",
                polyc_status_str(p.status), p.ctx ? polyc_last_error(p.ctx) : "");
         free(lines);
         pipeline_close(&p);
@@ -596,9 +507,9 @@ static int single_scans(const options *o, const scene *s)
          * and ms/scan is the median of those runs (init to optimised map).
          * `cold` is the first run with the block's malloc, pages first
          * touched and caches cold, as a one-off call would see it. */
-        int bad = pipeline_open(&p, o, scan, 1) != 0;
+        int bad = open_pipeline(&p, o, scan, 1) != 0;
         for (r = 0; r < o->runs && !bad; r++) {
-            bad = pipeline_run(&p, scan, 1, times) != 0;
+            bad = pipeline_run(&p, scan, 1, &times[ST_ADD]) != 0;
             run_total[r] = 0.0;
             for (i = ST_ADD; i <= ST_OPT; i++) {
                 run_total[r] += times[i];
@@ -607,9 +518,9 @@ static int single_scans(const options *o, const scene *s)
             if (r == 0)
                 cold = now_ms() - t0;
         }
-        if (bad || (lines = get_lines(&p, &count)) == NULL) {
+        if (bad || (lines = pipeline_lines(&p, &count)) == NULL) {
             printf("%-24s scan %u: error in %s: %s (%s)\n", label, idx,
-                   p.failed_at ? p.failed_at : "get_lines", polyc_status_str(p.status),
+                   p.failed_at ? p.failed_at : "pipeline_lines", polyc_status_str(p.status),
                    p.ctx ? polyc_last_error(p.ctx) : "");
             pipeline_close(&p);
             continue;

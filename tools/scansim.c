@@ -272,6 +272,51 @@ void scansim_transform(scansim_scene *scene, double angle_rad, double dx_m, doub
     }
 }
 
+int scansim_keep_every(scansim_scene *scene, uint32_t step)
+{
+    uint32_t i, n = 0;
+    if (!scene || step == 0)
+        return -1;
+    for (i = 0; i < scene->pose_count; i += step)
+        scene->poses[n++] = scene->poses[i];
+    scene->pose_count = n;
+    for (i = 0; i < scene->person_count; i++) {
+        scene->people[i].first_scan /= step;
+        scene->people[i].last_scan /= step;
+    }
+    return 0;
+}
+
+static double point_segment_distance(double px, double py, const double *a, const double *b)
+{
+    double ex = b[0] - a[0], ey = b[1] - a[1], len2 = ex * ex + ey * ey, t = 0.0;
+    if (len2 > 0.0) {
+        t = ((px - a[0]) * ex + (py - a[1]) * ey) / len2;
+        t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
+    }
+    return hypot(px - a[0] - t * ex, py - a[1] - t * ey);
+}
+
+double scansim_path_clearance(const scansim_scene *scene)
+{
+    double best = HUGE_VAL;
+    uint32_t p, w, j;
+    for (p = 0; p < scene->pose_count; p++)
+        for (w = 0; w < scene->wall_count; w++) {
+            const scansim_wall *wall = &scene->walls[w];
+            uint32_t nseg = wall->closed ? wall->point_count : wall->point_count - 1u;
+            for (j = 0; j < nseg; j++) {
+                const double *a = &scene->wall_xy_m[2u * (wall->first_point + j)];
+                const double *b =
+                    &scene->wall_xy_m[2u * (wall->first_point + (j + 1u) % wall->point_count)];
+                double d = point_segment_distance(scene->poses[p].x_m, scene->poses[p].y_m, a, b);
+                if (d < best)
+                    best = d;
+            }
+        }
+    return best;
+}
+
 /* ---- ray casting -------------------------------------------------------- */
 
 uint32_t scansim_segment_count(const scansim_scene *scene)

@@ -131,10 +131,30 @@ int scansim_add_person(scansim_scene *scene, const scansim_person *person);
  * origin, then shifts it: used to put walls off the grid axes. */
 void scansim_transform(scansim_scene *scene, double angle_rad, double dx_m, double dy_m);
 
-/* Built-in scenes: "square", "office", "angled", "circle". -1 if unknown. */
+/* Built-in scenes: "square", "office", "angled", "circle" (fixed layouts;
+ * the seed drives the noise only) and the randomised kinds "hall",
+ * "shelves", "flat", "curved", "thinwalls" (the seed also draws the layout,
+ * furniture, people, rotation and shift). -1 if unknown. */
 int scansim_scene_builtin(scansim_scene *scene, const char *name, uint64_t seed);
 /* NULL-terminated list of the built-in names. */
 const char *const *scansim_builtin_names(void);
+
+/* The randomised kinds (tools/scansim_kinds.c), as scansim_scene_builtin
+ * calls them: each fills a scene fresh from scansim_scene_init from its
+ * scene->seed. 0, or -1 when out of memory. */
+int scansim_kind_hall(scansim_scene *scene);
+int scansim_kind_shelves(scansim_scene *scene);
+int scansim_kind_flat(scansim_scene *scene);
+int scansim_kind_curved(scansim_scene *scene);
+int scansim_kind_thinwalls(scansim_scene *scene);
+
+/* Keeps every step-th pose (0, step, 2 step, ...) and moves the people's
+ * scan intervals with them: a smaller scene of the same layout, for tests.
+ * Call before scansim_run. -1 if step is 0. */
+int scansim_keep_every(scansim_scene *scene, uint32_t step);
+/* The smallest distance from any true pose to any wall segment (INFINITY
+ * without poses or walls): how close the robot comes to a wall. */
+double scansim_path_clearance(const scansim_scene *scene);
 
 /* ---- simulation -------------------------------------------------------- */
 

@@ -3,7 +3,8 @@
  * Takes a name and a seed; gives a scene ready for scansim_run. Each scene
  * is drawn in a convenient local frame, then rotated and shifted off the
  * grid axes, as shared/data/sim does. Sizes are kept small so that tests
- * stay fast: at most about 200 scans of 181 beams.
+ * stay fast: at most about 200 scans of 181 beams. The randomised kinds
+ * (300-1,000 scans) are in scansim_kinds.c.
  */
 #include "scansim.h"
 
@@ -148,9 +149,15 @@ static const builtin builtins[] = {
     {"office", make_office},
     {"angled", make_angled},
     {"circle", make_circle},
+    {"hall", scansim_kind_hall},
+    {"shelves", scansim_kind_shelves},
+    {"flat", scansim_kind_flat},
+    {"curved", scansim_kind_curved},
+    {"thinwalls", scansim_kind_thinwalls},
 };
 
-static const char *const builtin_names[] = {"square", "office", "angled", "circle", NULL};
+static const char *const builtin_names[] = {"square", "office",  "angled", "circle",    "hall",
+                                            "shelves", "flat", "curved", "thinwalls", NULL};
 
 const char *const *scansim_builtin_names(void)
 {

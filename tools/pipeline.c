@@ -1,0 +1,109 @@
+/* pipeline.c - the library's whole pipeline on a set of scans (see
+ * pipeline.h): takes scans and a configuration, gives the optimised map
+ * and each stage's time.
+ */
+#include "pipeline.h"
+
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
+}
+
+static int step(pipeline *p, polyc_status st, const char *what)
+{
+    if (st == POLYC_OK)
+        return 0;
+    p->status = st;
+    p->failed_at = what;
+    return -1;
+}
+
+int pipeline_open(pipeline *p, const polyc_config *config, const polyc_scan *scans, uint32_t n)
+{
+    memset(p, 0, sizeof *p);
+    p->config = *config;
+    if (step(p, polyc_limits_for_scans(&p->config, scans, n, &p->limits),
+             "polyc_limits_for_scans"))
+        return -1;
+    p->block_size = polyc_memory_size(&p->config, &p->limits);
+    if (p->block_size == 0)
+        return step(p, POLYC_ERR_CONFIG, "polyc_memory_size");
+    p->block = malloc(p->block_size);
+    if (!p->block)
+        return step(p, POLYC_ERR_NOMEM, "malloc of the block");
+    return 0;
+}
+
+void pipeline_close(pipeline *p)
+{
+    free(p->block);
+    p->block = NULL;
+}
+
+/* polyc_limits_for_scans sizes vertices and points for a usual map; as
+ * the polyc tool does, a map that needs more runs again with the worst case. */
+static int pipeline_grow(pipeline *p)
+{
+    if (p->status != POLYC_ERR_NOMEM || (!p->limits.max_vertices && !p->limits.max_points))
+        return -1;
+    p->limits.max_vertices = p->limits.max_points = 0;
+    free(p->block);
+    p->block_size = polyc_memory_size(&p->config, &p->limits);
+    p->block = p->block_size ? malloc(p->block_size) : NULL;
+    if (!p->block)
+        return -1;
+    p->failed_at = NULL;
+    p->status = POLYC_OK;
+    return 0;
+}
+
+int pipeline_run(pipeline *p, const polyc_scan *scans, uint32_t n, double *times)
+{
+    double t = now_ms(), t1;
+    uint32_t i;
+    if (step(p, polyc_init(p->block, p->block_size, &p->config, &p->limits, &p->ctx),
+             "polyc_init"))
+        return -1;
+    for (i = 0; i < n; i++)
+        if (step(p, polyc_add_scan(p->ctx, &scans[i]), "polyc_add_scan"))
+            return -1;
+    t1 = now_ms(); times[PIPELINE_ADD] = t1 - t; t = t1;
+    if (step(p, polyc_build_grid(p->ctx), "polyc_build_grid"))
+        return -1;
+    t1 = now_ms(); times[PIPELINE_GRID] = t1 - t; t = t1;
+    /* (a single scan's polylines come from its beam order: polyc_build
+     * skips the contour, and so does this) */
+    if (n > 1 && step(p, polyc_extract_contour(p->ctx), "polyc_extract_contour"))
+        return -1;
+    t1 = now_ms(); times[PIPELINE_CONTOUR] = t1 - t; t = t1;
+    if (step(p, polyc_trace(p->ctx), "polyc_trace"))
+        return pipeline_grow(p) ? -1 : pipeline_run(p, scans, n, times);
+    t1 = now_ms(); times[PIPELINE_TRACE] = t1 - t; t = t1;
+    if (p->config.max_iterations > 0 &&
+        step(p, polyc_optimize(p->ctx, NULL, NULL), "polyc_optimize"))
+        return pipeline_grow(p) ? -1 : pipeline_run(p, scans, n, times);
+    times[PIPELINE_OPTIMIZE] = now_ms() - t;
+    return 0;
+}
+
+polyc_polyline *pipeline_lines(pipeline *p, uint32_t *count)
+{
+    uint32_t i, n = polyc_polyline_count(p->ctx);
+    polyc_polyline *lines = calloc(n ? n : 1u, sizeof *lines);
+    *count = 0;
+    if (!lines)
+        return NULL;
+    for (i = 0; i < n; i++)
+        if (step(p, polyc_get_polyline(p->ctx, i, &lines[i]), "polyc_get_polyline")) {
+            free(lines);
+            return NULL;
+        }
+    *count = n;
+    return lines;
+}

@@ -1,0 +1,46 @@
+/* pipeline.h - the library's whole pipeline on a set of scans, as the
+ * benchmark and the sweep run it: polyc_limits_for_scans, one malloc'ed
+ * block of polyc_memory_size, init, add, grid, contour, trace, optimise.
+ *
+ * Memory: pipeline_open mallocs the block, pipeline_close frees it; the
+ * scans must outlive the runs. int returns: 0, or -1 with failed_at (the
+ * call that failed) and status set.
+ *
+ * SPDX-License-Identifier: MIT
+ */
+#ifndef POLYC_PIPELINE_H
+#define POLYC_PIPELINE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "polyc.h"
+
+/* Indices of the stage times pipeline_run fills (milliseconds). */
+enum pipeline_stage {
+    PIPELINE_ADD, PIPELINE_GRID, PIPELINE_CONTOUR, PIPELINE_TRACE, PIPELINE_OPTIMIZE,
+    PIPELINE_STAGES
+};
+
+typedef struct pipeline {
+    polyc_config config;
+    polyc_limits limits;
+    void *block;
+    size_t block_size;
+    polyc_ctx *ctx;
+    const char *failed_at;     /* the call that failed, NULL if none */
+    polyc_status status;
+} pipeline;
+
+/* Limits for these scans and a block for them, under `config` (copied). */
+int pipeline_open(pipeline *p, const polyc_config *config, const polyc_scan *scans, uint32_t n);
+void pipeline_close(pipeline *p);
+/* One run from polyc_init to the optimised map on the block (a single scan
+ * skips the contour, as polyc_build does); times[PIPELINE_STAGES] gets each
+ * stage. A map that needs more vertices or points than the usual limits
+ * runs again with the worst-case limits, as the polyc tool does. */
+int pipeline_run(pipeline *p, const polyc_scan *scans, uint32_t n, double *times);
+/* The current map as an array of polylines (malloc'ed; NULL on failure). */
+polyc_polyline *pipeline_lines(pipeline *p, uint32_t *count);
+
+#endif /* POLYC_PIPELINE_H */

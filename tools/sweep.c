@@ -1,0 +1,507 @@
+/* sweep.c - the library's maps on simulated scenes of every kind and many
+ * seeds, scored against each scene's own ground truth.
+ *
+ *   sweep [--seeds A-B] [--kinds a,b,...] [--save DIR] [--svg DIR]
+ *
+ * Takes nothing from disk: every scene is simulated (tools/scansim.h), its
+ * ground truth written to memory and read back by tools/gtscore.h, its scans
+ * mapped by the whole pipeline (tools/pipeline.h: polyc_config_default,
+ * polyc_limits_for_scans, one malloc'ed block). Gives one row per scene,
+ * then per kind and over all the median and the worst of every figure, and
+ * whether each scene meets the targets. Exit codes: 0 every scene ran (met
+ * its targets or not), 1 some scene failed to run, 2 usage error.
+ */
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "gtscore.h"
+#include "pipeline.h"
+#include "polyc.h"
+#include "scansim.h"
+
+#define EXIT_FAILED 1
+#define EXIT_USAGE 2
+#define MAX_KINDS 16
+/* the targets: precision within 25 % or 1.5 mm of the ideal fit, 98 % of
+ * the seen walls mapped, at most 1.5 times the ideal vertices */
+#define TARGET_FIT_FACTOR 1.25
+#define TARGET_FIT_MARGIN_M 0.0015
+#define TARGET_COMPLETENESS 0.98
+#define TARGET_RATIO 1.5
+
+static const char usage_text[] =
+    "usage: sweep [options]\n"
+    "Simulates every scene kind for a range of seeds, maps each with libpolyc's\n"
+    "whole pipeline and scores the map against the scene's ground truth;\n"
+    "`make sweep` builds it with -O3 and runs it (SWEEP_ARGS='...').\n"
+    "options:\n"
+    "  --seeds A-B      seeds A to B (or one seed A); default 1-6\n"
+    "  --kinds a,b,...  scene kinds; default hall,shelves,flat,curved,thinwalls,\n"
+    "                   office,angled,square (any of scansim's built-in names)\n"
+    "  --save DIR       write DIR/KIND-sSEED.log and .gt.txt (for build/polyc)\n"
+    "  --svg DIR        write DIR/KIND-sSEED.svg: true walls (grey), the robot's\n"
+    "                   path (blue), people (pink), the map (black, dots on vertices;\n"
+    "                   red where a segment strays over 5 cm from every true wall)\n"
+    "  -h, --help       this text\n"
+    "Columns: scans, beams (all scans), ms (the pipeline from polyc_init to the\n"
+    "optimised map), verts (map vertices), ideal, ratio (verts / ideal), rms\n"
+    "(precision RMS, mm), fit (the ideal map's fit to the data, mm), floor (the\n"
+    "line-fit floor, mm), compl (completeness), then the targets missed: P\n"
+    "precision > max(1.25 x fit, fit + 1.5 mm), C completeness < 0.98, V\n"
+    "vertices > 1.5 x ideal ('ok': none). Summary rows give per kind and over\n"
+    "all the median and the worst (highest; completeness: lowest) of each figure.\n"
+    "Exit: 0 every scene ran; 1 a scene failed (its row says why); 2 usage error.\n";
+
+static const char *const default_kinds[] = {"hall",   "shelves", "flat",   "curved",
+                                            "thinwalls", "office", "angled", "square"};
+
+typedef struct options {
+    uint64_t seed_first, seed_last;
+    const char *kinds[MAX_KINDS];
+    unsigned kind_count;
+    const char *save_dir;      /* NULL: none */
+    const char *svg_dir;       /* NULL: none */
+} options;
+
+/* ---- the figures ----------------------------------------------------------- */
+
+/* One entry per column: to add a figure, add it here, to `figures` and to
+ * score_scene. */
+enum figure { FIG_SCANS, FIG_BEAMS, FIG_MS, FIG_VERTS, FIG_IDEAL, FIG_RATIO, FIG_RMS,
+              FIG_FIT, FIG_FLOOR, FIG_COMPL, FIG_COUNT };
+
+typedef struct figure_info {
+    const char *name;
+    int width, decimals;
+    double scale;              /* printed value = figure * scale */
+    int low_is_worse;          /* the worst is the lowest (else the highest) */
+} figure_info;
+
+static const figure_info figures[FIG_COUNT] = {
+    {"scans", 6, 0, 1.0, 0},   {"beams", 8, 0, 1.0, 0},   {"ms", 7, 1, 1.0, 0},
+    {"verts", 6, 0, 1.0, 0},   {"ideal", 6, 0, 1.0, 0},   {"ratio", 6, 2, 1.0, 0},
+    {"rms", 6, 1, 1e3, 0},     {"fit", 6, 1, 1e3, 0},     {"floor", 6, 1, 1e3, 0},
+    {"compl", 7, 4, 1.0, 1},
+};
+
+/* Bits of the targets a scene misses. */
+enum { MISS_PRECISION = 1, MISS_COMPLETENESS = 2, MISS_VERTICES = 4 };
+
+typedef struct row {
+    char kind[32];
+    uint64_t seed;
+    double fig[FIG_COUNT];     /* NAN: not available */
+    unsigned missed;           /* MISS_* bits */
+    int ok;                    /* the scene ran and was scored */
+} row;
+
+/* ---- small helpers --------------------------------------------------------- */
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
+}
+
+static int compare_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* ---- one scene -------------------------------------------------------------- */
+
+/* The scene's ground truth as gtscore reads it: written by scansim to
+ * memory and read back, exactly what KIND-sSEED.gt.txt would hold. */
+static int truth_of(const scansim_scene *sc, gtscore_truth *truth, char *err, size_t err_size)
+{
+    char *text = NULL;
+    size_t size = 0;
+    FILE *f = open_memstream(&text, &size);
+    int rc = -1;
+    memset(truth, 0, sizeof *truth);
+    if (!f) {
+        snprintf(err, err_size, "open_memstream: %s", strerror(errno));
+        return -1;
+    }
+    if (scansim_write_gt(sc, f) != 0 || fclose(f) != 0) {
+        snprintf(err, err_size, "writing the ground truth failed");
+        free(text);
+        return -1;
+    }
+    f = fmemopen(text, size, "r");
+    if (f) {
+        rc = gtscore_truth_read(truth, f, sc->name, err, err_size);
+        fclose(f);
+    } else
+        snprintf(err, err_size, "fmemopen: %s", strerror(errno));
+    free(text);
+    return rc;
+}
+
+/* Every figure of one map and the targets it misses: the one place that
+ * scores a scene. */
+static int score_scene(const scansim_scene *sc, const gtscore_truth *truth,
+                       const polyc_polyline *lines, uint32_t count, double pipeline_ms, row *r)
+{
+    gtscore_map_score score;
+    double fit_m, floor_m;
+    uint32_t i;
+    for (i = 0; i < FIG_COUNT; i++)
+        r->fig[i] = (double)NAN;
+    if (gtscore_score_map(truth, lines, count, &score) != 0 ||
+        gtscore_ideal_fit(truth, sc->scans, sc->scan_count, &fit_m) != 0 ||
+        gtscore_line_floor(truth, sc->scans, sc->scan_count, &floor_m) != 0)
+        return -1;
+    r->fig[FIG_SCANS] = sc->scan_count;
+    r->fig[FIG_BEAMS] = (double)sc->scan_count * (double)sc->laser.beam_count;
+    r->fig[FIG_MS] = pipeline_ms;
+    r->fig[FIG_VERTS] = score.vertices;
+    r->fig[FIG_IDEAL] = score.ideal;
+    r->fig[FIG_RATIO] = score.ideal ? score.vertex_ratio : (double)NAN;
+    r->fig[FIG_RMS] = score.precision_rms_m;
+    r->fig[FIG_FIT] = fit_m >= 0.0 ? fit_m : (double)NAN;
+    r->fig[FIG_FLOOR] = floor_m >= 0.0 ? floor_m : (double)NAN;
+    r->fig[FIG_COMPL] = score.completeness;
+    r->missed = 0;
+    if (fit_m >= 0.0 &&
+        score.precision_rms_m > fmax(TARGET_FIT_FACTOR * fit_m, fit_m + TARGET_FIT_MARGIN_M))
+        r->missed |= MISS_PRECISION;
+    if (score.completeness < TARGET_COMPLETENESS)
+        r->missed |= MISS_COMPLETENESS;
+    if (score.ideal && (double)score.vertices > TARGET_RATIO * (double)score.ideal)
+        r->missed |= MISS_VERTICES;
+    return 0;
+}
+
+/* Does some point of the map segment ab lie over GTSCORE_COMPLETE_M from
+ * every true wall? (sampled every GTSCORE_SAMPLE_M, as precision is) */
+static int segment_off(const gtscore_truth *truth, const float *a, const float *b)
+{
+    double dx = (double)b[0] - (double)a[0], dy = (double)b[1] - (double)a[1];
+    double n = ceil(hypot(dx, dy) / GTSCORE_SAMPLE_M), k;
+    for (k = 0.0; k <= n; k += 1.0) {
+        double t = n > 0.0 ? k / n : 0.0;
+        if (gtscore_index_distance(&truth->index, (double)a[0] + t * dx, (double)a[1] + t * dy,
+                                   GTSCORE_COMPLETE_M) > GTSCORE_COMPLETE_M)
+            return 1;
+    }
+    return 0;
+}
+
+/* The scene's true walls, the robot's path, its people and the map (a
+ * segment in red where it strays over 5 cm from every true wall). */
+static int write_svg(const char *path, const scansim_scene *sc, const gtscore_truth *truth,
+                     const polyc_polyline *lines, uint32_t count)
+{
+    double x0 = HUGE_VAL, y0 = HUGE_VAL, x1 = -HUGE_VAL, y1 = -HUGE_VAL;
+    uint32_t i, j, w;
+    FILE *f = fopen(path, "w");
+    if (!f)
+        return -1;
+    for (i = 0; i < sc->wall_point_count; i++) {
+        x0 = fmin(x0, sc->wall_xy_m[2u * i]);
+        x1 = fmax(x1, sc->wall_xy_m[2u * i]);
+        y0 = fmin(y0, sc->wall_xy_m[2u * i + 1u]);
+        y1 = fmax(y1, sc->wall_xy_m[2u * i + 1u]);
+    }
+    x0 -= 0.5; y0 -= 0.5; x1 += 0.5; y1 += 0.5;
+    /* y up: the picture's y is -y */
+    fprintf(f, "<svg xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"%.3f %.3f %.3f %.3f\" "
+               "width=\"%.0f\" height=\"%.0f\">\n<rect x=\"%.3f\" y=\"%.3f\" width=\"%.3f\" "
+               "height=\"%.3f\" fill=\"white\"/>\n",
+            x0, -y1, x1 - x0, y1 - y0, 40.0 * (x1 - x0), 40.0 * (y1 - y0), x0, -y1, x1 - x0,
+            y1 - y0);
+    for (w = 0; w < sc->wall_count; w++) {
+        const scansim_wall *wall = &sc->walls[w];
+        fprintf(f, "<%s fill=\"none\" stroke=\"#bbb\" stroke-width=\"0.06\" points=\"",
+                wall->closed ? "polygon" : "polyline");
+        for (j = 0; j < wall->point_count; j++)
+            fprintf(f, "%.3f,%.3f ", sc->wall_xy_m[2u * (wall->first_point + j)],
+                    -sc->wall_xy_m[2u * (wall->first_point + j) + 1u]);
+        fprintf(f, "\"/>\n");
+    }
+    fprintf(f, "<polyline fill=\"none\" stroke=\"#48f\" stroke-width=\"0.02\" points=\"");
+    for (i = 0; i < sc->pose_count; i++)
+        fprintf(f, "%.3f,%.3f ", sc->poses[i].x_m, -sc->poses[i].y_m);
+    fprintf(f, "\"/>\n");
+    for (i = 0; i < sc->person_count; i++) {
+        const scansim_person *p = &sc->people[i];
+        fprintf(f, "<line x1=\"%.3f\" y1=\"%.3f\" x2=\"%.3f\" y2=\"%.3f\" stroke=\"#f44\" "
+                   "stroke-width=\"%.3f\" stroke-linecap=\"round\" opacity=\"0.5\"/>\n",
+                p->from_x_m, -p->from_y_m, p->to_x_m, -p->to_y_m, 2.0 * p->radius_m);
+    }
+    for (i = 0; i < count; i++) {
+        const polyc_polyline *l = &lines[i];
+        uint32_t nseg = l->closed ? l->point_count : l->point_count - 1u;
+        for (j = 0; j < nseg && l->point_count > 1u; j++) {
+            const float *a = &l->xy_m[2u * j], *b = &l->xy_m[2u * ((j + 1u) % l->point_count)];
+            fprintf(f, "<line x1=\"%.4f\" y1=\"%.4f\" x2=\"%.4f\" y2=\"%.4f\" stroke=\"%s\" "
+                       "stroke-width=\"0.015\"/>\n",
+                    (double)a[0], -(double)a[1], (double)b[0], -(double)b[1],
+                    segment_off(truth, a, b) ? "#e00" : "black");
+        }
+        for (j = 0; j < l->point_count; j++)
+            fprintf(f, "<circle cx=\"%.4f\" cy=\"%.4f\" r=\"0.03\" fill=\"black\"/>\n",
+                    (double)l->xy_m[2u * j], -(double)l->xy_m[2u * j + 1u]);
+    }
+    fprintf(f, "</svg>\n");
+    {
+        int bad = ferror(f);
+        return fclose(f) == 0 && !bad ? 0 : -1;
+    }
+}
+
+static void print_figures(const double *fig)
+{
+    uint32_t i;
+    for (i = 0; i < FIG_COUNT; i++) {
+        if (isnan(fig[i]))
+            printf(" %*s", figures[i].width, "-");
+        else
+            printf(" %*.*f", figures[i].width, figures[i].decimals, fig[i] * figures[i].scale);
+    }
+}
+
+static void print_missed(unsigned missed)
+{
+    if (!missed) {
+        printf("  ok\n");
+        return;
+    }
+    printf("  %s%s%s\n", missed & MISS_PRECISION ? "P" : "", missed & MISS_COMPLETENESS ? "C" : "",
+           missed & MISS_VERTICES ? "V" : "");
+}
+
+/* Simulates, maps and scores one scene; prints its row. */
+static int sweep_scene(const options *o, const char *kind, uint64_t seed, row *r)
+{
+    scansim_scene sc;
+    gtscore_truth truth;
+    pipeline p;
+    polyc_config config;
+    polyc_polyline *lines = NULL;
+    double times[PIPELINE_STAGES], ms = 0.0;
+    uint32_t count = 0, i;
+    char err[512] = "", label[48];
+    int rc = -1;
+
+    memset(r, 0, sizeof *r);
+    snprintf(r->kind, sizeof r->kind, "%s", kind);
+    r->seed = seed;
+    snprintf(label, sizeof label, "%-10s %4llu", kind, (unsigned long long)seed);
+    memset(&truth, 0, sizeof truth);
+    memset(&p, 0, sizeof p);
+    if (scansim_scene_builtin(&sc, kind, seed) != 0) {
+        printf("%s error: out of memory\n", label);
+        return -1;
+    }
+    if (scansim_run(&sc) != 0) {
+        printf("%s error: simulation failed\n", label);
+        goto done;
+    }
+    if (truth_of(&sc, &truth, err, sizeof err) != 0) {
+        printf("%s error: ground truth: %s\n", label, err);
+        goto done;
+    }
+    polyc_config_default(&config);
+    if (pipeline_open(&p, &config, sc.scans, sc.scan_count) != 0 ||
+        pipeline_run(&p, sc.scans, sc.scan_count, times) != 0 ||
+        (lines = pipeline_lines(&p, &count)) == NULL) {
+        printf("%s error in %s: %s (%s)\n", label, p.failed_at ? p.failed_at : "pipeline_lines",
+               polyc_status_str(p.status), p.ctx ? polyc_last_error(p.ctx) : "");
+        goto done;
+    }
+    for (i = 0; i < PIPELINE_STAGES; i++)
+        ms += times[i];
+    if (score_scene(&sc, &truth, lines, count, ms, r) != 0) {
+        printf("%s error: scoring ran out of memory\n", label);
+        goto done;
+    }
+    r->ok = 1;
+    printf("%s", label);
+    print_figures(r->fig);
+    print_missed(r->missed);
+    fflush(stdout);
+    if (o->save_dir || o->svg_dir) {
+        char log_path[1024], gt_path[1024], svg_path[1024];
+        snprintf(log_path, sizeof log_path, "%s/%s-s%llu.log", o->save_dir ? o->save_dir : "",
+                 kind, (unsigned long long)seed);
+        snprintf(gt_path, sizeof gt_path, "%s/%s-s%llu.gt.txt", o->save_dir ? o->save_dir : "",
+                 kind, (unsigned long long)seed);
+        snprintf(svg_path, sizeof svg_path, "%s/%s-s%llu.svg", o->svg_dir ? o->svg_dir : "",
+                 kind, (unsigned long long)seed);
+        if (o->save_dir && scansim_save(&sc, log_path, gt_path) != 0)
+            fprintf(stderr, "sweep: cannot write %s: %s\n", log_path, strerror(errno));
+        if (o->svg_dir && write_svg(svg_path, &sc, &truth, lines, count) != 0)
+            fprintf(stderr, "sweep: cannot write %s: %s\n", svg_path, strerror(errno));
+    }
+    rc = 0;
+done:
+    free(lines);
+    pipeline_close(&p);
+    gtscore_truth_free(&truth);
+    scansim_scene_free(&sc);
+    return rc;
+}
+
+/* ---- the summary -------------------------------------------------------------- */
+
+/* Median and worst of each figure over the rows of `kind` (NULL: all). */
+static void summarise(const row *rows, size_t n, const char *kind, const char *label)
+{
+    double median[FIG_COUNT], worst[FIG_COUNT], *v = malloc((n ? n : 1u) * sizeof *v);
+    unsigned passed = 0, scenes = 0;
+    uint32_t f;
+    size_t i, m;
+    if (!v)
+        return;
+    for (f = 0; f < FIG_COUNT; f++) {
+        for (m = 0, i = 0; i < n; i++)
+            if (rows[i].ok && (!kind || strcmp(rows[i].kind, kind) == 0) &&
+                !isnan(rows[i].fig[f]))
+                v[m++] = rows[i].fig[f];
+        median[f] = worst[f] = (double)NAN;
+        if (m) {
+            qsort(v, m, sizeof *v, compare_double);
+            median[f] = m % 2u ? v[m / 2u] : 0.5 * (v[m / 2u - 1u] + v[m / 2u]);
+            worst[f] = figures[f].low_is_worse ? v[0] : v[m - 1u];
+        }
+    }
+    for (i = 0; i < n; i++)
+        if (rows[i].ok && (!kind || strcmp(rows[i].kind, kind) == 0)) {
+            scenes++;
+            passed += rows[i].missed == 0;
+        }
+    free(v);
+    printf("%-10s %4s", label, "med");
+    print_figures(median);
+    printf("  %u/%u ok\n", passed, scenes);
+    printf("%-10s %4s", "", "worst");
+    print_figures(worst);
+    printf("\n");
+}
+
+/* ---- main ------------------------------------------------------------------- */
+
+static int parse_seeds(const char *text, options *o)
+{
+    char *end;
+    unsigned long long a, b;
+    errno = 0;
+    a = strtoull(text, &end, 10);
+    if (errno || end == text || text[0] == '-')
+        return -1;
+    b = a;
+    if (*end == '-') {
+        const char *second = end + 1;
+        b = strtoull(second, &end, 10);
+        if (errno || end == second || second[0] == '-')
+            return -1;
+    }
+    if (*end || b < a || b - a > 100000u)
+        return -1;
+    o->seed_first = a;
+    o->seed_last = b;
+    return 0;
+}
+
+/* A comma-separated list of scansim's built-in names. */
+static int parse_kinds(char *text, options *o)
+{
+    char *tok;
+    o->kind_count = 0;
+    for (tok = strtok(text, ","); tok; tok = strtok(NULL, ",")) {
+        const char *const *name = scansim_builtin_names();
+        while (*name && strcmp(*name, tok) != 0)
+            name++;
+        if (!*name) {
+            fprintf(stderr, "sweep: no scene kind '%s'\n", tok);
+            return -1;
+        }
+        if (o->kind_count == MAX_KINDS)
+            return -1;
+        o->kinds[o->kind_count++] = tok;
+    }
+    return o->kind_count ? 0 : -1;
+}
+
+static int parse_options(int argc, char **argv, options *o)
+{
+    int i;
+    memset(o, 0, sizeof *o);
+    o->seed_first = 1;
+    o->seed_last = 6;
+    for (i = 0; i < (int)(sizeof default_kinds / sizeof default_kinds[0]); i++)
+        o->kinds[o->kind_count++] = default_kinds[i];
+    for (i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
+            fputs(usage_text, stdout);
+            exit(0);
+        } else if (strcmp(a, "--seeds") == 0 && i + 1 < argc) {
+            if (parse_seeds(argv[++i], o))
+                return -1;
+        } else if (strcmp(a, "--kinds") == 0 && i + 1 < argc) {
+            if (parse_kinds(argv[++i], o))
+                return -1;
+        } else if (strcmp(a, "--save") == 0 && i + 1 < argc) {
+            o->save_dir = argv[++i];
+        } else if (strcmp(a, "--svg") == 0 && i + 1 < argc) {
+            o->svg_dir = argv[++i];
+        } else
+            return -1;
+    }
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    options o;
+    row *rows;
+    size_t n, k = 0;
+    unsigned kind;
+    uint64_t seed;
+    double t0 = now_ms(), pipeline_ms = 0.0;
+    int failed = 0;
+    uint32_t f;
+
+    if (parse_options(argc, argv, &o) != 0) {
+        fputs(usage_text, stderr);
+        return EXIT_USAGE;
+    }
+    n = (size_t)o.kind_count * (size_t)(o.seed_last - o.seed_first + 1u);
+    rows = calloc(n, sizeof *rows);
+    if (!rows) {
+        fprintf(stderr, "sweep: out of memory\n");
+        return EXIT_FAILED;
+    }
+    printf("libpolyc %u.%u.%u sweep: seeds %llu-%llu, targets: rms <= max(%.2f x fit, fit + "
+           "%.1f mm), compl >= %.2f, verts <= %.1f x ideal\n",
+           polyc_version() / 10000u, polyc_version() / 100u % 100u, polyc_version() % 100u,
+           (unsigned long long)o.seed_first, (unsigned long long)o.seed_last, TARGET_FIT_FACTOR,
+           1e3 * TARGET_FIT_MARGIN_M, TARGET_COMPLETENESS, TARGET_RATIO);
+    printf("%-10s %4s", "kind", "seed");
+    for (f = 0; f < FIG_COUNT; f++)
+        printf(" %*s", figures[f].width, figures[f].name);
+    printf("  missed\n");
+    for (kind = 0; kind < o.kind_count; kind++)
+        for (seed = o.seed_first; seed <= o.seed_last; seed++)
+            if (sweep_scene(&o, o.kinds[kind], seed, &rows[k++]) != 0)
+                failed = 1;
+    printf("\n");
+    for (kind = 0; kind < o.kind_count; kind++)
+        summarise(rows, n, o.kinds[kind], o.kinds[kind]);
+    summarise(rows, n, NULL, "all");
+    for (k = 0; k < n; k++)
+        pipeline_ms += rows[k].ok ? rows[k].fig[FIG_MS] : 0.0;
+    printf("\n%zu scenes in %.1f s, %.1f s of it in the pipeline (the ms column)\n", n,
+           (now_ms() - t0) / 1e3, pipeline_ms / 1e3);
+    free(rows);
+    return failed ? EXIT_FAILED : 0;
+}
