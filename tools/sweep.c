@@ -19,6 +19,7 @@
 #include <time.h>
 
 #include "gtscore.h"
+#include "gttopo.h"
 #include "pipeline.h"
 #include "polyc.h"
 #include "scansim.h"
@@ -32,6 +33,10 @@
 #define TARGET_FIT_MARGIN_M 0.0015
 #define TARGET_COMPLETENESS 0.98
 #define TARGET_RATIO 1.5
+/* and the topology's: double cover at most 25 cm, no crossing, no run of
+ * map over 20 cm without a scan endpoint within 5 cm */
+#define TARGET_DCOV_M 0.25
+#define CORE_M 0.5                 /* core precision: map samples this near a true wall */
 
 static const char usage_text[] =
     "usage: sweep [options]\n"
@@ -72,7 +77,8 @@ typedef struct options {
 /* One entry per column: to add a figure, add it here, to `figures` and to
  * score_scene. */
 enum figure { FIG_SCANS, FIG_BEAMS, FIG_MS, FIG_VERTS, FIG_IDEAL, FIG_RATIO, FIG_RMS,
-              FIG_FIT, FIG_FLOOR, FIG_COMPL, FIG_COUNT };
+              FIG_CORE, FIG_FIT, FIG_FLOOR, FIG_COMPL, FIG_DCOV, FIG_CROSS, FIG_UNS20,
+              FIG_COUNT };
 
 typedef struct figure_info {
     const char *name;
@@ -84,12 +90,13 @@ typedef struct figure_info {
 static const figure_info figures[FIG_COUNT] = {
     {"scans", 6, 0, 1.0, 0},   {"beams", 8, 0, 1.0, 0},   {"ms", 7, 1, 1.0, 0},
     {"verts", 6, 0, 1.0, 0},   {"ideal", 6, 0, 1.0, 0},   {"ratio", 6, 2, 1.0, 0},
-    {"rms", 6, 1, 1e3, 0},     {"fit", 6, 1, 1e3, 0},     {"floor", 6, 1, 1e3, 0},
-    {"compl", 7, 4, 1.0, 1},
+    {"rms", 6, 1, 1e3, 0},     {"core", 6, 1, 1e3, 0},    {"fit", 6, 1, 1e3, 0},
+    {"floor", 6, 1, 1e3, 0},   {"compl", 7, 4, 1.0, 1},   {"dcov", 6, 2, 1.0, 0},
+    {"cross", 5, 0, 1.0, 0},   {"uns20", 5, 0, 1.0, 0},
 };
 
 /* Bits of the targets a scene misses. */
-enum { MISS_PRECISION = 1, MISS_COMPLETENESS = 2, MISS_VERTICES = 4 };
+enum { MISS_PRECISION = 1, MISS_COMPLETENESS = 2, MISS_VERTICES = 4, MISS_TOPOLOGY = 8 };
 
 typedef struct row {
     char kind[32];
@@ -150,14 +157,26 @@ static int score_scene(const scansim_scene *sc, const gtscore_truth *truth,
                        const polyc_polyline *lines, uint32_t count, double pipeline_ms, row *r)
 {
     gtscore_map_score score;
-    double fit_m, floor_m;
+    gttopo_score topo;
+    double fit_m, floor_m, core_m, *hits = NULL;
+    uint64_t hit_count = 0;
     uint32_t i;
     for (i = 0; i < FIG_COUNT; i++)
         r->fig[i] = (double)NAN;
     if (gtscore_score_map(truth, lines, count, &score) != 0 ||
+        gtscore_core_precision(truth, lines, count, CORE_M, &core_m) != 0 ||
         gtscore_ideal_fit(truth, sc->scans, sc->scan_count, &fit_m) != 0 ||
-        gtscore_line_floor(truth, sc->scans, sc->scan_count, &floor_m) != 0)
+        gtscore_line_floor(truth, sc->scans, sc->scan_count, &floor_m) != 0 ||
+        gttopo_scan_points(sc->scans, sc->scan_count, &hits, &hit_count) != 0)
         return -1;
+    int topo_rc = gttopo_score_map(lines, count, hits, hit_count, &topo);
+    free(hits);
+    if (topo_rc != 0)
+        return -1;
+    r->fig[FIG_CORE] = core_m;
+    r->fig[FIG_DCOV] = topo.double_cover_m;
+    r->fig[FIG_CROSS] = topo.crossings;
+    r->fig[FIG_UNS20] = topo.unsupported_20;
     r->fig[FIG_SCANS] = sc->scan_count;
     r->fig[FIG_BEAMS] = (double)sc->scan_count * (double)sc->laser.beam_count;
     r->fig[FIG_MS] = pipeline_ms;
@@ -169,9 +188,10 @@ static int score_scene(const scansim_scene *sc, const gtscore_truth *truth,
     r->fig[FIG_FLOOR] = floor_m >= 0.0 ? floor_m : (double)NAN;
     r->fig[FIG_COMPL] = score.completeness;
     r->missed = 0;
-    if (fit_m >= 0.0 &&
-        score.precision_rms_m > fmax(TARGET_FIT_FACTOR * fit_m, fit_m + TARGET_FIT_MARGIN_M))
+    if (fit_m >= 0.0 && core_m > fmax(TARGET_FIT_FACTOR * fit_m, fit_m + TARGET_FIT_MARGIN_M))
         r->missed |= MISS_PRECISION;
+    if (topo.double_cover_m > TARGET_DCOV_M || topo.crossings > 0 || topo.unsupported_20 > 0)
+        r->missed |= MISS_TOPOLOGY;
     if (score.completeness < TARGET_COMPLETENESS)
         r->missed |= MISS_COMPLETENESS;
     if (score.ideal && (double)score.vertices > TARGET_RATIO * (double)score.ideal)
@@ -274,8 +294,9 @@ static void print_missed(unsigned missed)
         printf("  ok\n");
         return;
     }
-    printf("  %s%s%s\n", missed & MISS_PRECISION ? "P" : "", missed & MISS_COMPLETENESS ? "C" : "",
-           missed & MISS_VERTICES ? "V" : "");
+    printf("  %s%s%s%s\n", missed & MISS_PRECISION ? "P" : "",
+           missed & MISS_COMPLETENESS ? "C" : "", missed & MISS_VERTICES ? "V" : "",
+           missed & MISS_TOPOLOGY ? "T" : "");
 }
 
 /* Simulates, maps and scores one scene; prints its row. */
@@ -481,11 +502,12 @@ int main(int argc, char **argv)
         fprintf(stderr, "sweep: out of memory\n");
         return EXIT_FAILED;
     }
-    printf("libpolyc %u.%u.%u sweep: seeds %llu-%llu, targets: rms <= max(%.2f x fit, fit + "
-           "%.1f mm), compl >= %.2f, verts <= %.1f x ideal\n",
+    printf("libpolyc %u.%u.%u sweep: seeds %llu-%llu, targets: P core <= max(%.2f x fit, fit + "
+           "%.1f mm), C compl >= %.2f, V verts <= %.1f x ideal, T dcov <= %.2f m, 0 cross, "
+           "0 uns20\n",
            polyc_version() / 10000u, polyc_version() / 100u % 100u, polyc_version() % 100u,
            (unsigned long long)o.seed_first, (unsigned long long)o.seed_last, TARGET_FIT_FACTOR,
-           1e3 * TARGET_FIT_MARGIN_M, TARGET_COMPLETENESS, TARGET_RATIO);
+           1e3 * TARGET_FIT_MARGIN_M, TARGET_COMPLETENESS, TARGET_RATIO, TARGET_DCOV_M);
     printf("%-10s %4s", "kind", "seed");
     for (f = 0; f < FIG_COUNT; f++)
         printf(" %*s", figures[f].width, figures[f].name);
