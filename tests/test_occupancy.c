@@ -738,6 +738,42 @@ static void test_exhaustion(void **state)
     scene_free(&s);
 }
 
+/* The room in a corner of a 80 m x 80 m grid that is unknown elsewhere:
+ * the limits store the tiles that hold occupied cells (and the directory of
+ * all tiles), not the whole grid, and the map is the same room. */
+static void test_sparse_grid(void **state)
+{
+    (void)state;
+    scene s;
+    scene_make(&s, 0.3, RES);
+    const uint32_t side = 1600, at_x = 700, at_y = 900;
+    int8_t *big = malloc((size_t)side * side);
+    assert_non_null(big);
+    memset(big, -1, (size_t)side * side);
+    for (uint32_t j = 0; j < s.grid.height; j++)
+        memcpy(big + (size_t)(j + at_y) * side + at_x, s.cells + (size_t)j * s.grid.width, s.grid.width);
+    polyc_occupancy_grid g = s.grid;
+    double c = cos(0.3), sn = sin(0.3), dx = at_x * RES, dy = at_y * RES;
+    g.origin_x_m -= c * dx - sn * dy;
+    g.origin_y_m -= sn * dx + c * dy;
+    g.width = g.height = side;
+    g.cells = big;
+    opened o;
+    open_for(&o, &g);
+    uint32_t all_tiles = (side / 32) * (side / 32);
+    assert_true(o.lim.max_grid_cells / 1024 < all_tiles / 2);
+    assert_int_equal(polyc_add_grid(o.ctx, &g), POLYC_OK);
+    assert_int_equal(polyc_build(o.ctx, NULL, NULL), POLYC_OK);
+    check_room_map(o.ctx, RES, "sparse grid");
+    polyc_stats st;
+    assert_int_equal(polyc_get_stats(o.ctx, &st), POLYC_OK);
+    assert_int_equal(st.grid_width, side);
+    assert_true(st.grid_tiles < 64);
+    close_opened(&o);
+    free(big);
+    scene_free(&s);
+}
+
 /* A grid with nothing occupied: no polylines, no error. */
 static void test_empty_grid(void **state)
 {
@@ -775,6 +811,7 @@ int main(void)
         cmocka_unit_test(test_one_kind_of_input),
         cmocka_unit_test(test_too_small),
         cmocka_unit_test(test_exhaustion),
+        cmocka_unit_test(test_sparse_grid),
         cmocka_unit_test(test_empty_grid),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
