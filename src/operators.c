@@ -434,13 +434,14 @@ static int no_gap_over(const float *t, int32_t n, float len, float gap)
     return 1;
 }
 
-/* Whether data point i lies within POLYC__SUPPORT_M of segment sg: a
+/* Whether data point i lies within support_m (POLYC__SUPPORT_M, wider for
+ * an occupancy grid's coarse cells) of segment sg: a
  * point farther away is nearest to it only for want of a better segment
  * (clutter, the far side of a wall band) and holds no stretch of it. */
 static int supports(const polyc__opt *o, int32_t i, int32_t sg)
 {
     const polyc__vertex *a = &o->s->v[sg], *b = &o->s->v[a->next];
-    float lim = POLYC__SUPPORT_M;
+    float lim = o->support_m;
     return seg_dist2(o->pts[i].x, o->pts[i].y, a->x, a->y, b->x, b->y) <= lim * lim;
 }
 
@@ -451,7 +452,7 @@ static float gap_needed(const polyc__opt *o, float x, float y)
 {
     float gap_min = o->cfg->split_gap_m;
     float sparse = polyc__minf(2.5f * polyc__spacing_at(&o->spacing, x, y),
-                               gap_min + 0.5f * POLYC__SUPPORT_M);
+                               gap_min + 0.5f * o->support_m);
     return polyc__maxf(gap_min, sparse) + 0.5f * o->point_span_m;
 }
 

@@ -35,6 +35,8 @@ typedef struct polyc__opt {
     double n, log_n;               /* BIC's n: every endpoint */
     float R, R2;                   /* search radius: the cost of a point is capped at w R^2 */
     float point_span_m;            /* side of the block a weighted point stands for */
+    float support_m;               /* a point supports the map this near it: POLYC__SUPPORT_M,
+                                    * or a point's span where that is wider (grids) */
 
     /* model terms, kept incrementally */
     double err;                    /* sum of pt_cost */

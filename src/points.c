@@ -272,6 +272,7 @@ polyc_status polyc__points_collect(polyc__opt *o)
     o->point_span_m = ctx->from_grid ? ctx->grid.cell_m
                       : exact        ? 0.0f
                                      : ctx->grid.cell_m * (float)BLOCK_SIDE;
+    o->support_m = polyc__maxf(POLYC__SUPPORT_M, o->point_span_m);
     ctx->point_weight = total;
     ctx->stats.data_points = (uint64_t)total;
     ctx->stats.weighted_points = (uint32_t)n;
