@@ -174,15 +174,6 @@ void polyc__apply_move(polyc__opt *o, int32_t v, float x, float y)
 
 /* ---- geometry helpers ---- */
 
-static float seg_dist2(float px, float py, float ax, float ay, float bx, float by)
-{
-    float dx = bx - ax, dy = by - ay, mx = px - ax, my = py - ay;
-    float l2 = dx * dx + dy * dy;
-    float t = l2 > 0.0f ? (mx * dx + my * dy) / l2 : 0.0f;
-    t = t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
-    float ex = mx - t * dx, ey = my - t * dy;
-    return ex * ex + ey * ey;
-}
 
 /* Is segment `seg` within `hops` links of vertex v on the same polyline? */
 static int near_on_line(const polyc__opt *o, int32_t v, int32_t seg, int hops)
@@ -216,7 +207,7 @@ static float other_dist2(const polyc__opt *o, float x, float y, int32_t v)
                 if (near_on_line(o, v, sg, 3))
                     continue;
                 const polyc__vertex *a = &o->s->v[sg], *c = &o->s->v[a->next];
-                float d = seg_dist2(x, y, a->x, a->y, c->x, c->y);
+                float d = polyc__seg_dist2(x, y, a->x, a->y, c->x, c->y);
                 if (d < best)
                     best = d;
             }
@@ -442,7 +433,7 @@ static int supports(const polyc__opt *o, int32_t i, int32_t sg)
 {
     const polyc__vertex *a = &o->s->v[sg], *b = &o->s->v[a->next];
     float lim = o->support_m;
-    return seg_dist2(o->pts[i].x, o->pts[i].y, a->x, a->y, b->x, b->y) <= lim * lim;
+    return polyc__seg_dist2(o->pts[i].x, o->pts[i].y, a->x, a->y, b->x, b->y) <= lim * lim;
 }
 
 /* The length a stretch without data must exceed at (x, y) to be cut.

@@ -225,6 +225,16 @@ int polyc__op_remove_vertices(polyc__opt *o, uint32_t since);
 /* the change of the BIC if v is removed when that is below `bound`, else
  * some value >= bound (INFINITY: always exact) */
 double polyc__removal_delta_below(polyc__opt *o, int32_t v, double bound);
+/* Squared distance from (px, py) to segment a-b. */
+static inline float polyc__seg_dist2(float px, float py, float ax, float ay, float bx, float by)
+{
+    float dx = bx - ax, dy = by - ay, mx = px - ax, my = py - ay;
+    float l2 = dx * dx + dy * dy;
+    float t = l2 > 0.0f ? (mx * dx + my * dy) / l2 : 0.0f;
+    t = t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
+    float ex = mx - t * dx, ey = my - t * dy;
+    return ex * ex + ey * ey;
+}
 /* A point changes segment from `from` to `to`: both are due for op_split. */
 static inline void polyc__split_due_pt(polyc__opt *o, int32_t from, int32_t to)
 {

@@ -206,25 +206,15 @@ int polyc__op_untangle(polyc__opt *o)
 /* ---- double cover ---- */
 
 /* The nearest segment to (x, y) that does not touch a or b (within the
- * 3 x 3 buckets around it), or NONE. */
-static int32_t nearest_other(const polyc__opt *o, float x, float y, int32_t a, int32_t b);
-
-static float dist2_seg(float px, float py, float ax, float ay, float bx, float by)
-{
-    float dx = bx - ax, dy = by - ay, mx = px - ax, my = py - ay;
-    float l2 = dx * dx + dy * dy;
-    float t = l2 > 0.0f ? (mx * dx + my * dy) / l2 : 0.0f;
-    t = t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
-    float ex = mx - t * dx, ey = my - t * dy;
-    return ex * ex + ey * ey;
-}
-
-/* Is (x, y) within lim of a segment that does not touch a or b? */
-static int covered(const polyc__opt *o, float x, float y, int32_t a, int32_t b, float lim2)
+ * 3 x 3 buckets around it: at least the search radius), or NONE; *d2 its
+ * squared distance. */
+static int32_t nearest_other(const polyc__opt *o, float x, float y, int32_t a, int32_t b,
+                             float *d2)
 {
     const polyc__hash *h = &o->h;
     const polyc__store *s = o->s;
-    int32_t bx, by;
+    int32_t bx, by, best = POLYC__NONE;
+    *d2 = 1e30f;
     polyc__bucket_xy(h, x, y, &bx, &by);
     for (int32_t yy = by - 1; yy <= by + 1; yy++)
         for (int32_t xx = bx - 1; xx <= bx + 1; xx++) {
@@ -235,11 +225,21 @@ static int covered(const polyc__opt *o, float x, float y, int32_t a, int32_t b, 
                 if (touches(s, sg, a, b))
                     continue;
                 const polyc__vertex *c = &s->v[sg], *d = &s->v[c->next];
-                if (dist2_seg(x, y, c->x, c->y, d->x, d->y) <= lim2)
-                    return 1;
+                float dd = polyc__seg_dist2(x, y, c->x, c->y, d->x, d->y);
+                if (dd < *d2) {
+                    *d2 = dd;
+                    best = sg;
+                }
             }
         }
-    return 0;
+    return best;
+}
+
+/* Is (x, y) within sqrt(lim2) of a segment that does not touch a or b? */
+static int covered(const polyc__opt *o, float x, float y, int32_t a, int32_t b, float lim2)
+{
+    float d2;
+    return nearest_other(o, x, y, a, b, &d2) != POLYC__NONE && d2 <= lim2;
 }
 
 /* The longest doubly covered stretch of segment v, as fractions [*t0, *t1]
@@ -370,7 +370,8 @@ int polyc__op_zip(polyc__opt *o)
             int32_t w = V[v].next;
             float mx = V[v].x + 0.5f * (t0 + t1) * (V[w].x - V[v].x);
             float my = V[v].y + 0.5f * (t0 + t1) * (V[w].y - V[v].y);
-            int32_t q = nearest_other(o, mx, my, v, w);
+            float qd2;
+            int32_t q = nearest_other(o, mx, my, v, w, &qd2);
             float u0, u1;
             double d_here = drop_delta(o, v, t0, t1);
             if (q != POLYC__NONE && covered_run(o, q, &u0, &u1) &&
@@ -386,28 +387,3 @@ int polyc__op_zip(polyc__opt *o)
     return zipped;
 }
 
-static int32_t nearest_other(const polyc__opt *o, float x, float y, int32_t a, int32_t b)
-{
-    const polyc__hash *h = &o->h;
-    const polyc__store *s = o->s;
-    int32_t bx, by, best = POLYC__NONE;
-    float best_d = 1e30f;
-    polyc__bucket_xy(h, x, y, &bx, &by);
-    for (int32_t yy = by - 1; yy <= by + 1; yy++)
-        for (int32_t xx = bx - 1; xx <= bx + 1; xx++) {
-            if (xx < 0 || yy < 0 || xx >= h->bx || yy >= h->by)
-                continue;
-            for (int32_t e = h->seg_head[yy * h->bx + xx]; e != POLYC__NONE; e = h->entries[e].next) {
-                int32_t sg = h->entries[e].seg;
-                if (touches(s, sg, a, b))
-                    continue;
-                const polyc__vertex *c = &s->v[sg], *d = &s->v[c->next];
-                float dd = dist2_seg(x, y, c->x, c->y, d->x, d->y);
-                if (dd < best_d) {
-                    best_d = dd;
-                    best = sg;
-                }
-            }
-        }
-    return best;
-}

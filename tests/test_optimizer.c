@@ -1192,23 +1192,29 @@ static double longest_unsupported(const polyc__opt *o)
     return worst;
 }
 
+/* Data along two parallel 2 m walls `gap` apart, with a polyline on each. */
+static void parallel_case(fixture *f, float gap)
+{
+    static ptlist p;
+    p.n = 0;
+    pts_line(&p, -1.0f, 0.0f, 1.0f, 0.0f, 0.02f);
+    pts_line(&p, -1.0f, gap, 1.0f, gap, 0.02f);
+    set_points(f, p.xy, p.n);
+    clear_lines(&f->o);
+    const float a[4] = {-1.0f, 0.0f, 1.0f, 0.0f}, b[4] = {-1.0f, gap, 1.0f, gap};
+    add_line(&f->o, a, 2, 0);
+    add_line(&f->o, b, 2, 0);
+    rebuild(&f->o);
+}
+
 /* Two polylines 3 cm apart along one wall (its data a band between them):
  * one of them goes, the other is left whole. */
 static void test_zip_parallel_lines_become_one(void **state)
 {
     (void)state;
     static fixture f;
-    static ptlist p;
     fx_open_hand(&f, 0.0f);
-    p.n = 0;
-    pts_line(&p, -1.0f, 0.0f, 1.0f, 0.0f, 0.02f);
-    pts_line(&p, -1.0f, 0.03f, 1.0f, 0.03f, 0.02f);
-    set_points(&f, p.xy, p.n);
-    clear_lines(&f.o);
-    const float a[4] = {-1.0f, 0.0f, 1.0f, 0.0f}, b[4] = {-1.0f, 0.03f, 1.0f, 0.03f};
-    add_line(&f.o, a, 2, 0);
-    add_line(&f.o, b, 2, 0);
-    rebuild(&f.o);
+    parallel_case(&f, 0.03f);
     assert_true(polyc__op_zip(&f.o) >= 1);
     check_books(&f.o, "zip");
     assert_int_equal(live_lines(&f.o), 1);
@@ -1222,17 +1228,8 @@ static void test_zip_leaves_walls_10cm_apart(void **state)
 {
     (void)state;
     static fixture f;
-    static ptlist p;
     fx_open_hand(&f, 0.0f);
-    p.n = 0;
-    pts_line(&p, -1.0f, 0.0f, 1.0f, 0.0f, 0.02f);
-    pts_line(&p, -1.0f, 0.10f, 1.0f, 0.10f, 0.02f);
-    set_points(&f, p.xy, p.n);
-    clear_lines(&f.o);
-    const float a[4] = {-1.0f, 0.0f, 1.0f, 0.0f}, b[4] = {-1.0f, 0.10f, 1.0f, 0.10f};
-    add_line(&f.o, a, 2, 0);
-    add_line(&f.o, b, 2, 0);
-    rebuild(&f.o);
+    parallel_case(&f, 0.10f);
     assert_int_equal(polyc__op_zip(&f.o), 0);
     assert_int_equal(live_lines(&f.o), 2);
     fx_close(&f);

@@ -99,24 +99,12 @@ typedef struct scene {
 
 /* ---- small helpers -------------------------------------------------------- */
 
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
-}
-
-static int compare_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
 
 static double median(const double *v, unsigned n)
 {
     double tmp[MAX_RUNS];
     memcpy(tmp, v, n * sizeof *v);
-    qsort(tmp, n, sizeof *tmp, compare_double);
+    qsort(tmp, n, sizeof *tmp, pipeline_compare_double);
     return n % 2u ? tmp[n / 2u] : 0.5 * (tmp[n / 2u - 1u] + tmp[n / 2u]);
 }
 
@@ -200,7 +188,7 @@ static size_t find_scenes(const options *o, const char *kind, scene **list, size
 static int read_log(const char *path, scanlog *log, double *ms)
 {
     FILE *f = fopen(path, "r");
-    double t0 = now_ms();
+    double t0 = pipeline_now_ms();
     int rc;
     memset(log, 0, sizeof *log);
     if (!f) {
@@ -209,7 +197,7 @@ static int read_log(const char *path, scanlog *log, double *ms)
     }
     rc = scanlog_read(log, f, path, NULL);
     fclose(f);
-    *ms = now_ms() - t0;
+    *ms = pipeline_now_ms() - t0;
     return rc;
 }
 
@@ -244,7 +232,7 @@ static int open_pipeline(pipeline *p, const options *o, const polyc_scan *scans,
 
 static double write_output(const pipeline *p, const polyc_polyline *lines, uint32_t count)
 {
-    double t = now_ms();
+    double t = pipeline_now_ms();
     polyc_stats stats;
     mapout_map map;
     FILE *f = fopen("/dev/null", "w");
@@ -257,7 +245,7 @@ static double write_output(const pipeline *p, const polyc_polyline *lines, uint3
     map.stats = &stats;
     mapout_json(f, &map);
     fclose(f);
-    return now_ms() - t;
+    return pipeline_now_ms() - t;
 }
 
 /* ---- the table ----------------------------------------------------------- */
@@ -301,13 +289,13 @@ typedef struct row_accuracy {
 static void topology(const scanlog *log, const polyc_polyline *lines, uint32_t count,
                      const gtscore_truth *truth, const row_accuracy *acc, topo_row *row)
 {
-    double t0 = now_ms(), *xy = NULL;
+    double t0 = pipeline_now_ms(), *xy = NULL;
     uint64_t n = 0;
     row->rms_m = row->core_m = -1.0;
     row->ok = gttopo_scan_points(log->scans, log->count, &xy, &n) == 0 &&
               gttopo_score_map(lines, count, xy, n, &row->score) == 0;
     free(xy);
-    row->ms = now_ms() - t0;
+    row->ms = pipeline_now_ms() - t0;
     if (row->ok && truth) {
         row->rms_m = acc->score.precision_rms_m;
         if (gtscore_core_precision(truth, lines, count, CORE_M, &row->core_m) != 0)
@@ -496,7 +484,7 @@ static int single_scans(const options *o, const scene *s)
         uint32_t idx = (uint32_t)(((uint64_t)2u * k + 1u) * log.count / (2u * o->single));
         const polyc_scan *scan = &log.scans[idx];
         double times[ST_COUNT] = {0}, run_total[MAX_RUNS], run_stage[ST_COUNT][MAX_RUNS];
-        double t0 = now_ms(), cold = 0.0;
+        double t0 = pipeline_now_ms(), cold = 0.0;
         pipeline p;
         polyc_polyline *lines;
         uint32_t count = 0, i;
@@ -516,7 +504,7 @@ static int single_scans(const options *o, const scene *s)
                 run_stage[i][r] = times[i];
             }
             if (r == 0)
-                cold = now_ms() - t0;
+                cold = pipeline_now_ms() - t0;
         }
         if (bad || (lines = pipeline_lines(&p, &count)) == NULL) {
             printf("%-24s scan %u: error in %s: %s (%s)\n", label, idx,

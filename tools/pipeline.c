@@ -8,11 +8,17 @@
 #include <string.h>
 #include <time.h>
 
-static double now_ms(void)
+double pipeline_now_ms(void)
 {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
+}
+
+int pipeline_compare_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
 }
 
 static int step(pipeline *p, polyc_status st, const char *what)
@@ -65,7 +71,7 @@ static int pipeline_grow(pipeline *p)
 
 int pipeline_run(pipeline *p, const polyc_scan *scans, uint32_t n, double *times)
 {
-    double t = now_ms(), t1;
+    double t = pipeline_now_ms(), t1;
     uint32_t i;
     if (step(p, polyc_init(p->block, p->block_size, &p->config, &p->limits, &p->ctx),
              "polyc_init"))
@@ -73,22 +79,22 @@ int pipeline_run(pipeline *p, const polyc_scan *scans, uint32_t n, double *times
     for (i = 0; i < n; i++)
         if (step(p, polyc_add_scan(p->ctx, &scans[i]), "polyc_add_scan"))
             return -1;
-    t1 = now_ms(); times[PIPELINE_ADD] = t1 - t; t = t1;
+    t1 = pipeline_now_ms(); times[PIPELINE_ADD] = t1 - t; t = t1;
     if (step(p, polyc_build_grid(p->ctx), "polyc_build_grid"))
         return -1;
-    t1 = now_ms(); times[PIPELINE_GRID] = t1 - t; t = t1;
+    t1 = pipeline_now_ms(); times[PIPELINE_GRID] = t1 - t; t = t1;
     /* (a single scan's polylines come from its beam order: polyc_build
      * skips the contour, and so does this) */
     if (n > 1 && step(p, polyc_extract_contour(p->ctx), "polyc_extract_contour"))
         return -1;
-    t1 = now_ms(); times[PIPELINE_CONTOUR] = t1 - t; t = t1;
+    t1 = pipeline_now_ms(); times[PIPELINE_CONTOUR] = t1 - t; t = t1;
     if (step(p, polyc_trace(p->ctx), "polyc_trace"))
         return pipeline_grow(p) ? -1 : pipeline_run(p, scans, n, times);
-    t1 = now_ms(); times[PIPELINE_TRACE] = t1 - t; t = t1;
+    t1 = pipeline_now_ms(); times[PIPELINE_TRACE] = t1 - t; t = t1;
     if (p->config.max_iterations > 0 &&
         step(p, polyc_optimize(p->ctx, NULL, NULL), "polyc_optimize"))
         return pipeline_grow(p) ? -1 : pipeline_run(p, scans, n, times);
-    times[PIPELINE_OPTIMIZE] = now_ms() - t;
+    times[PIPELINE_OPTIMIZE] = pipeline_now_ms() - t;
     return 0;
 }
 

@@ -43,4 +43,9 @@ int pipeline_run(pipeline *p, const polyc_scan *scans, uint32_t n, double *times
 /* The current map as an array of polylines (malloc'ed; NULL on failure). */
 polyc_polyline *pipeline_lines(pipeline *p, uint32_t *count);
 
+/* A monotonic clock in milliseconds, and a qsort comparison of doubles
+ * (the bench's and the sweep's medians). */
+double pipeline_now_ms(void);
+int pipeline_compare_double(const void *a, const void *b);
+
 #endif /* POLYC_PIPELINE_H */

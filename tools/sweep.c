@@ -108,18 +108,6 @@ typedef struct row {
 
 /* ---- small helpers --------------------------------------------------------- */
 
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
-}
-
-static int compare_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
 
 /* ---- one scene -------------------------------------------------------------- */
 
@@ -389,7 +377,7 @@ static void summarise(const row *rows, size_t n, const char *kind, const char *l
                 v[m++] = rows[i].fig[f];
         median[f] = worst[f] = (double)NAN;
         if (m) {
-            qsort(v, m, sizeof *v, compare_double);
+            qsort(v, m, sizeof *v, pipeline_compare_double);
             median[f] = m % 2u ? v[m / 2u] : 0.5 * (v[m / 2u - 1u] + v[m / 2u]);
             worst[f] = figures[f].low_is_worse ? v[0] : v[m - 1u];
         }
@@ -488,7 +476,7 @@ int main(int argc, char **argv)
     size_t n, k = 0;
     unsigned kind;
     uint64_t seed;
-    double t0 = now_ms(), pipeline_ms = 0.0;
+    double t0 = pipeline_now_ms(), pipeline_ms = 0.0;
     int failed = 0;
     uint32_t f;
 
@@ -523,7 +511,7 @@ int main(int argc, char **argv)
     for (k = 0; k < n; k++)
         pipeline_ms += rows[k].ok ? rows[k].fig[FIG_MS] : 0.0;
     printf("\n%zu scenes in %.1f s, %.1f s of it in the pipeline (the ms column)\n", n,
-           (now_ms() - t0) / 1e3, pipeline_ms / 1e3);
+           (pipeline_now_ms() - t0) / 1e3, pipeline_ms / 1e3);
     free(rows);
     return failed ? EXIT_FAILED : 0;
 }
