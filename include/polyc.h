@@ -27,7 +27,7 @@ extern "C" {
 #endif
 
 #define POLYC_VERSION_MAJOR 0
-#define POLYC_VERSION_MINOR 1
+#define POLYC_VERSION_MINOR 2
 #define POLYC_VERSION_PATCH 0
 /* One number, comparable: major * 10000 + minor * 100 + patch. */
 #define POLYC_VERSION (POLYC_VERSION_MAJOR * 10000 + POLYC_VERSION_MINOR * 100 + POLYC_VERSION_PATCH)
@@ -91,6 +91,11 @@ typedef struct polyc_config {
     uint32_t flags;            /* POLYC_FLAG_* */
     uint32_t reserved;         /* must be 0 */
     uint64_t seed;             /* PRNG seed: same input and seed, same map */
+    /* Occupancy grids (polyc_add_grid) */
+    float occupied_thresh;     /* an occupancy-grid cell with value >= 100 * this is
+                                  occupied; default 0.65 (map_server's) */
+    float free_thresh;         /* a cell with 0 <= value <= 100 * this is free;
+                                  default 0.196 (map_server's); must be < occupied_thresh */
 } polyc_config;
 
 /* Upper bounds that size the memory block. */
@@ -125,6 +130,23 @@ typedef struct polyc_scan {
 typedef struct polyc_box {
     double min_x_m, min_y_m, max_x_m, max_y_m;
 } polyc_box;
+
+/* An occupancy grid shaped like ROS nav_msgs/OccupancyGrid: cell (column i,
+ * row j) is cells[j * width + i]; row 0 is at the origin, columns run along
+ * the origin's x axis (yaw origin_yaw_rad), rows along its y axis. The
+ * origin pose is that of cell (0, 0)'s outer corner, as in map_server.
+ * Values: -1 unknown, 0..100 occupancy (others are refused). `cells` is only
+ * read during the call that takes it. */
+typedef struct polyc_occupancy_grid {
+    uint32_t width;            /* cells along x */
+    uint32_t height;           /* cells along y */
+    float resolution_m;        /* metres per cell, > 0 */
+    uint32_t reserved;         /* must be 0 */
+    double origin_x_m;         /* pose of cell (0, 0)'s corner */
+    double origin_y_m;
+    double origin_yaw_rad;
+    const int8_t *cells;       /* width * height values, row-major */
+} polyc_occupancy_grid;
 
 /* One polyline of the result; points belong to the context and stay valid
  * until the next call that changes the map (build, optimise, reset). */
@@ -182,7 +204,8 @@ POLYC_API uint32_t polyc_version(void);
 POLYC_API const char *polyc_status_str(polyc_status status);
 /* sizeof of the public struct named by `name` ("polyc_config", "polyc_limits",
  * "polyc_scan", "polyc_box", "polyc_polyline", "polyc_stats",
- * "polyc_iteration"), 0 if unknown: lets bindings detect ABI drift. */
+ * "polyc_iteration", "polyc_occupancy_grid"), 0 if unknown: lets bindings
+ * detect ABI drift. */
 POLYC_API size_t polyc_struct_size(const char *name);
 
 /* The paper's parameters and this library's defaults. */
@@ -204,6 +227,11 @@ POLYC_API polyc_status polyc_limits_for_scans(const polyc_config *config,
 POLYC_API void polyc_scan_extent(const polyc_config *config, const polyc_scan *scan,
                                  polyc_box *box);
 
+/* Limits for mapping one occupancy grid (counts its occupied cells). Pure. */
+POLYC_API polyc_status polyc_limits_for_grid(const polyc_config *config,
+                                             const polyc_occupancy_grid *grid,
+                                             polyc_limits *out);
+
 /* Bytes needed for a context with these limits; 0 if config or limits are
  * invalid or the size would overflow size_t. */
 POLYC_API size_t polyc_memory_size(const polyc_config *config, const polyc_limits *limits);
@@ -220,6 +248,13 @@ POLYC_API polyc_status polyc_reset(polyc_ctx *ctx);
  * negative step with beams, beam_count 0 is allowed and adds nothing);
  * NaN/inf ranges are counted in stats.beams_skipped. */
 POLYC_API polyc_status polyc_add_scan(polyc_ctx *ctx, const polyc_scan *scan);
+
+/* Takes the grid's occupied and free cells as the map's evidence; then
+ * polyc_build (or trace + optimize) works as for scans. One grid per context;
+ * a context that holds scans refuses a grid and the other way round
+ * (POLYC_ERR_STATE). POLYC_ERR_CONFIG for a bad resolution, size or value,
+ * POLYC_ERR_NOMEM / POLYC_ERR_LIMIT if the block or limits are too small. */
+POLYC_API polyc_status polyc_add_grid(polyc_ctx *ctx, const polyc_occupancy_grid *grid);
 
 /* Stage by stage (each runs the earlier ones if needed), or all at once. */
 POLYC_API polyc_status polyc_build_grid(polyc_ctx *ctx);   /* hit/miss grid */

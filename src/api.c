@@ -35,6 +35,7 @@ size_t polyc_struct_size(const char *name)
         {"polyc_scan", sizeof(polyc_scan)},       {"polyc_box", sizeof(polyc_box)},
         {"polyc_polyline", sizeof(polyc_polyline)}, {"polyc_stats", sizeof(polyc_stats)},
         {"polyc_iteration", sizeof(polyc_iteration)},
+        {"polyc_occupancy_grid", sizeof(polyc_occupancy_grid)},
     };
     if (!name)
         return 0;
@@ -68,6 +69,8 @@ void polyc_config_default(polyc_config *c)
     c->max_iterations = 100;
     c->flags = 0;
     c->seed = 1;
+    c->occupied_thresh = 0.65f;
+    c->free_thresh = 0.196f;
 }
 
 static int in(float v, float lo, float hi)
@@ -97,6 +100,9 @@ polyc_status polyc_config_check(const polyc_config *c, const char **why)
     else if (!in(c->noise_decay, 1e-6f, 1.0f)) w = "noise_decay must be in (0, 1]";
     else if (!in(c->overlap_m, 0.0f, 10.0f)) w = "overlap_m must be in [0, 10]";
     else if (!in(c->search_radius_m, 1e-3f, 100.0f)) w = "search_radius_m must be in (0, 100]";
+    else if (!in(c->occupied_thresh, 1e-6f, 1.0f)) w = "occupied_thresh must be in (0, 1]";
+    else if (!in(c->free_thresh, 0.0f, 1.0f) || !(c->free_thresh < c->occupied_thresh))
+        w = "free_thresh must be in [0, occupied_thresh)";
     else if (c->reserved != 0) w = "reserved must be 0";
     else if (c->flags & ~(POLYC_FLAG_EXACT_POINTS | POLYC_FLAG_NO_GRAZING | POLYC_FLAG_GRID_TRACE))
         w = "unknown flags";
@@ -263,7 +269,8 @@ polyc_status polyc_init(void *block, size_t size, const polyc_config *config,
     ctx->ranges = polyc__alloc(&ctx->arena, limits->max_beams, sizeof(float));
     if ((!ctx->scans && limits->max_scans) || (!ctx->ranges && limits->max_beams))
         return POLYC_ERR_NOMEM;
-    ctx->scans_mark = ctx->arena.used;
+    ctx->scans_mark = ctx->base_mark = ctx->arena.used;
+    ctx->frame_cos = 1.0;
     ctx->stats.memory_size_bytes = size;
     ctx->error_scan = -1;
     *out = ctx;
@@ -274,9 +281,15 @@ polyc_status polyc_reset(polyc_ctx *ctx)
 {
     if (check_ctx(ctx) != POLYC_OK)
         return POLYC_ERR_NULL;
-    ctx->arena.used = ctx->scans_mark;
+    ctx->arena.used = ctx->scans_mark = ctx->base_mark;
     ctx->scan_count = ctx->range_count = 0;
     ctx->have_frame = ctx->have_extent = 0;
+    ctx->from_grid = 0;
+    ctx->frame_x = ctx->frame_y = 0.0;
+    ctx->frame_cos = 1.0;
+    ctx->frame_sin = 0.0;
+    memset(&ctx->grid, 0, sizeof ctx->grid);
+    ctx->contour_count = 0;
     ctx->stage = POLYC__STAGE_SCANS;
     ctx->error = NULL;
     ctx->error_scan = -1;
@@ -292,6 +305,9 @@ polyc_status polyc_add_scan(polyc_ctx *ctx, const polyc_scan *s)
     if (check_ctx(ctx) != POLYC_OK || !s)
         return POLYC_ERR_NULL;
     ctx->error = NULL;
+    if (ctx->from_grid)
+        return polyc__fail(ctx, POLYC_ERR_STATE,
+                           "the context holds a grid: scans need a context of their own");
     if (s->beam_count && !s->range_m)
         return polyc__fail(ctx, POLYC_ERR_NULL, "scan.range_m is NULL with beams");
     const char *bad = NULL;
@@ -350,6 +366,14 @@ polyc_status polyc_add_scan(polyc_ctx *ctx, const polyc_scan *s)
     return POLYC_OK;
 }
 
+polyc_status polyc_add_grid(polyc_ctx *ctx, const polyc_occupancy_grid *grid)
+{
+    if (check_ctx(ctx) != POLYC_OK || !grid)
+        return POLYC_ERR_NULL;
+    ctx->error = NULL;
+    return polyc__occ_add(ctx, grid);
+}
+
 /* ---- stages ---- */
 
 static void note_memory(polyc_ctx *ctx)
@@ -394,11 +418,17 @@ static polyc_status stage_contour(polyc_ctx *ctx)
     return st;
 }
 
-/* The result form, in the frame of the input poses. */
+/* The result form, in the frame of the input poses (an occupancy grid's
+ * map frame: its origin pose applied). */
 static void export_result(polyc_ctx *ctx)
 {
     polyc__flat_from_store(&ctx->flat, &ctx->store);
-    for (uint32_t i = 0; i < ctx->flat.points; i++) {
+    for (uint32_t i = 0; ctx->from_grid && i < ctx->flat.points; i++) {
+        double x = (double)ctx->flat.xy[2 * i], y = (double)ctx->flat.xy[2 * i + 1];
+        ctx->flat.xy[2 * i] = (float)(ctx->frame_x + ctx->frame_cos * x - ctx->frame_sin * y);
+        ctx->flat.xy[2 * i + 1] = (float)(ctx->frame_y + ctx->frame_sin * x + ctx->frame_cos * y);
+    }
+    for (uint32_t i = 0; !ctx->from_grid && i < ctx->flat.points; i++) {
         ctx->flat.xy[2 * i] = (float)((double)ctx->flat.xy[2 * i] + ctx->frame_x);
         ctx->flat.xy[2 * i + 1] = (float)((double)ctx->flat.xy[2 * i + 1] + ctx->frame_y);
     }
@@ -425,6 +455,8 @@ static polyc_status stage_trace(polyc_ctx *ctx)
 static polyc_status need_stage(polyc_ctx *ctx, polyc__stage want)
 {
     polyc_status st = POLYC_OK;
+    if (ctx->from_grid && ctx->stage < POLYC__STAGE_CONTOUR)
+        ctx->stage = POLYC__STAGE_CONTOUR; /* an occupancy grid's are its input */
     if (ctx->stage < POLYC__STAGE_GRID && want >= POLYC__STAGE_GRID)
         st = run_stage(ctx, POLYC__STAGE_GRID, ctx->scans_mark, stage_grid, POLYC__STAGE_SCANS);
     if (st == POLYC_OK && ctx->stage < POLYC__STAGE_CONTOUR && want > POLYC__STAGE_CONTOUR &&
@@ -457,7 +489,9 @@ polyc_status polyc_build_grid(polyc_ctx *ctx)
     if (check_ctx(ctx) != POLYC_OK)
         return POLYC_ERR_NULL;
     ctx->error = NULL;
-    ctx->stage = POLYC__STAGE_SCANS; /* explicit call: rebuild */
+    /* explicit call: rebuild (an occupancy grid's is its input: the results
+     * after it are dropped) */
+    ctx->stage = ctx->from_grid ? POLYC__STAGE_CONTOUR : POLYC__STAGE_SCANS;
     return need_stage(ctx, POLYC__STAGE_GRID);
 }
 
@@ -467,7 +501,7 @@ polyc_status polyc_extract_contour(polyc_ctx *ctx)
         return POLYC_ERR_NULL;
     ctx->error = NULL;
     if (ctx->stage >= POLYC__STAGE_CONTOUR)
-        ctx->stage = POLYC__STAGE_GRID;
+        ctx->stage = ctx->from_grid ? POLYC__STAGE_CONTOUR : POLYC__STAGE_GRID;
     return need_stage(ctx, POLYC__STAGE_CONTOUR);
 }
 

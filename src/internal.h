@@ -217,6 +217,13 @@ struct polyc_ctx {
 
     double frame_x, frame_y;       /* first pose: stored floats are relative to it */
     int have_frame;
+    /* an occupancy grid (occupancy.c) instead of scans: stored floats are in
+     * its frame, whose corner is frame_x, frame_y and whose x axis points
+     * along (frame_cos, frame_sin); its grid and contour are input, kept
+     * below scans_mark */
+    int from_grid;
+    double frame_cos, frame_sin;
+    size_t base_mark;              /* arena use after polyc_init's scan storage */
     polyc__scan *scans;
     float *ranges;
     uint32_t scan_count, range_count;
@@ -307,6 +314,9 @@ int polyc__beam_path(const polyc_ctx *ctx, const polyc__scan *s, uint32_t i, pol
  * and `last` set for the end cell; a non-zero return stops the walk. */
 typedef int (*polyc__cell_fn)(void *u, int32_t ix, int32_t iy, float t_enter, int last);
 void polyc__traverse(const polyc__beam *b, polyc__cell_fn visit, void *u);
+
+/* occupancy.c: the grid and contour stages of an occupancy grid, at once */
+polyc_status polyc__occ_add(polyc_ctx *ctx, const polyc_occupancy_grid *grid);
 
 /* contour.c */
 /* entries the grid's tile directory may have under the limits */

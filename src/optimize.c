@@ -14,10 +14,11 @@
 
 
 /* No copy for a context of one scan: its trials list fewer than 8 points
- * nine times in ten (and its block is the embedded one). */
+ * nine times in ten (and its block is the embedded one). An occupancy
+ * grid's limits have no scans (polyc_limits_for_grid) and get the copy. */
 static int32_t loc_soa_cap(const polyc_limits *lim)
 {
-    return lim->max_scans > 1 ? POLYC__LOC_SOA : 0;
+    return lim->max_scans != 1 ? POLYC__LOC_SOA : 0;
 }
 
 size_t polyc__optimizer_bytes(const polyc_config *cfg, const polyc_limits *lim)

@@ -187,6 +187,37 @@ static polyc_status collect_raw(polyc__opt *o, polyc__point *tmp, int32_t cap, i
     return POLYC_OK;
 }
 
+/* An occupancy grid's data: one point per occupied cell (a hit in its
+ * tile, occupancy.c), at the cell's centre, of weight OCC_WEIGHT and no
+ * spread. */
+#define OCC_WEIGHT 1.0f
+
+static polyc_status collect_occupied(polyc__opt *o, polyc__point *tmp, int32_t cap, int32_t *n_out)
+{
+    polyc_ctx *ctx = o->ctx;
+    const polyc__grid *g = &ctx->grid;
+    int32_t n = 0, dir_n = g->tiles_x * g->tiles_y;
+    for (int32_t d = 0; d < dir_n; d++) {
+        if (!g->dir[d])
+            continue;
+        const polyc__tile *t = &g->tiles[g->dir[d] - 1];
+        int32_t tx = (d % g->tiles_x) << POLYC__TILE_SHIFT, ty = (d / g->tiles_x) << POLYC__TILE_SHIFT;
+        for (int32_t k = 0; k < POLYC__TILE_CELLS; k++) {
+            if (!t->hits[k])
+                continue;
+            if (n >= cap)
+                return polyc__fail(ctx, POLYC_ERR_NOMEM, "more data points than limits.max_points");
+            polyc__point *p = &tmp[n++];
+            memset(p, 0, sizeof *p);
+            p->x = cell_centre(0.0, tx + (k & (POLYC__TILE_SIDE - 1)), g->cell_m);
+            p->y = cell_centre(0.0, ty + (k >> POLYC__TILE_SHIFT), g->cell_m);
+            p->w = OCC_WEIGHT;
+        }
+    }
+    *n_out = n;
+    return POLYC_OK;
+}
+
 int32_t polyc__points_bound(const polyc_config *cfg, const polyc_limits *lim)
 {
     uint32_t b = lim->max_points ? lim->max_points : lim->max_beams;
@@ -209,7 +240,9 @@ polyc_status polyc__points_collect(polyc__opt *o)
     /* one scan: a point per return, whose beam the ends are set by (a
      * weighted point of several near returns would set them by their mean) */
     int exact = (o->cfg->flags & POLYC_FLAG_EXACT_POINTS) || o->rays.on;
-    polyc_status st = exact ? collect_raw(o, tmp, cap, &n) : collect_cells(o, tmp, cap, &n);
+    polyc_status st = ctx->from_grid ? collect_occupied(o, tmp, cap, &n)
+                      : exact        ? collect_raw(o, tmp, cap, &n)
+                                     : collect_cells(o, tmp, cap, &n);
     if (st != POLYC_OK)
         return st;
     /* counting sort by bucket: points of one bucket are contiguous */
@@ -236,7 +269,9 @@ polyc_status polyc__points_collect(polyc__opt *o)
     o->n = total;
     /* the span of one weighted point: gaps between points shorter than it
      * say nothing (split) */
-    o->point_span_m = exact ? 0.0f : ctx->grid.cell_m * (float)BLOCK_SIDE;
+    o->point_span_m = ctx->from_grid ? ctx->grid.cell_m
+                      : exact        ? 0.0f
+                                     : ctx->grid.cell_m * (float)BLOCK_SIDE;
     ctx->point_weight = total;
     ctx->stats.data_points = (uint64_t)total;
     ctx->stats.weighted_points = (uint32_t)n;

@@ -28,6 +28,8 @@ int main()
     check(polyc_struct_size("polyc_polyline") == sizeof(polyc_polyline), "sizeof polyc_polyline");
     check(polyc_struct_size("polyc_stats") == sizeof(polyc_stats), "sizeof polyc_stats");
     check(polyc_struct_size("polyc_iteration") == sizeof(polyc_iteration), "sizeof polyc_iteration");
+    check(polyc_struct_size("polyc_occupancy_grid") == sizeof(polyc_occupancy_grid),
+          "sizeof polyc_occupancy_grid");
     check(std::strcmp(polyc_status_str(POLYC_OK), "ok") == 0, "polyc_status_str");
 
     // one scan of a wall 2 m ahead, 1 to 3 m wide: at least one polyline

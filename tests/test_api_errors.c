@@ -110,6 +110,8 @@ static void test_null_pointers(void **state)
     assert_int_equal(polyc_struct_size(NULL), 0);
     assert_int_equal(polyc_struct_size("polyc_nothing"), 0);
     assert_int_equal(polyc_struct_size("polyc_scan"), sizeof(polyc_scan));
+    assert_int_equal(polyc_struct_size("polyc_config"), sizeof(polyc_config));
+    assert_int_equal(polyc_struct_size("polyc_occupancy_grid"), sizeof(polyc_occupancy_grid));
     polyc_config_default(NULL);
     assert_int_equal(polyc_config_check(NULL, NULL), POLYC_ERR_NULL);
     assert_int_equal(polyc_config_check(NULL, &why), POLYC_ERR_NULL);
