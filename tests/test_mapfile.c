@@ -55,6 +55,8 @@ static void test_yaml_map_saver_layout(void **state)
     assert_true(y.free_thresh == 0.196);
     assert_int_equal(y.mode, MAPFILE_TRINARY);
     assert_int_equal(y.image_line, 1);
+    assert_int_equal(y.resolution_line, 2);
+    assert_int_equal(y.origin_line, 3);
     assert_int_equal(y.lines, 7);
     mapfile_yaml_free(&y);
 }
@@ -183,8 +185,10 @@ static void test_yaml_errors(void **state)
                       "m.yaml:2: resolution: '.nan' is not a number");
     expect_yaml_error(WITH("image: a.pgm\nresolution: 1e999\n"),
                       "m.yaml:2: resolution: '1e999' is not a number");
-    expect_yaml_error(WITH("image: a.pgm\nresolution: 5000\n"),
-                      "m.yaml:2: resolution 5000 m is above 1000 m");
+    expect_yaml_error(WITH("image: a.pgm\nresolution: 500\n"),
+                      "m.yaml:2: resolution 500 m is outside [0.0001, 100] m");
+    expect_yaml_error(WITH("image: a.pgm\nresolution: 1e-5\n"),
+                      "m.yaml:2: resolution 1e-5 m is outside [0.0001, 100] m");
     expect_yaml_error(WITH("image: a.pgm\nresolution:\n"), "m.yaml:2: resolution has no value");
     expect_yaml_error(WITH("image: ''\nresolution: 1\n"), "m.yaml:1: image is empty");
     expect_yaml_error(WITH("image: \"a\\0b\"\nresolution: 1\n"),
@@ -235,8 +239,8 @@ static void test_yaml_errors(void **state)
     expect_yaml_error(WITH2("origin:\n  - 1\n  x: 2\n"), "m.yaml:5: origin: expected '- number', found 'x: 2'");
     expect_yaml_error(WITH2("origin: [2e6, 0, 0]\nnegate: 0\n"),
                       "m.yaml:3: origin x or y beyond +-1e+06 m");
-    expect_yaml_error(WITH2("origin: [0, 0, 1e4]\nnegate: 0\n"),
-                      "m.yaml:3: origin yaw beyond +-1000 rad");
+    expect_yaml_error(WITH2("origin: [0, 0, 101]\nnegate: 0\n"),
+                      "m.yaml:3: origin yaw beyond +-100 rad");
     const char *h3 = "image: a.pgm\nresolution: 1\norigin: [0, 0, 0]\n";
     char t3[512];
 #define WITH3(tail) (snprintf(t3, sizeof t3, "%s%s", h3, tail), t3)

@@ -307,9 +307,9 @@ static int set_scalar(yparser *p, const char *s, size_t len, int has_nul)
             return yfail(p, p->line, "resolution: '%s' is not a number", quote(&e, s, len));
         if (!(v > 0))
             return yfail(p, p->line, "resolution %s must be above 0 m", quote(&e, s, len));
-        if (v > MAPFILE_MAX_RESOLUTION_M)
-            return yfail(p, p->line, "resolution %s m is above %g m", quote(&e, s, len),
-                         MAPFILE_MAX_RESOLUTION_M);
+        if (v < MAPFILE_MIN_RESOLUTION_M || v > MAPFILE_MAX_RESOLUTION_M)
+            return yfail(p, p->line, "resolution %s m is outside [%g, %g] m", quote(&e, s, len),
+                         MAPFILE_MIN_RESOLUTION_M, MAPFILE_MAX_RESOLUTION_M);
         y->resolution_m = v;
         return 0;
     case K_NEGATE:
@@ -614,6 +614,8 @@ int mapfile_yaml_parse(mapfile_yaml *y, const char *text, size_t len, const char
         pos = end + 1;
     }
     y->lines = p.line;
+    y->resolution_line = p.seen[K_RESOLUTION];
+    y->origin_line = p.seen[K_ORIGIN];
     if (rc == 0)
         rc = key_end(&p);
     for (int k = 0; rc == 0 && k < K_COUNT; k++)
@@ -790,8 +792,6 @@ int mapfile_pgm_parse(mapfile_pgm *p, const uint8_t *data, size_t len, const cha
     p->height = (uint32_t)h;
     p->maxval = (uint32_t)maxval;
     size_t cells = (size_t)(w * h);
-    if (!(p->samples = malloc(cells * sizeof *p->samples)))
-        return pfail(&r, r.pos, "out of memory for %zu pixels", cells);
     if (!p->plain) {
         if (r.pos >= len)
             return pfail(&r, r.pos, "the file ends after maxval: no pixel data (truncated)");
@@ -806,6 +806,9 @@ int mapfile_pgm_parse(mapfile_pgm *p, const uint8_t *data, size_t len, const cha
         if (have > need)
             return pfail(&r, start + need, "%zu bytes after the pixel data (trailing garbage,"
                                            " or the size does not match)", have - need);
+        /* allocated only now: the file holds every pixel */
+        if (!(p->samples = malloc(cells * sizeof *p->samples)))
+            return pfail(&r, start, "out of memory for %zu pixels", cells);
         for (size_t i = 0; i < cells; i++) {
             const uint8_t *q = data + start + i * bps;
             uint32_t v = bps == 2 ? (uint32_t)q[0] << 8 | q[1] : q[0];
@@ -816,25 +819,34 @@ int mapfile_pgm_parse(mapfile_pgm *p, const uint8_t *data, size_t len, const cha
         }
         return 0;
     }
-    for (size_t i = 0; i < cells; i++) {
-        uint64_t v;
-        size_t at;
+    /* P2: a first pass checks every value, so that memory is taken only for
+     * a file that holds them all; the second stores them */
+    size_t raster = r.pos;
+    for (int pass = 0; pass < 2; pass++) {
+        r.pos = raster;
+        if (pass == 1 && !(p->samples = malloc(cells * sizeof *p->samples)))
+            return pfail(&r, raster, "out of memory for %zu pixels", cells);
+        for (size_t i = 0; i < cells; i++) {
+            uint64_t v;
+            size_t at;
+            pgm_skip(&r);
+            if (r.pos >= len)
+                return pfail(&r, len, "truncated: %zu of %zu pixel values (%llu x %llu)", i,
+                             cells, (unsigned long long)w, (unsigned long long)h);
+            if (pgm_number(&r, "pixel value", 999999, &v, &at))
+                return -1;
+            if (v > maxval)
+                return pfail(&r, at, "pixel value %llu above maxval %u", (unsigned long long)v,
+                             (unsigned)maxval);
+            if (pass == 1)
+                p->samples[i] = (uint16_t)v;
+        }
         pgm_skip(&r);
-        if (r.pos >= len)
-            return pfail(&r, len, "truncated: %zu of %zu pixel values (%llu x %llu)", i, cells,
-                         (unsigned long long)w, (unsigned long long)h);
-        if (pgm_number(&r, "pixel value", 999999, &v, &at))
-            return -1;
-        if (v > maxval)
-            return pfail(&r, at, "pixel value %llu above maxval %u", (unsigned long long)v,
-                         (unsigned)maxval);
-        p->samples[i] = (uint16_t)v;
+        if (r.pos < len)
+            return pfail(&r, r.pos, "more than %llu x %llu pixel values (trailing garbage, or"
+                                    " the size does not match)", (unsigned long long)w,
+                         (unsigned long long)h);
     }
-    pgm_skip(&r);
-    if (r.pos < len)
-        return pfail(&r, r.pos, "more than %llu x %llu pixel values (trailing garbage, or the"
-                                " size does not match)", (unsigned long long)w,
-                     (unsigned long long)h);
     return 0;
 }
 

@@ -15,8 +15,9 @@
 #define MAPFILE_MAX_CELLS       (1u << 28)    /* width x height */
 #define MAPFILE_MAX_IMAGE_NAME  4096u         /* bytes of the `image` value */
 #define MAPFILE_MAX_ORIGIN_M    1e6           /* |origin x|, |origin y| */
-#define MAPFILE_MAX_YAW_RAD     1e3           /* |origin yaw| */
-#define MAPFILE_MAX_RESOLUTION_M 1e3
+#define MAPFILE_MAX_YAW_RAD     100.0         /* |origin yaw| (the library's bound) */
+#define MAPFILE_MIN_RESOLUTION_M 1e-4         /* the library's bounds */
+#define MAPFILE_MAX_RESOLUTION_M 100.0
 
 /* map_saver's pixel values and thresholds (what `polyc grid` writes). */
 #define MAPFILE_PIXEL_OCCUPIED  0
@@ -38,7 +39,9 @@ typedef struct mapfile_yaml {
     double occupied_thresh;    /* in [0, 1], above free_thresh */
     double free_thresh;
     int mode;                  /* enum mapfile_mode; trinary if `mode` is absent */
-    uint32_t image_line;       /* where `image` is, for messages about the image */
+    uint32_t image_line;       /* where `image`, `resolution` and `origin` are, */
+    uint32_t resolution_line;  /* for messages about what they give */
+    uint32_t origin_line;
     uint32_t lines;            /* lines read */
     char error[512];           /* "NAME:LINE: what is wrong" after a failure */
 } mapfile_yaml;
