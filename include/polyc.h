@@ -255,6 +255,20 @@ POLYC_API polyc_status polyc_add_scan(polyc_ctx *ctx, const polyc_scan *scan);
  * (POLYC_ERR_STATE). POLYC_ERR_CONFIG for a bad resolution, size or value,
  * POLYC_ERR_NOMEM / POLYC_ERR_LIMIT if the block or limits are too small. */
 POLYC_API polyc_status polyc_add_grid(polyc_ctx *ctx, const polyc_occupancy_grid *grid);
+/* Grids, in detail. polyc_limits_for_grid gives max_scans 0, max_beams,
+ * max_points the occupied cells (each is one data point and at most one
+ * contour cell), max_vertices that + 1024, max_grid_cells the 32 x 32-cell
+ * tiles that hold an occupied cell (at least a quarter of all the grid's
+ * tiles, for their directory). More occupied cells than max_beams is POLYC_ERR_LIMIT,
+ * more tiles than max_grid_cells POLYC_ERR_NOMEM; cells NULL is
+ * POLYC_ERR_NULL; a grid wider or taller than config.max_extent_m is
+ * POLYC_ERR_EXTENT. The polylines come in the map frame (the origin pose
+ * applied); polyc_grid_info gives the origin corner and the resolution,
+ * polyc_grid_cell hits 1 for an occupied cell, misses 1 for a free one (in
+ * tiles holding an occupied cell), contour 1 for an occupied cell with a
+ * free side neighbour. The optimiser weighs a grid's squared distances by
+ * alpha (0.025 / resolution_m)^2, searches at least 3 cells and has no
+ * angle prior (gamma unused): docs/algorithm.md, "From an occupancy grid". */
 
 /* Stage by stage (each runs the earlier ones if needed), or all at once. */
 POLYC_API polyc_status polyc_build_grid(polyc_ctx *ctx);   /* hit/miss grid */

@@ -89,6 +89,21 @@ static polyc_status count_occupied(const uint8_t *cls, const polyc_occupancy_gri
     return POLYC_OK;
 }
 
+/* Tiles of 32 x 32 cells that hold an occupied cell. */
+static uint64_t occupied_tiles(const uint8_t *cls, const polyc_occupancy_grid *grid)
+{
+    uint64_t n = 0;
+    for (uint32_t ty = 0; ty < grid->height; ty += POLYC__TILE_SIDE)
+        for (uint32_t tx = 0; tx < grid->width; tx += POLYC__TILE_SIDE) {
+            int any = 0;
+            for (uint32_t j = ty; !any && j < ty + POLYC__TILE_SIDE && j < grid->height; j++)
+                for (uint32_t i = tx; !any && i < tx + POLYC__TILE_SIDE && i < grid->width; i++)
+                    any = class_of(cls, grid->cells[(size_t)j * grid->width + i]) == CELL_OCCUPIED;
+            n += (uint64_t)any;
+        }
+    return n;
+}
+
 polyc_status polyc_limits_for_grid(const polyc_config *config, const polyc_occupancy_grid *grid,
                                    polyc_limits *out)
 {
@@ -114,7 +129,13 @@ polyc_status polyc_limits_for_grid(const polyc_config *config, const polyc_occup
      * optimiser's additions are bounded as for beams */
     out->max_scans = 0;
     out->max_beams = (uint32_t)occupied;
-    out->max_grid_cells = tx * ty * POLYC__TILE_CELLS;
+    /* only the tiles holding an occupied cell are stored; the directory of
+     * all tiles must fit the budget too (polyc__grid_dir_cap: 4 entries a
+     * tile and 64) */
+    uint64_t tiles = occupied_tiles(cls, grid), dir_n = (uint64_t)tx * ty;
+    if (tiles * 4 + 64 < dir_n)
+        tiles = (dir_n - 64 + 3) / 4;
+    out->max_grid_cells = (uint32_t)(tiles * POLYC__TILE_CELLS);
     out->max_vertices = (uint32_t)occupied + 1024u;
     out->max_points = (uint32_t)occupied;
     return POLYC_OK;

@@ -24,7 +24,8 @@ typedef struct polyc__rays {
 
 typedef struct polyc__opt {
     polyc_ctx *ctx;
-    const polyc_config *cfg;
+    const polyc_config *cfg;       /* ctx->cfg, or grid_cfg for an occupancy grid */
+    polyc_config grid_cfg;
     polyc__store *s;
 
     /* data: weighted points sorted by hash bucket, and their assignment */

@@ -55,16 +55,17 @@ static double scene_dist(double x, double y)
 }
 
 /* A grid whose cells are `res` wide, turned by `yaw`, holding the room (in
- * the map frame) with 0.5 m to spare: a cell whose centre lies within 0.6
- * cells of a wall is occupied (walls 1-2 cells thick, as maps from SLAM
- * draw them), the room's other cells free, all others unknown (-1). */
+ * the map frame) with 0.5 m to spare: a cell whose centre lies within
+ * `thick_cells` cells of a wall is occupied (0.6: walls 1-2 cells thick, as
+ * maps from SLAM draw them; 1.1: 2-3 cells), the room's other cells free,
+ * all others unknown (-1). */
 typedef struct scene {
     polyc_occupancy_grid grid;
     int8_t *cells;
     uint32_t occupied;
 } scene;
 
-static void scene_make(scene *s, double yaw, double res)
+static void scene_make_thick(scene *s, double yaw, double res, double thick_cells)
 {
     double c = cos(yaw), sn = sin(yaw), lo_x = 1e9, lo_y = 1e9, hi_x = -1e9, hi_y = -1e9;
     for (int k = 0; k < 4; k++) {
@@ -89,7 +90,7 @@ static void scene_make(scene *s, double yaw, double res)
             double gx = (i + 0.5) * res, gy = (j + 0.5) * res;
             double x = s->grid.origin_x_m + c * gx - sn * gy, y = s->grid.origin_y_m + sn * gx + c * gy;
             int8_t v = -1;
-            if (scene_dist(x, y) <= 0.6 * res)
+            if (scene_dist(x, y) <= thick_cells * res)
                 v = 100;
             else if (x > 0 && x < 6 && y > 0 && y < 4 && !(x > 3.5 && x < 4.5 && y > 1.5 && y < 2.5))
                 v = 0;
@@ -97,6 +98,11 @@ static void scene_make(scene *s, double yaw, double res)
             s->cells[(size_t)j * s->grid.width + i] = v;
         }
     s->grid.cells = s->cells;
+}
+
+static void scene_make(scene *s, double yaw, double res)
+{
+    scene_make_thick(s, yaw, res, 0.6);
 }
 
 static void scene_free(scene *s)
@@ -241,6 +247,30 @@ static void test_room_rotated_grid(void **state)
         close_opened(&o);
         scene_free(&s);
     }
+}
+
+/* The same room at other resolutions and with thicker walls: the same
+ * corners (alpha is weighed by the resolution, docs/algorithm.md). */
+static void test_room_resolutions(void **state)
+{
+    (void)state;
+    const double res[] = {0.025, 0.1, 0.15, 0.05};
+    for (size_t k = 0; k < sizeof res / sizeof res[0]; k++)
+        for (int thick = 0; thick < 2; thick++) {
+            scene s;
+            opened o;
+            char what[64];
+            snprintf(what, sizeof what, "%.3f m cells, walls %s", res[k], thick ? "2-3 cells" : "1-2 cells");
+            scene_make_thick(&s, 0.7, res[k], thick ? 1.1 : 0.6);
+            open_for(&o, &s.grid);
+            assert_int_equal(polyc_add_grid(o.ctx, &s.grid), POLYC_OK);
+            polyc_status st = polyc_build(o.ctx, NULL, NULL);
+            if (st != POLYC_OK)
+                fail_msg("%s: %s (%s)", what, polyc_status_str(st), polyc_last_error(o.ctx));
+            check_room_map(o.ctx, res[k], what);
+            close_opened(&o);
+            scene_free(&s);
+        }
 }
 
 /* The same grid twice gives the same map; the stages can be rerun. */
@@ -708,6 +738,42 @@ static void test_exhaustion(void **state)
     scene_free(&s);
 }
 
+/* The room in a corner of a 80 m x 80 m grid that is unknown elsewhere:
+ * the limits store the tiles that hold occupied cells (and the directory of
+ * all tiles), not the whole grid, and the map is the same room. */
+static void test_sparse_grid(void **state)
+{
+    (void)state;
+    scene s;
+    scene_make(&s, 0.3, RES);
+    const uint32_t side = 1600, at_x = 700, at_y = 900;
+    int8_t *big = malloc((size_t)side * side);
+    assert_non_null(big);
+    memset(big, -1, (size_t)side * side);
+    for (uint32_t j = 0; j < s.grid.height; j++)
+        memcpy(big + (size_t)(j + at_y) * side + at_x, s.cells + (size_t)j * s.grid.width, s.grid.width);
+    polyc_occupancy_grid g = s.grid;
+    double c = cos(0.3), sn = sin(0.3), dx = at_x * RES, dy = at_y * RES;
+    g.origin_x_m -= c * dx - sn * dy;
+    g.origin_y_m -= sn * dx + c * dy;
+    g.width = g.height = side;
+    g.cells = big;
+    opened o;
+    open_for(&o, &g);
+    uint32_t all_tiles = (side / 32) * (side / 32);
+    assert_true(o.lim.max_grid_cells / 1024 < all_tiles / 2);
+    assert_int_equal(polyc_add_grid(o.ctx, &g), POLYC_OK);
+    assert_int_equal(polyc_build(o.ctx, NULL, NULL), POLYC_OK);
+    check_room_map(o.ctx, RES, "sparse grid");
+    polyc_stats st;
+    assert_int_equal(polyc_get_stats(o.ctx, &st), POLYC_OK);
+    assert_int_equal(st.grid_width, side);
+    assert_true(st.grid_tiles < 64);
+    close_opened(&o);
+    free(big);
+    scene_free(&s);
+}
+
 /* A grid with nothing occupied: no polylines, no error. */
 static void test_empty_grid(void **state)
 {
@@ -738,12 +804,14 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_room_rotated_grid),
+        cmocka_unit_test(test_room_resolutions),
         cmocka_unit_test(test_stages_and_determinism),
         cmocka_unit_test(test_thresholds_and_queries),
         cmocka_unit_test(test_bad_grids),
         cmocka_unit_test(test_one_kind_of_input),
         cmocka_unit_test(test_too_small),
         cmocka_unit_test(test_exhaustion),
+        cmocka_unit_test(test_sparse_grid),
         cmocka_unit_test(test_empty_grid),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -9,6 +9,10 @@
         print(line.closed, line.points)               # [(x, y), ...] in metres
     print(result.stats["memory_used_bytes"])
 
+    # a ROS map (nav_msgs/OccupancyGrid data: int8, -1 unknown, 0..100)
+    result = polyc.build_map_from_grid(msg.data, msg.info.width, msg.info.height,
+                                       msg.info.resolution, origin=(x, y, yaw))
+
 The library is loaded from $POLYC_LIB, else from build/libpolyc.so of the
 repository this file lives in, else from the system (ctypes.util). At import
 the ctypes structs are checked against polyc_struct_size(): a binding that
@@ -25,7 +29,7 @@ import os
 from array import array
 from typing import NamedTuple, Sequence, Tuple, List
 
-__all__ = ["PolycError", "Scan", "Polyline", "Result", "Context", "build_map",
+__all__ = ["PolycError", "Scan", "Polyline", "Result", "Context", "build_map", "build_map_from_grid",
            "default_config", "version", "STATUS", "FLAG_EXACT_POINTS", "FLAG_NO_GRAZING",
            "FLAG_GRID_TRACE"]
 
@@ -61,7 +65,7 @@ class _Config(ctypes.Structure):
         "max_extent_m", "alpha", "gamma", "merge_dist_m", "split_gap_m", "step_m", "noise_m",
         "noise_decay", "overlap_m", "search_radius_m")] + [
         ("patience", _u32), ("max_iterations", _u32), ("flags", _u32), ("reserved", _u32),
-        ("seed", _u64)]
+        ("seed", _u64), ("occupied_thresh", _f32), ("free_thresh", _f32)]
 
 
 class _Limits(ctypes.Structure):
@@ -99,9 +103,15 @@ class _Iteration(ctypes.Structure):
                 ("reserved", _u32), ("bic", _f64), ("best_bic", _f64), ("noise_m", _f64)]
 
 
+class _OccupancyGrid(ctypes.Structure):
+    _fields_ = [("width", _u32), ("height", _u32), ("resolution_m", _f32), ("reserved", _u32),
+                ("origin_x_m", _f64), ("origin_y_m", _f64), ("origin_yaw_rad", _f64),
+                ("cells", ctypes.POINTER(ctypes.c_int8))]
+
+
 _STRUCTS = {"polyc_config": _Config, "polyc_limits": _Limits, "polyc_scan": _Scan,
             "polyc_box": _Box, "polyc_polyline": _Polyline, "polyc_stats": _Stats,
-            "polyc_iteration": _Iteration}
+            "polyc_iteration": _Iteration, "polyc_occupancy_grid": _OccupancyGrid}
 _PROGRESS = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.POINTER(_Iteration))
 
 
@@ -131,10 +141,12 @@ def _load():
         "polyc_config_default": (None, [P(_Config)]),
         "polyc_config_check": (st, [P(_Config), P(ctypes.c_char_p)]),
         "polyc_limits_for_scans": (st, [P(_Config), P(_Scan), _u32, P(_Limits)]),
+        "polyc_limits_for_grid": (st, [P(_Config), P(_OccupancyGrid), P(_Limits)]),
         "polyc_memory_size": (sz, [P(_Config), P(_Limits)]),
         "polyc_init": (st, [ctypes.c_void_p, sz, P(_Config), P(_Limits), P(ctx)]),
         "polyc_reset": (st, [ctx]),
         "polyc_add_scan": (st, [ctx, P(_Scan)]),
+        "polyc_add_grid": (st, [ctx, P(_OccupancyGrid)]),
         "polyc_build_grid": (st, [ctx]),
         "polyc_extract_contour": (st, [ctx]),
         "polyc_trace": (st, [ctx]),
@@ -225,6 +237,37 @@ def _scan(scan):
     return s, buf
 
 
+def _grid(cells, width, height, resolution, origin):
+    """An _OccupancyGrid and the int8 array it points to (keep both alive).
+    cells: any buffer of bytes (bytes, bytearray, array('b'), a numpy int8
+    array; byte 255 is -1) or a sequence of ints, width * height of them,
+    row-major from the origin's row."""
+    width, height = int(width), int(height)
+    if width < 0 or height < 0:
+        raise ValueError("width and height must not be negative")
+    try:
+        view = memoryview(cells)
+    except TypeError:
+        view = None
+    if view is not None:
+        if view.itemsize != 1 or view.format not in ("b", "B", "c"):
+            raise TypeError("cells must be a buffer of int8 (format 'b'), not format %r"
+                            % view.format)
+        data = view.tobytes()              # any layout, in C order
+    else:
+        try:
+            data = array("b", cells).tobytes()
+        except OverflowError:
+            raise PolycError(ERR_CONFIG, "grid", "grid cell value outside -1..100") from None
+    if len(data) != width * height:
+        raise ValueError("%d cells given for a grid of %d x %d" % (len(data), width, height))
+    buf = (ctypes.c_int8 * max(len(data), 1)).from_buffer_copy(data or b"\0")
+    x, y, yaw = origin
+    g = _OccupancyGrid(width, height, resolution, 0, x, y, yaw,
+                       ctypes.cast(buf, ctypes.POINTER(ctypes.c_int8)))
+    return g, buf
+
+
 def _progress(fn):
     """A C callback calling fn(dict of polyc_iteration); a true result stops."""
     if fn is None:
@@ -273,6 +316,12 @@ class Context:
         s, _buf = _scan((pose, start_angle_rad, angle_step_rad, min_range_m, max_range_m,
                          ranges_m))
         self._check(_lib.polyc_add_scan(self._ctx, ctypes.byref(s)), "add scan")
+
+    def add_grid(self, cells, width, height, resolution, origin=(0.0, 0.0, 0.0)):
+        """Takes an occupancy grid (see build_map_from_grid for the arguments);
+        a context holds one grid or scans, not both."""
+        g, _buf = _grid(cells, width, height, resolution, origin)
+        self._check(_lib.polyc_add_grid(self._ctx, ctypes.byref(g)), "add grid")
 
     def build(self, progress=None):
         """Grid, contour, trace and (if max_iterations > 0) the optimiser.
@@ -333,6 +382,31 @@ def build_map(scans, memory_bytes=None, max_vertices=0, progress=None, **config)
                    lim.max_points), memory_bytes, **config)
     for i, (s, _) in enumerate(held):
         ctx._check(_lib.polyc_add_scan(ctx._ctx, ctypes.byref(s)), "add scan %d" % i)
+    ctx.build(progress)
+    return Result(ctx.polylines(), ctx.stats())
+
+
+def build_map_from_grid(cells, width, height, resolution, origin=(0.0, 0.0, 0.0),
+                        memory_bytes=None, progress=None, **config):
+    """Maps an occupancy grid as ROS keeps it (nav_msgs/OccupancyGrid): cells
+    (column i, row j) at cells[j * width + i], -1 unknown, 0..100 occupancy
+    (occupied from occupied_thresh * 100, free up to free_thresh * 100);
+    origin = (x, y, yaw) of cell (0, 0)'s outer corner, resolution in metres.
+    cells: bytes, bytearray, array('b'), a numpy int8 array (any buffer of
+    int8) or a list of ints. Returns a Result, polylines in the map frame."""
+    cfg = _config(config)
+    g, _buf = _grid(cells, width, height, resolution, origin)
+    lim = _Limits()
+    status = _lib.polyc_limits_for_grid(ctypes.byref(cfg), ctypes.byref(g), ctypes.byref(lim))
+    if status != OK:
+        detail = {ERR_EXTENT: "the grid spans more than max_extent_m",
+                  ERR_CONFIG: "a bad grid: resolution must be > 0, width and height >= 1, "
+                              "cell values -1..100, origin finite",
+                  ERR_NULL: "no cells"}.get(status, "")
+        raise PolycError(status, "limits for grid", detail)
+    ctx = Context((lim.max_scans, lim.max_beams, lim.max_grid_cells, lim.max_vertices,
+                   lim.max_points), memory_bytes, **config)
+    ctx._check(_lib.polyc_add_grid(ctx._ctx, ctypes.byref(g)), "add grid")
     ctx.build(progress)
     return Result(ctx.polylines(), ctx.stats())
 
