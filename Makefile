@@ -118,7 +118,8 @@ $(BUILD)/footprint8: examples/footprint.c $(EMB_OBJ)
 # (tests/cli_bad_input.sh). test-fuzz-replay: the committed fuzz corpus through
 # the fuzz targets, built with $(CC). test-asan: unit tests, corpus replay and
 # the quick bad-input tests again in build-asan/ under ASan and UBSan.
-# test-valgrind: the tool over a sample log and a bad one, no error or leak.
+# test-valgrind: the tool over a sample log, its grid as a ROS map and a bad
+# log, no error or leak.
 FUZZ_TARGETS = scanlog library mapyaml pgm
 FUZZ_REPLAY  = $(FUZZ_TARGETS:%=$(BUILD)/tests/fuzz_replay_%)
 $(BUILD)/tests/fuzz_replay_%: tests/fuzz_%.c tests/fuzz_replay.c $(TOOL_OBJ) $(BUILD)/libpolyc.a
@@ -141,10 +142,13 @@ test-valgrind: $(BUILD)/polyc
 	$(VALGRIND) --error-exitcode=1 $(BUILD)/polyc --stats --iterations 20 \
 	    -o $(BUILD)/valgrind.svg examples/office.log
 	$(VALGRIND) --error-exitcode=1 $(BUILD)/polyc convert -o $(BUILD)/valgrind.txt examples/office.log
+	$(VALGRIND) --error-exitcode=1 $(BUILD)/polyc grid -o $(BUILD)/valgrind_grid examples/office.log
+	$(VALGRIND) --error-exitcode=1 $(BUILD)/polyc --stats --iterations 5 -o $(BUILD)/valgrind.svg \
+	    $(BUILD)/valgrind_grid.yaml
 	printf 'SCAN 0 0 0 0 0.1 0.05 4 3 1 1 1\nSCAN 0 0 0 0 0.1 0.05 4 3 1 x 1\n' > $(BUILD)/valgrind_bad.log
 	$(VALGRIND) --error-exitcode=99 $(BUILD)/polyc -o $(BUILD)/valgrind.svg $(BUILD)/valgrind_bad.log; \
 	    test $$? = 1
-	rm -f $(BUILD)/valgrind.svg $(BUILD)/valgrind.txt $(BUILD)/valgrind_bad.log
+	rm -f $(BUILD)/valgrind.svg $(BUILD)/valgrind.txt $(BUILD)/valgrind_bad.log $(BUILD)/valgrind_grid.*
 
 # libFuzzer (`make fuzz FUZZ_TIME=600`; needs clang): every target in
 # build-fuzz/, run one after the other on a scratch corpus seeded from
