@@ -335,6 +335,8 @@ run --occupied-thresh 0.5 -o map.svg lf.log
 name=map-thresholds
 run --occupied-thresh 0.9 --free-thresh 0.1 --format txt room.yaml
 [ $rc -eq 0 ] && inside -0.9 -0.1 2.25 2.7 || bad "exit $rc with --occupied-thresh and --free-thresh"
+name=log-through-a-pipe
+cat lf.log | { run --format txt /dev/stdin; cmp -s out.txt lf.txt || bad "exit $rc, or a log read through a pipe differs"; }
 name=convert-map
 run convert room.yaml
 [ $rc -eq 1 ] && grep -q "^polyc: room.yaml: a map YAML: polyc convert takes a laser log$" err.txt \

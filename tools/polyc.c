@@ -1131,11 +1131,15 @@ static int grid_files(const options *o, run *r, double t_start)
 
 enum input_kind { INPUT_LOG, INPUT_MAP_YAML, INPUT_IMAGE };
 
-/* A map YAML or an image is told from a log by its first bytes; anything
+/* A map YAML or an image is told from a log by its first bytes. Only a
+ * regular file is looked at (a pipe would lose what is read); anything
  * unreadable is left to the log reader, which reports it. */
 static enum input_kind sniff(const char *path)
 {
     char head[65536];
+    struct stat st;
+    if (stat(path, &st) != 0 || !S_ISREG(st.st_mode))
+        return INPUT_LOG;
     FILE *f = fopen(path, "rb");
     if (!f)
         return INPUT_LOG;
