@@ -332,6 +332,14 @@ name=log-option-refused
 run --occupied-thresh 0.5 -o map.svg lf.log
 [ $rc -eq 2 ] && grep -q "^polyc: --occupied-thresh does not apply to a laser log$" err.txt \
     || bad "exit $rc for --occupied-thresh on a log"
+name=map-grid-layer
+run --grid --vertices --quiet -o map.svg room.yaml
+[ $rc -eq 0 ] && grep -q '<path' map.svg || bad "exit $rc for --grid on a map"
+rm -f map.svg
+name=map-grid-layer-yaw
+run --grid -o map.svg yaw.yaml
+[ $rc -eq 2 ] && grep -q '^polyc: --grid draws the grid unrotated' err.txt && [ ! -e map.svg ] \
+    || bad "exit $rc for --grid on a turned map"
 name=map-thresholds
 run --occupied-thresh 0.9 --free-thresh 0.1 --format txt room.yaml
 [ $rc -eq 0 ] && inside -0.9 -0.1 2.25 2.7 || bad "exit $rc with --occupied-thresh and --free-thresh"
