@@ -259,9 +259,9 @@ POLYC_API polyc_status polyc_add_grid(polyc_ctx *ctx, const polyc_occupancy_grid
  * max_points the occupied cells (each is one data point and at most one
  * contour cell), max_vertices that + 1024, max_grid_cells the 32 x 32-cell
  * tiles that hold an occupied cell (at least a quarter of all the grid's
- * tiles, for their directory). More occupied cells than max_beams is POLYC_ERR_LIMIT,
- * more tiles than max_grid_cells POLYC_ERR_NOMEM; cells NULL is
- * POLYC_ERR_NULL; a grid wider or taller than config.max_extent_m is
+ * tiles, for their directory). More occupied cells than max_beams is
+ * POLYC_ERR_LIMIT, more tiles than max_grid_cells POLYC_ERR_NOMEM; cells
+ * NULL is POLYC_ERR_NULL; a grid wider or taller than config.max_extent_m is
  * POLYC_ERR_EXTENT. The polylines come in the map frame (the origin pose
  * applied); polyc_grid_info gives the origin corner and the resolution,
  * polyc_grid_cell hits 1 for an occupied cell, misses 1 for a free one (in

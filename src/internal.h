@@ -224,6 +224,8 @@ struct polyc_ctx {
     int from_grid;
     double frame_cos, frame_sin;
     size_t base_mark;              /* arena use after polyc_init's scan storage */
+    polyc_config grid_cfg;         /* the optimiser's weights for it (optimize.c);
+                                      here, not on the optimiser's stack */
     polyc__scan *scans;
     float *ranges;
     uint32_t scan_count, range_count;

@@ -269,7 +269,12 @@ polyc_status polyc__occ_add(polyc_ctx *ctx, const polyc_occupancy_grid *grid)
     if (occupied > ctx->lim.max_beams)
         return polyc__fail(ctx, POLYC_ERR_LIMIT,
                            "more occupied cells than limits.max_beams (polyc_limits_for_grid)");
-    size_t mark = ctx->arena.used;
+    /* in the block where the scans' grid would start (an empty context may
+     * have run its stages: their results go) */
+    size_t mark = ctx->scans_mark;
+    ctx->arena.used = mark;
+    ctx->stage = POLYC__STAGE_SCANS;
+    ctx->flat.count = 0;
     memset(&ctx->grid, 0, sizeof ctx->grid);
     st = fill(ctx, grid, cls, tx, ty);
     size_t head = polyc__bytes(1, sizeof(polyc_ctx));

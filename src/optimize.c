@@ -66,8 +66,9 @@ size_t polyc__optimizer_bytes(const polyc_config *cfg, const polyc_limits *lim)
 #define GRID_CELL_M 0.025f
 #define GRID_RADIUS_CELLS 3.0f
 
-static const polyc_config *grid_config(const polyc_ctx *ctx, polyc_config *c)
+static const polyc_config *grid_config(polyc_ctx *ctx)
 {
+    polyc_config *c = &ctx->grid_cfg;
     float r = ctx->grid.cell_m, k = GRID_CELL_M / r;
     *c = ctx->cfg;
     c->alpha = ctx->cfg.alpha * k * k;
@@ -83,7 +84,7 @@ polyc_status polyc__opt_setup(polyc_ctx *ctx, polyc__opt *o)
 {
     memset(o, 0, sizeof *o);
     o->ctx = ctx;
-    o->cfg = ctx->from_grid ? grid_config(ctx, &o->grid_cfg) : &ctx->cfg;
+    o->cfg = ctx->from_grid ? grid_config(ctx) : &ctx->cfg;
     o->s = &ctx->store;
     o->R = o->cfg->search_radius_m;
     o->R2 = o->R * o->R;

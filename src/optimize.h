@@ -24,8 +24,7 @@ typedef struct polyc__rays {
 
 typedef struct polyc__opt {
     polyc_ctx *ctx;
-    const polyc_config *cfg;       /* ctx->cfg, or grid_cfg for an occupancy grid */
-    polyc_config grid_cfg;
+    const polyc_config *cfg;       /* ctx->cfg, or ctx->grid_cfg for an occupancy grid */
     polyc__store *s;
 
     /* data: weighted points sorted by hash bucket, and their assignment */

@@ -634,8 +634,13 @@ static void test_too_small(void **state)
         if (k == 1) /* the traced map is the result */
             assert_true(polyc_polyline_count(ctx) >= 2);
     }
-    /* the full limits build in exactly the queried size */
+    /* the full limits build in exactly the queried size, also after the
+     * empty context has been built and a grid refused */
     assert_int_equal(polyc_init(block, need, &cfg, &full, &ctx), POLYC_OK);
+    assert_int_equal(polyc_build(ctx, NULL, NULL), POLYC_OK);
+    polyc_occupancy_grid bad = s.grid;
+    bad.reserved = 7;
+    assert_int_equal(polyc_add_grid(ctx, &bad), POLYC_ERR_CONFIG);
     assert_int_equal(polyc_add_grid(ctx, &s.grid), POLYC_OK);
     assert_int_equal(polyc_build(ctx, NULL, NULL), POLYC_OK);
     check_room_map(ctx, RES, "exact block");
