@@ -119,8 +119,9 @@ $(BUILD)/footprint8: examples/footprint.c $(EMB_OBJ)
 # (tests/cli_bad_input.sh). test-fuzz-replay: the committed fuzz corpus through
 # the fuzz targets, built with $(CC). test-asan: unit tests, corpus replay and
 # the quick bad-input tests again in build-asan/ under ASan and UBSan.
-# test-valgrind: the tool over a sample log and a bad one, no error or leak.
-FUZZ_TARGETS = scanlog library
+# test-valgrind: the tool over a sample log, its grid as a ROS map and a bad
+# log, no error or leak.
+FUZZ_TARGETS = scanlog library mapyaml pgm
 FUZZ_REPLAY  = $(FUZZ_TARGETS:%=$(BUILD)/tests/fuzz_replay_%)
 $(BUILD)/tests/fuzz_replay_%: tests/fuzz_%.c tests/fuzz_replay.c $(TOOL_OBJ) $(BUILD)/libpolyc.a
 	@mkdir -p $(dir $@)
@@ -142,12 +143,15 @@ test-valgrind: $(BUILD)/polyc
 	$(VALGRIND) --error-exitcode=1 $(BUILD)/polyc --stats --iterations 20 \
 	    -o $(BUILD)/valgrind.svg examples/office.log
 	$(VALGRIND) --error-exitcode=1 $(BUILD)/polyc convert -o $(BUILD)/valgrind.txt examples/office.log
+	$(VALGRIND) --error-exitcode=1 $(BUILD)/polyc grid -o $(BUILD)/valgrind_grid examples/office.log
+	$(VALGRIND) --error-exitcode=1 $(BUILD)/polyc --stats --iterations 5 -o $(BUILD)/valgrind.svg \
+	    $(BUILD)/valgrind_grid.yaml
 	printf 'SCAN 0 0 0 0 0.1 0.05 4 3 1 1 1\nSCAN 0 0 0 0 0.1 0.05 4 3 1 x 1\n' > $(BUILD)/valgrind_bad.log
 	$(VALGRIND) --error-exitcode=99 $(BUILD)/polyc -o $(BUILD)/valgrind.svg $(BUILD)/valgrind_bad.log; \
 	    test $$? = 1
-	rm -f $(BUILD)/valgrind.svg $(BUILD)/valgrind.txt $(BUILD)/valgrind_bad.log
+	rm -f $(BUILD)/valgrind.svg $(BUILD)/valgrind.txt $(BUILD)/valgrind_bad.log $(BUILD)/valgrind_grid.*
 
-# libFuzzer (`make fuzz FUZZ_TIME=600`; needs clang): both targets in
+# libFuzzer (`make fuzz FUZZ_TIME=600`; needs clang): every target in
 # build-fuzz/, run one after the other on a scratch corpus seeded from
 # tests/corpus/; `make fuzz-merge` adds to tests/corpus/ the inputs that reach
 # new edges (hit counts ignored, which keeps the committed corpus small).
@@ -158,9 +162,11 @@ FUZZ_CFLAGS = $(WARN) -g -O2 -fno-omit-frame-pointer -fsanitize=fuzzer,$(SAN_LIS
               -Iinclude -Itools -D_POSIX_C_SOURCE=200809L
 build-fuzz/fuzz_scanlog: tests/fuzz_scanlog.c tools/scanlog.c $(LIB_SRC)
 build-fuzz/fuzz_library: tests/fuzz_library.c $(LIB_SRC)
+build-fuzz/fuzz_mapyaml: tests/fuzz_mapyaml.c tools/mapfile.c
+build-fuzz/fuzz_pgm: tests/fuzz_pgm.c tools/mapfile.c
 # the optimiser's float compares drown the run in comparison tracing: off
 build-fuzz/fuzz_library: FUZZ_CFLAGS += -fno-sanitize-coverage=trace-cmp
-$(FUZZ_BIN): include/polyc.h $(wildcard src/*.h) tools/scanlog.h
+$(FUZZ_BIN): include/polyc.h $(wildcard src/*.h) tools/scanlog.h tools/mapfile.h
 	@mkdir -p $(dir $@)
 	$(FUZZ_CC) $(FUZZ_CFLAGS) $(filter %.c,$^) -o $@ -lm
 fuzz: $(FUZZ_BIN)

@@ -1,5 +1,6 @@
 #!/bin/sh
-# cli_bad_input.sh - every bad input of issue 6 through the polyc tool.
+# cli_bad_input.sh - every bad input of issue 6 through the polyc tool, and
+# bad ROS maps (a map YAML and its PGM) and `polyc grid`.
 #   tests/cli_bad_input.sh [--quick] POLYC
 # Each input must give either a map (exit 0, what was skipped counted in
 # --stats) or one line `polyc: FILE:LINE: reason` on stderr with a non-zero
@@ -16,6 +17,7 @@ fi
 [ $# -eq 1 ] || { echo "usage: $0 [--quick] POLYC" >&2; exit 2; }
 case $1 in /*) POLYC=$1 ;; *) POLYC=$(pwd)/$1 ;; esac
 [ -x "$POLYC" ] || { echo "$0: $POLYC is not executable" >&2; exit 2; }
+ROOT=$(cd "$(dirname "$0")/.." && pwd)   # for examples/office.log
 
 T=$(mktemp -d "${TMPDIR:-/tmp}/polyc_cli.XXXXXX") || exit 2
 trap 'rm -rf "$T"' EXIT INT TERM
@@ -45,21 +47,29 @@ run() {
         bad "exit $rc (timeout, crash or signal)"
         return 1
     fi
-    if ls map.svg.tmp* > /dev/null 2>&1; then
+    if ls map.svg.tmp* g.pgm.tmp* g.yaml.tmp* > /dev/null 2>&1; then
         bad "a temporary output file is left behind"
-        rm -f map.svg.tmp*
+        rm -f map.svg.tmp* g.pgm.tmp* g.yaml.tmp*
     fi
+    # stderr is a file here: no progress line (it would carry a carriage return)
+    if grep -q "$(printf '\r')" err.txt; then bad "a progress line on stderr, which is not a terminal"; fi
     return 0
 }
 
 # refused NAME FILE LINE PATTERN: exit 1, `polyc: FILE:LINE: ...` matching
 # PATTERN (grep -E, after the prefix) as the only stderr line, no output file.
 refused() {
-    name=$1 file=$2 line=$3 pattern=$4
+    prefix="polyc: $2:$3: "
+    [ "$3" = - ] && prefix="polyc: $2: "
+    refused_as "$1" "$2" "$prefix" "$4"
+}
+
+# refused_as NAME FILE PREFIX PATTERN: the same, with the message's prefix
+# given whole (a PGM's is `polyc: IMAGE: byte N: `).
+refused_as() {
+    name=$1 file=$2 prefix=$3 pattern=$4
     rm -f map.svg
     run -o map.svg "$file" || return
-    prefix="polyc: $file:$line: "
-    [ "$line" = - ] && prefix="polyc: $file: "
     [ $rc -eq 1 ] || bad "exit $rc, expected 1"
     [ -e map.svg ] && bad "map.svg exists after a failure"
     [ -s out.txt ] && bad "stdout is not empty"
@@ -215,6 +225,200 @@ run -o map.svg adir
     || bad "exit $rc for a directory as input"
 [ -e map.svg ] && bad "map.svg exists after a failure"
 
+# ---- ROS maps: a map YAML and its PGM image ----
+# A room in the image's top half (PGM rows 2..10 of 16), so that a row order
+# turned upside down shows: its walls are at cell centres x -0.875..-0.125,
+# y 2.275..2.675 with the origin (-1, 2) and 5 cm cells.
+awk 'BEGIN { w = 20; h = 16; printf "P2\n# a room\n%d %d\n255\n", w, h
+    for (y = 0; y < h; y++) { for (x = 0; x < w; x++) {
+        v = (x < 2 || y < 2 || x > w - 3 || y > 10) ? 205 : (x == 2 || y == 2 || x == w - 3 || y == 10) ? 0 : 254
+        printf "%d ", v }; printf "\n" } }' > room.pgm
+REST='origin: [-1.0, 2.0, 0.0]
+negate: 0
+occupied_thresh: 0.65
+free_thresh: 0.196'
+printf 'image: room.pgm\nresolution: 0.05\n%s\n' "$REST" > room.yaml
+# inside BOX (x0 x1 y0 y1): every point of the TXT map in out.txt is
+inside() {
+    awk -v x0=$1 -v x1=$2 -v y0=$3 -v y1=$4 '{ for (i = 3; i < NF; i += 2)
+        if ($i < x0 || $i > x1 || $(i + 1) < y0 || $(i + 1) > y1) bad++; n += $2 }
+        END { exit !(n >= 4 && bad == 0) }' out.txt
+}
+name=map-room
+run --format txt room.yaml
+[ $rc -eq 0 ] && [ -s out.txt ] || bad "exit $rc, no map"
+inside -0.9 -0.1 2.25 2.7 || bad "the room's polylines are not in the map's frame: $(head -c 300 out.txt)"
+name=map-room-yaw
+printf 'image: room.pgm\nresolution: 0.05\norigin: [1.0, 0.0, 1.5707963268]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n' > yaw.yaml
+run --format txt yaw.yaml
+# turned by 90 degrees about (1, 0): (x, y) in the grid -> (1 - y, x)
+[ $rc -eq 0 ] && inside 0.3 0.75 0.1 0.9 || bad "exit $rc, or the yaw is not applied: $(head -c 300 out.txt)"
+name=map-stats
+run --stats -o map.svg room.yaml
+[ $rc -eq 0 ] && tail -c 7 map.svg | grep -q '</svg>' || bad "exit $rc, no complete SVG"
+grep -qE '^map +20 x 16 cells of 0.05 m, room.pgm \(P2, maxval 255\), mode trinary$' err.txt \
+    || bad "--stats lacks the map line"
+grep -qE '^cells +occupied 46, free 98, unknown 176$' err.txt || bad "--stats lacks the cell counts"
+rm -f map.svg
+# the same room as P5 (binary), in another folder: the image is found next
+# to the YAML, or by its absolute path
+mkdir -p sub/dir
+{ printf 'P5\n20 16\n255\n'; awk 'NR > 4 { for (i = 1; i <= NF; i++) printf "%s\n", $i }' room.pgm |
+    while read -r v; do case $v in 0) printf '\000' ;; 254) printf '\376' ;; *) printf '\315' ;; esac; done
+} > sub/dir/room5.pgm
+printf 'image: room5.pgm\nresolution: 0.05\n%s\n' "$REST" > sub/dir/m.yaml
+printf 'image: "%s/sub/dir/room5.pgm"\nresolution: 0.05\n%s\n' "$T" "$REST" > abs.yaml
+run --format txt room.yaml && cp out.txt p2.txt
+for f in sub/dir/m.yaml abs.yaml; do
+    name="map-path-$f"
+    run --format txt "$f"
+    [ $rc -eq 0 ] && cmp -s out.txt p2.txt || bad "exit $rc, or the P5 map differs from the P2 one"
+done
+
+# refused: the YAML's line, or the image's byte
+cat > nonegate.yaml <<YAML
+image: room.pgm
+resolution: 0.05
+origin: [-1.0, 2.0, 0.0]
+occupied_thresh: 0.65
+free_thresh: 0.196
+YAML
+refused map-missing-key nonegate.yaml 5 'no negate key \(map_server needs it\)$'
+printf 'image: room.pgm\nresolution: 5cm\n%s\n' "$REST" > badnum.yaml
+refused map-bad-number badnum.yaml 2 "resolution: '5cm' is not a number$"
+printf 'image: room.pgm\nresolution: 0\n%s\n' "$REST" > res0.yaml
+refused map-resolution-0 res0.yaml 2 'resolution 0 must be above 0 m$'
+printf 'image: room.pgm\nresolution: 0.05\norigin: [0, 0, 0]\nnegate: 0\noccupied_thresh: 0.3\nfree_thresh: 0.4\n' > order.yaml
+refused map-free-above-occupied order.yaml 6 'free_thresh 0.4 must be below occupied_thresh 0.3$'
+printf 'image: room.pgm\nresolution: 0.05\norigin: [0, 0, 0]\nnegate: 0\noccupied_thresh: 1.2\nfree_thresh: 0.4\n' > over.yaml
+refused map-threshold-over-1 over.yaml 5 'occupied_thresh 1.2 is outside \[0, 1\]$'
+printf 'image: room.pgm\nresolution: 0.05\nmode: binary\n%s\n' "$REST" > mode.yaml
+refused map-bad-mode mode.yaml 3 "mode must be trinary, scale or raw, not 'binary'$"
+printf 'image: room.pgm\nresolution: 0.05\norigin: [0, 0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n' > origin2.yaml
+refused map-origin-2 origin2.yaml 3 'origin must have 3 elements \[x, y, yaw\], not 2$'
+printf 'image: nothere.pgm\nresolution: 0.05\n%s\n' "$REST" > noimg.yaml
+refused map-no-image noimg.yaml 1 'image nothere.pgm: No such file or directory$'
+printf 'image: "\\e[2J.pgm"\nresolution: 0.05\n%s\n' "$REST" > esc.yaml
+refused map-image-name-escaped esc.yaml 1 'image .x1b\[2J.pgm: No such file or directory$'
+printf 'image: adir\nresolution: 0.05\n%s\n' "$REST" > dirimg.yaml
+refused map-image-directory dirimg.yaml 1 'image adir: Is a directory$'
+printf '\211PNG\r\n\032\n\000\000\000\rIHDR' > png.pgm
+printf 'image: png.pgm\nresolution: 0.05\n%s\n' "$REST" > png.yaml
+refused_as map-png png.yaml 'polyc: png.pgm: byte 0: ' 'a PNG image: polyc reads PGM \(P5 or P2\) only; save the map as PGM'
+img() { printf 'image: %s\nresolution: 0.05\n%s\n' "$1" "$REST" > "$1.yaml"; }
+printf 'P5\n4 2\n255\n\000\000\000' > cut.pgm; img cut.pgm
+refused_as map-truncated cut.pgm.yaml 'polyc: cut.pgm: byte 14: ' 'truncated: 3 bytes of pixel data, 4 x 2 at 1 bytes a pixel need 8$'
+printf 'P5\n4 2\n255\n\000\000\000\000\000\000\000\000\n' > long.pgm; img long.pgm
+refused_as map-trailing long.pgm.yaml 'polyc: long.pgm: byte 19: ' '1 bytes after the pixel data \(trailing garbage, or the size does not match\)$'
+printf 'P5\n4 2\n0\n\000\000\000\000\000\000\000\000' > max0.pgm; img max0.pgm
+refused_as map-maxval-0 max0.pgm.yaml 'polyc: max0.pgm: byte 7: ' 'maxval is 0 \(must be 1..65535\)$'
+printf 'P5\n4 2\n70000\n' > maxbig.pgm; img maxbig.pgm
+refused_as map-maxval-70000 maxbig.pgm.yaml 'polyc: maxbig.pgm: byte 7: ' 'maxval above 65535$'
+printf 'P5\n65536 65536\n255\n' > huge.pgm; img huge.pgm
+refused_as map-huge huge.pgm.yaml 'polyc: huge.pgm: byte 9: ' '65536 x 65536 pixels: more than 268435456 cells$'
+printf 'P2\n3 1\n255\n0 0\n' > p2cut.pgm; img p2cut.pgm
+refused_as map-p2-truncated p2cut.pgm.yaml 'polyc: p2cut.pgm: byte 15: ' 'truncated: 2 of 3 pixel values \(3 x 1\)$'
+printf 'P2\n21 1\n255\n' > wide.pgm; i=0; while [ $i -lt 21 ]; do printf '0 ' >> wide.pgm; i=$((i + 1)); done
+printf 'image: wide.pgm\nresolution: 100\n%s\n' "$REST" > wide.yaml
+refused map-too-wide wide.yaml 2 'the map spans 2100.0 x 100.0 m \(21 x 1 cells of 100 m\): more than the grid.s limit of 2000 m$'
+refused map-image-given room.pgm - "an image: give the map's YAML file \(map_server's map.yaml\), which names the image$"
+printf 'P5\n4 2\n255\n\000\000\000\000\000\000\000\000' > direct.pgm
+refused map-p5-given direct.pgm - "an image: give the map's YAML file"
+name=map-option-refused
+run --cell 0.05 -o map.svg room.yaml
+[ $rc -eq 2 ] && grep -q "^polyc: --cell does not apply to a map YAML" err.txt && [ ! -e map.svg ] \
+    || bad "exit $rc for --cell on a map"
+name=log-option-refused
+run --occupied-thresh 0.5 -o map.svg lf.log
+[ $rc -eq 2 ] && grep -q "^polyc: --occupied-thresh does not apply to a laser log$" err.txt \
+    || bad "exit $rc for --occupied-thresh on a log"
+name=map-grid-layer
+run --grid --vertices --quiet -o map.svg room.yaml
+[ $rc -eq 0 ] && grep -q '<path' map.svg || bad "exit $rc for --grid on a map"
+rm -f map.svg
+name=map-grid-layer-yaw
+run --grid -o map.svg yaw.yaml
+[ $rc -eq 2 ] && grep -q '^polyc: --grid draws the grid unrotated' err.txt && [ ! -e map.svg ] \
+    || bad "exit $rc for --grid on a turned map"
+name=map-thresholds
+run --occupied-thresh 0.9 --free-thresh 0.1 --format txt room.yaml
+[ $rc -eq 0 ] && inside -0.9 -0.1 2.25 2.7 || bad "exit $rc with --occupied-thresh and --free-thresh"
+name=log-through-a-pipe
+cat lf.log | { run --format txt /dev/stdin; cmp -s out.txt lf.txt || bad "exit $rc, or a log read through a pipe differs"; }
+name=convert-map
+run convert room.yaml
+[ $rc -eq 1 ] && grep -q "^polyc: room.yaml: a map YAML: polyc convert takes a laser log$" err.txt \
+    || bad "exit $rc for convert of a map"
+
+# ---- polyc grid: the log's hit/miss grid as map_saver's two files ----
+name=grid-needs-prefix
+run grid lf.log
+[ $rc -eq 2 ] && grep -q '^polyc: polyc grid needs -o PREFIX' err.txt || bad "exit $rc without -o"
+name=grid-option-refused
+run grid --alpha 5 -o g lf.log
+[ $rc -eq 2 ] && grep -q '^polyc: --alpha does not apply to polyc grid$' err.txt && [ ! -e g.pgm ] \
+    || bad "exit $rc for --alpha"
+name=grid-files
+run grid -o g lf.log
+[ $rc -eq 0 ] && [ ! -s out.txt ] || bad "exit $rc, or output on stdout"
+head -c 3 g.pgm | grep -q '^P5$' || bad "g.pgm is not a P5 image"
+grep -qE '^image: g.pgm$' g.yaml && grep -qE '^resolution: 0.025000$' g.yaml &&
+    grep -qE '^origin: \[-?[0-9]+\.[0-9]{6}, -?[0-9]+\.[0-9]{6}, 0\.000000\]$' g.yaml &&
+    grep -qE '^negate: 0$' g.yaml && grep -qE '^occupied_thresh: 0.65$' g.yaml &&
+    grep -qE '^free_thresh: 0.196$' g.yaml || bad "g.yaml is not map_saver's: $(cat g.yaml)"
+name=grid-back-as-map
+run --format txt g.yaml
+[ $rc -eq 0 ] || bad "exit $rc reading polyc grid's map back"
+mkdir -p out
+name=grid-in-folder
+run grid --cell 0.05 -o out/g lf.log
+[ $rc -eq 0 ] && grep -q '^image: g.pgm$' out/g.yaml && grep -q '^resolution: 0.050000$' out/g.yaml \
+    || bad "exit $rc, or out/g.yaml names its image by more than its file name"
+name=grid-bad-log
+cp g.yaml g.yaml.old
+run grid -o g text.log
+[ $rc -eq 1 ] && cmp -s g.yaml g.yaml.old || bad "exit $rc, or a failed run changed g.yaml"
+rm -f g.pgm g.yaml
+run grid -o g text.log
+[ ! -e g.pgm ] && [ ! -e g.yaml ] || bad "a failed run left g.pgm or g.yaml"
+name=grid-unwritable
+run grid -o nodir/g lf.log
+[ $rc -eq 1 ] && [ ! -e nodir ] && grep -q '^polyc: nodir/g.pgm: cannot create a temporary file' err.txt \
+    || bad "exit $rc for an unwritable prefix"
+
+# ---- round trip: office.log -> polyc grid -> polyc PREFIX.yaml ----
+# The map from the grid must lie on the map from the log, and cover it: the
+# share of each map's length within 10 cm of the other (sampled every 2 cm).
+NEAR='function d2(px, py, i,   dx, dy, l2, t, qx, qy) {
+        dx = bx2[i] - bx1[i]; dy = by2[i] - by1[i]; l2 = dx * dx + dy * dy
+        t = l2 > 0 ? ((px - bx1[i]) * dx + (py - by1[i]) * dy) / l2 : 0
+        t = t < 0 ? 0 : t > 1 ? 1 : t
+        qx = bx1[i] + t * dx; qy = by1[i] + t * dy
+        return (px - qx) ^ 2 + (py - qy) ^ 2 }
+    FNR == 1 { file++ }
+    { n = $2; m = $1 == "closed" ? n : n - 1
+      for (k = 0; k < n; k++) { x[k] = $(3 + 2 * k); y[k] = $(4 + 2 * k) }
+      for (k = 0; k < m; k++) {
+        x1 = x[k]; y1 = y[k]; x2 = x[(k + 1) % n]; y2 = y[(k + 1) % n]
+        if (file == 1) { bx1[ns] = x1; by1[ns] = y1; bx2[ns] = x2; by2[ns] = y2; ns++; continue }
+        L = sqrt((x2 - x1) ^ 2 + (y2 - y1) ^ 2); steps = int(L / 0.02) + 1
+        for (s = 0; s < steps; s++) {
+          t = (s + 0.5) / steps; px = x1 + t * (x2 - x1); py = y1 + t * (y2 - y1)
+          best = 1e30; for (i = 0; i < ns; i++) { e = d2(px, py, i); if (e < best) best = e }
+          total += L / steps; if (best <= 0.01) near += L / steps } } }
+    END { printf "%.3f\n", (total > 0 ? near / total : 0) }'
+name=round-trip-office
+run --format txt "$ROOT/examples/office.log" && cp out.txt office_log.txt
+run grid -o office "$ROOT/examples/office.log"
+[ $rc -eq 0 ] || bad "polyc grid: exit $rc"
+run --format txt office.yaml && cp out.txt office_map.txt
+[ $rc -eq 0 ] && [ -s office_map.txt ] || bad "polyc office.yaml: exit $rc, or no polylines"
+on=$(awk "$NEAR" office_log.txt office_map.txt)
+covered=$(awk "$NEAR" office_map.txt office_log.txt)
+echo "round trip office.log: $on of the grid map's length within 10 cm of the log map, $covered of the log map's within 10 cm of it"
+awk -v a="$on" -v b="$covered" 'BEGIN { exit !(a >= 0.9 && b >= 0.9) }' \
+    || bad "the map from polyc grid's files is not on the log's map ($on, $covered)"
+
 # ---- big inputs: bounded time and memory ----
 if [ $quick = 0 ]; then
     # a 10 MB line: 1048576 ranges, the most one scan may have
@@ -240,6 +444,25 @@ if [ $quick = 0 ]; then
     took=$(( $(date +%s) - start ))
     [ $took -le 60 ] || bad "two million scans took $took s"
     rm -f long.log longodom.log toolong.log huge.log two_million.log
+    # progress on a terminal (script(1) gives polyc a pty): the stage, the
+    # iteration, vertices and BIC, on one line blanked at the end; nothing
+    # with --quiet; the map the same either way. Needs a run over 2 s.
+    F079="$ROOT/../shared/data/carmen/freiburg-079.log"
+    if command -v script > /dev/null 2>&1 && [ -r "$F079" ]; then
+        name=progress-on-a-terminal
+        count=$((count + 1))
+        script -qefc "'$POLYC' -o pty.svg '$F079'" pty.txt > /dev/null 2>&1 < /dev/null
+        grep -qE "$(printf '\r')polyc: optimize: iteration [0-9]+, [0-9]+ vertices, BIC -?[0-9.]+ \([0-9.]+ s\)" pty.txt \
+            || bad "no progress line on a terminal: $(head -c 300 pty.txt)"
+        grep -qE "$(printf '\r') +$(printf '\r')" pty.txt || bad "the progress line is not blanked at the end"
+        count=$((count + 1))
+        script -qefc "'$POLYC' --quiet -o pty2.svg '$F079'" pty2.txt > /dev/null 2>&1 < /dev/null
+        if grep -q 'polyc: ' pty2.txt; then bad "a progress line with --quiet"; fi
+        cmp -s pty.svg pty2.svg || bad "the map differs with and without the progress line"
+        rm -f pty.svg pty2.svg pty.txt pty2.txt
+    else
+        echo "progress-on-a-terminal: skipped (needs script(1) and ../shared/data/carmen/freiburg-079.log)"
+    fi
 fi
 
 echo "cli_bad_input: $count runs, $failed failures"

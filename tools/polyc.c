@@ -1,6 +1,10 @@
-/* polyc.c - the command-line tool: a laser log in, a polyline map out.
- *   polyc [options] INPUT        map as SVG (default), JSON or TXT
+/* polyc.c - the command-line tool: a laser log or a ROS map in, a polyline
+ * map out.
+ *   polyc [options] INPUT        map as SVG (default), JSON or TXT; INPUT is
+ *                                a log or a map_server map YAML (by content)
  *   polyc convert INPUT          the scans in the plain format
+ *   polyc grid LOG -o PREFIX     the hit/miss grid as map_saver's PREFIX.pgm
+ *                                and PREFIX.yaml
  * Exit codes: 0 ok, 1 bad input or other failure, 2 usage, 3 memory budget.
  * Formats and rules: docs/formats.md. */
 #include <errno.h>
@@ -13,6 +17,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "mapfile.h"
 #include "mapout.h"
 #include "polyc.h"
 #include "scanlog.h"
@@ -23,24 +28,59 @@
 #define TOOL_VERSION "0.1.0"
 
 enum format { FORMAT_SVG, FORMAT_JSON, FORMAT_TXT };
+enum command { CMD_MAP, CMD_CONVERT, CMD_GRID };
+
+/* The options that apply to some inputs only, as bits of options.given. */
+enum {
+    OPT_FORMAT = 1u << 0, OPT_OUTPUT = 1u << 1, OPT_TRACE = 1u << 2, OPT_SEED = 1u << 3,
+    OPT_ITERATIONS = 1u << 4, OPT_MAX_RANGE = 1u << 5, OPT_MEMORY = 1u << 6, OPT_CELL = 1u << 7,
+    OPT_THRESHOLD = 1u << 8, OPT_ALPHA = 1u << 9, OPT_GAMMA = 1u << 10, OPT_OCCUPIED = 1u << 11,
+    OPT_FREE = 1u << 12, OPT_STATS = 1u << 13, OPT_NO_OPTIMIZE = 1u << 14, OPT_EXACT = 1u << 15,
+    OPT_GRID_TRACE = 1u << 16, OPT_POINTS = 1u << 17, OPT_GRID = 1u << 18, OPT_VERTICES = 1u << 19
+};
+static const struct {
+    const char *name;
+    unsigned bit;
+} option_bits[] = {
+    {"--format", OPT_FORMAT},       {"-o", OPT_OUTPUT},           {"--output", OPT_OUTPUT},
+    {"--trace", OPT_TRACE},         {"--seed", OPT_SEED},         {"--iterations", OPT_ITERATIONS},
+    {"--max-range", OPT_MAX_RANGE}, {"--memory-mb", OPT_MEMORY},  {"--cell", OPT_CELL},
+    {"--threshold", OPT_THRESHOLD}, {"--alpha", OPT_ALPHA},       {"--gamma", OPT_GAMMA},
+    {"--occupied-thresh", OPT_OCCUPIED}, {"--free-thresh", OPT_FREE}, {"--stats", OPT_STATS},
+    {"--no-optimize", OPT_NO_OPTIMIZE}, {"--exact-points", OPT_EXACT},
+    {"--grid-trace", OPT_GRID_TRACE}, {"--points", OPT_POINTS}, {"--grid", OPT_GRID},
+    {"--vertices", OPT_VERTICES},
+};
+/* what applies where */
+#define OPTS_LOG_ONLY (OPT_CELL | OPT_THRESHOLD | OPT_MAX_RANGE | OPT_EXACT | OPT_GRID_TRACE | OPT_POINTS)
+#define OPTS_MAP_ONLY (OPT_OCCUPIED | OPT_FREE)
+#define OPTS_GRID_CMD (OPT_OUTPUT | OPT_CELL | OPT_MAX_RANGE | OPT_MEMORY | OPT_STATS)
 
 typedef struct options {
     const char *input;
     const char *output;        /* NULL or "-": stdout */
     const char *trace;
-    int convert;
+    enum command command;
     enum format format;
-    int stats, no_optimize, points, grid, vertices;
+    unsigned given;            /* OPT_* bits of the options on the command line */
+    int stats, no_optimize, points, grid, vertices, quiet;
     double max_range_m;        /* 0: detect */
     double memory_mb;          /* 0: no cap */
     polyc_config config;
 } options;
 
 static const char usage_text[] =
-    "usage: polyc [options] INPUT       learn a polyline map from a laser log\n"
+    "usage: polyc [options] INPUT       learn a polyline map from a laser log or a ROS map\n"
     "       polyc convert [-o FILE] [--max-range M] INPUT\n"
     "                                   write the scans in polyc's plain format\n"
-    "INPUT is a CARMEN log (FLASER, ROBOTLASER1) or a plain scan file; - is stdin.\n"
+    "       polyc grid [--cell M] [--max-range M] -o PREFIX LOG\n"
+    "                                   write the log's hit/miss grid as a ROS map:\n"
+    "                                   PREFIX.pgm and PREFIX.yaml, as map_saver does\n"
+    "INPUT is a CARMEN log (FLASER, ROBOTLASER1) or a plain scan file (- is stdin),\n"
+    "or a ROS map_server map YAML (found by its content: key: value lines naming an\n"
+    "image, a PGM). A map's cells are its own: --cell, --threshold, --max-range,\n"
+    "--exact-points, --grid-trace and --points act on scans and are refused for a\n"
+    "map; --occupied-thresh and --free-thresh apply to maps only.\n"
     "options:\n"
     "  --format svg|json|txt   output format (default svg)\n"
     "  -o, --output FILE       write FILE (atomically) instead of stdout\n"
@@ -58,14 +98,85 @@ static const char usage_text[] =
     "  --grid-trace            one scan: trace the grid's contour, not the beam order\n"
     "  --trace FILE            per iteration: iteration bic best_bic vertices polylines noise_m\n"
     "  --memory-mb N           fail (exit 3) if the library needs more than N MiB\n"
+    "  --occupied-thresh P     map: a cell of value >= 100 P is occupied (default 0.65)\n"
+    "  --free-thresh P         map: a cell of value 0..100 P is free (default 0.196)\n"
+    "  --quiet                 no progress line on a terminal (shown on stderr for runs\n"
+    "                          over 2 s: stage, iteration, vertices, BIC)\n"
     "  --points, --grid, --vertices\n"
     "                          SVG layers: scan endpoints, grid cells, vertex dots\n"
     "  --help, --version\n"
     "exit codes: 0 ok, 1 bad input or other failure, 2 usage, 3 memory budget too small\n";
 
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6;
+}
+
+/* ---- progress: one line on a terminal ---- */
+
+/* Shown on stderr when it is a terminal (not with --quiet), once a run has
+ * taken PROGRESS_AFTER_MS: the stage, and in the optimiser the iteration,
+ * vertices and BIC, rewritten in place (carriage return) at each stage and
+ * iteration, and blanked before anything else is written to stderr. The
+ * stages without a callback (grid, contour) show when they start. */
+#define PROGRESS_AFTER_MS 2000.0
+#define PROGRESS_EVERY_MS 100.0
+
+static struct progress {
+    int on;
+    double start_ms, last_ms;
+    const char *stage;
+    size_t shown;              /* characters of the line now on the terminal */
+} prog;
+
+static void progress_clear(void)
+{
+    if (!prog.shown)
+        return;
+    fputc('\r', stderr);
+    for (size_t i = 0; i < prog.shown; i++)
+        fputc(' ', stderr);
+    fputc('\r', stderr);
+    fflush(stderr);
+    prog.shown = 0;
+}
+
+static void progress_show(const polyc_iteration *it)
+{
+    if (!prog.on || !prog.stage)
+        return;
+    double now = now_ms();
+    if (now - prog.start_ms < PROGRESS_AFTER_MS || (it && now - prog.last_ms < PROGRESS_EVERY_MS))
+        return;
+    prog.last_ms = now;
+    char line[160];
+    int n = snprintf(line, sizeof line, "polyc: %s", prog.stage);
+    if (it && n > 0 && (size_t)n < sizeof line)
+        n += snprintf(line + n, sizeof line - (size_t)n, ": iteration %u, %u vertices, BIC %.1f",
+                      (unsigned)it->iteration, (unsigned)it->vertices, it->best_bic);
+    if (n > 0 && (size_t)n < sizeof line)
+        snprintf(line + n, sizeof line - (size_t)n, " (%.1f s)", (now - prog.start_ms) / 1e3);
+    size_t len = strlen(line);
+    fputc('\r', stderr);
+    fputs(line, stderr);
+    for (size_t i = len; i < prog.shown; i++)   /* over the rest of a longer line */
+        fputc(' ', stderr);
+    fflush(stderr);
+    prog.shown = len > prog.shown ? len : prog.shown;
+}
+
+static void progress_stage(const char *stage)
+{
+    prog.stage = stage;
+    progress_show(NULL);
+}
+
 static int complain(int code, const char *fmt, ...)
 {
     va_list ap;
+    progress_clear();
     fputs("polyc: ", stderr);
     va_start(ap, fmt);
     vfprintf(stderr, fmt, ap);
@@ -74,13 +185,6 @@ static int complain(int code, const char *fmt, ...)
     if (code == EXIT_USAGE)
         fputs("try 'polyc --help'\n", stderr);
     return code;
-}
-
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6;
 }
 
 /* ---- options ---- */
@@ -149,7 +253,9 @@ static int set_value(options *o, const char *name, const char *val)
                        : strcmp(name, "--threshold") == 0 ? &o->config.contour_threshold
                        : strcmp(name, "--alpha") == 0     ? &o->config.alpha
                        : strcmp(name, "--gamma") == 0     ? &o->config.gamma
-                                                          : NULL;
+                       : strcmp(name, "--occupied-thresh") == 0 ? &o->config.occupied_thresh
+                       : strcmp(name, "--free-thresh") == 0     ? &o->config.free_thresh
+                                                                : NULL;
         if (!field)
             return complain(EXIT_USAGE, "unknown option '%s'", name);
         if (parse_double(val, -1e30, 1e30, &d))
@@ -159,9 +265,19 @@ static int set_value(options *o, const char *name, const char *val)
     return 0;
 }
 
+static unsigned option_bit(const char *name)
+{
+    for (size_t i = 0; i < sizeof option_bits / sizeof option_bits[0]; i++)
+        if (strcmp(name, option_bits[i].name) == 0)
+            return option_bits[i].bit;
+    return 0;
+}
+
 static int set_flag(options *o, const char *name)
 {
-    if (strcmp(name, "--stats") == 0)
+    if (strcmp(name, "--quiet") == 0)
+        o->quiet = 1;
+    else if (strcmp(name, "--stats") == 0)
         o->stats = 1;
     else if (strcmp(name, "--no-optimize") == 0)
         o->no_optimize = 1;
@@ -184,7 +300,8 @@ static int takes_value(const char *name)
 {
     static const char *const names[] = {"--format", "-o",          "--output",    "--trace",
                                         "--seed",   "--iterations", "--max-range", "--memory-mb",
-                                        "--cell",   "--threshold", "--alpha",     "--gamma"};
+                                        "--cell",   "--threshold", "--alpha",     "--gamma",
+                                        "--occupied-thresh", "--free-thresh"};
     for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
         if (strcmp(name, names[i]) == 0)
             return 1;
@@ -217,6 +334,7 @@ static int parse_args(int argc, char **argv, options *o)
                    (unsigned)(v / 100 % 100), (unsigned)(v % 100));
             return -1;
         } else if (set_flag(o, a) == 0) {
+            o->given |= option_bit(a);
             continue;
         } else {
             char name[32];
@@ -233,16 +351,20 @@ static int parse_args(int argc, char **argv, options *o)
             int rc = set_value(o, name, eq && a[1] == '-' ? eq + 1 : argv[++i]);
             if (rc)
                 return rc;
+            o->given |= option_bit(name);
         }
     }
-    if (npos >= 1 && strcmp(positional[0], "convert") == 0) {
-        o->convert = 1;
+    if (npos >= 1 && (strcmp(positional[0], "convert") == 0 || strcmp(positional[0], "grid") == 0)) {
+        o->command = positional[0][0] == 'c' ? CMD_CONVERT : CMD_GRID;
         positional[0] = npos == 2 ? positional[1] : NULL;
         npos--;
     }
     if (npos != 1 || !positional[0])
         return complain(EXIT_USAGE, npos == 0 ? "no input file" : "too many arguments");
     o->input = positional[0];
+    if (o->command == CMD_GRID && (!o->output || strcmp(o->output, "-") == 0))
+        return complain(EXIT_USAGE, "polyc grid needs -o PREFIX (it writes PREFIX.pgm and"
+                                    " PREFIX.yaml)");
     const char *why = NULL;
     if (polyc_config_check(&o->config, &why) != POLYC_OK)
         return complain(EXIT_USAGE, "bad option value: %s", why ? why : "?");
@@ -372,15 +494,39 @@ static int membuf_close(membuf *m, int write_failed)
     return bad ? complain(EXIT_INPUT, "out of memory rendering the output") : 0;
 }
 
-/* ---- the optimiser trace ---- */
+/* ---- the optimiser's callback: --trace and the progress line ---- */
 
 static int on_iteration(void *user, const polyc_iteration *it)
 {
     FILE *f = user;
-    fprintf(f, "%u %.6f %.6f %u %u %.6f\n", (unsigned)it->iteration, it->bic, it->best_bic,
-            (unsigned)it->vertices, (unsigned)it->polylines, it->noise_m);
+    if (f)
+        fprintf(f, "%u %.6f %.6f %u %u %.6f\n", (unsigned)it->iteration, it->bic, it->best_bic,
+                (unsigned)it->vertices, (unsigned)it->polylines, it->noise_m);
+    progress_show(it);
     return 0;
 }
+
+/* ---- the run's state ---- */
+
+/* A map read from a map YAML and its image. */
+typedef struct map_input {
+    mapfile_yaml yaml;
+    mapfile_pgm pgm;
+    char *image_path;          /* as opened */
+    int8_t *cells;             /* OccupancyGrid values, row 0 at the bottom */
+    polyc_occupancy_grid grid;
+    uint64_t occupied, free_cells, unknown;   /* under the library's thresholds */
+} map_input;
+
+typedef struct run {
+    scanlog log;
+    map_input *map;            /* a map instead of a log; NULL for a log */
+    void *block;
+    polyc_polyline *lines;
+    membuf out, trace;
+    uint8_t *pixels;           /* polyc grid */
+    membuf pgm, yaml;
+} run;
 
 /* ---- --stats ---- */
 
@@ -416,18 +562,39 @@ static void print_input_stats(const scanlog *log)
     }
 }
 
-static void print_stats(const options *o, const scanlog *log, const polyc_stats *s,
+static void print_map_stats(const map_input *m)
+{
+    static const char *const modes[] = {"trinary", "scale", "raw"};
+    FILE *e = stderr;
+    fprintf(e, "map            %u x %u cells of %g m, %s (%s, maxval %u), mode %s%s\n",
+            (unsigned)m->pgm.width, (unsigned)m->pgm.height, m->yaml.resolution_m,
+            m->image_path, m->pgm.plain ? "P2" : "P5", (unsigned)m->pgm.maxval,
+            modes[m->yaml.mode], m->yaml.negate ? ", negate" : "");
+    fprintf(e, "origin         %.6f %.6f m, yaw %.6f rad\n", m->yaml.origin_x_m,
+            m->yaml.origin_y_m, m->yaml.origin_yaw_rad);
+    fprintf(e, "cells          occupied %llu, free %llu, unknown %llu\n",
+            (unsigned long long)m->occupied, (unsigned long long)m->free_cells,
+            (unsigned long long)m->unknown);
+}
+
+static void print_stats(const options *o, const run *r, const polyc_stats *s,
                         const mapout_times *t, double output_ms, double total_ms)
 {
     FILE *e = stderr;
-    print_input_stats(log);
-    fprintf(e, "beams          %llu (hits %llu, skipped by the library %llu)\n",
-            (unsigned long long)s->beams, (unsigned long long)s->hits,
-            (unsigned long long)s->beams_skipped);
+    progress_clear();
+    if (r->map) {
+        print_map_stats(r->map);
+    } else {
+        print_input_stats(&r->log);
+        fprintf(e, "beams          %llu (hits %llu, skipped by the library %llu)\n",
+                (unsigned long long)s->beams, (unsigned long long)s->hits,
+                (unsigned long long)s->beams_skipped);
+    }
     fprintf(e, "points         %llu data points, %u weighted points\n",
             (unsigned long long)s->data_points, (unsigned)s->weighted_points);
     fprintf(e, "grid           %u x %u cells of %.4f m, %u tiles, %llu bytes\n",
-            (unsigned)s->grid_width, (unsigned)s->grid_height, (double)o->config.cell_m,
+            (unsigned)s->grid_width, (unsigned)s->grid_height,
+            r->map ? (double)r->map->grid.resolution_m : (double)o->config.cell_m,
             (unsigned)s->grid_tiles, (unsigned long long)s->grid_bytes);
     fprintf(e, "contour cells  %u\n", (unsigned)s->contour_cells);
     fprintf(e, "initial        %u polylines, %u vertices\n", (unsigned)s->initial_polylines,
@@ -437,10 +604,10 @@ static void print_stats(const options *o, const scanlog *log, const polyc_stats 
     fprintf(e, "BIC            %.3f (error %.6f m^2)\n", s->bic, s->error_sq_m2);
     fprintf(e, "memory         block %llu bytes, used %llu bytes\n",
             (unsigned long long)s->memory_size_bytes, (unsigned long long)s->memory_used_bytes);
-    fprintf(e, "time ms        parse %.1f, add %.1f, grid %.1f, contour %.1f, trace %.1f,"
+    fprintf(e, "time ms        %s %.1f, add %.1f, grid %.1f, contour %.1f, trace %.1f,"
                " optimize %.1f, output %.1f, total %.1f\n",
-            t->parse_ms, t->add_ms, t->grid_ms, t->contour_ms, t->trace_ms, t->optimize_ms,
-            output_ms, total_ms);
+            r->map ? "read" : "parse", t->parse_ms, t->add_ms, t->grid_ms, t->contour_ms,
+            t->trace_ms, t->optimize_ms, output_ms, total_ms);
 }
 
 /* ---- the run ---- */
@@ -453,7 +620,7 @@ static int library_fail(const char *stage, polyc_status st, const polyc_ctx *ctx
         return complain(EXIT_MEMORY, "memory budget too small: need more than %zu bytes (%s: %s)",
                         block, stage, msg ? msg : polyc_status_str(st));
     return complain(EXIT_INPUT, "%s failed: %s%s%s", stage, polyc_status_str(st),
-                    msg ? ": " : "", msg ? msg : "");
+                    msg && *msg ? ": " : "", msg ? msg : "");
 }
 
 static int struct_sizes_match(void)
@@ -463,15 +630,9 @@ static int struct_sizes_match(void)
            polyc_struct_size("polyc_scan") == sizeof(polyc_scan) &&
            polyc_struct_size("polyc_polyline") == sizeof(polyc_polyline) &&
            polyc_struct_size("polyc_stats") == sizeof(polyc_stats) &&
-           polyc_struct_size("polyc_iteration") == sizeof(polyc_iteration);
+           polyc_struct_size("polyc_iteration") == sizeof(polyc_iteration) &&
+           polyc_struct_size("polyc_occupancy_grid") == sizeof(polyc_occupancy_grid);
 }
-
-typedef struct run {
-    scanlog log;
-    void *block;
-    polyc_polyline *lines;
-    membuf out, trace;
-} run;
 
 static int convert(const options *o, run *r)
 {
@@ -484,7 +645,6 @@ static int convert(const options *o, run *r)
         print_input_stats(&r->log);
     return emit(o->output, r->out.data, r->out.len);
 }
-
 static const char *input_name(const options *o)
 {
     return strcmp(o->input, "-") == 0 ? "<stdin>" : o->input;
@@ -541,13 +701,170 @@ static int extent_fail(const options *o, const scanlog *log, const polyc_config 
                     input_name(o), w, h, (double)cfg->cell_m);
 }
 
+
+/* ---- a ROS map in ---- */
+
+/* A copy of s for messages: bytes outside printable ASCII as \xNN. */
+static char *printable(const char *s)
+{
+    static const char hex[] = "0123456789abcdef";
+    size_t n = strlen(s), o = 0;
+    char *out = malloc(4 * n + 1);
+    if (!out)
+        return NULL;
+    for (size_t i = 0; i < n; i++) {
+        unsigned char c = (unsigned char)s[i];
+        if (c >= 0x20 && c < 0x7f) {
+            out[o++] = (char)c;
+        } else {
+            out[o++] = '\\';
+            out[o++] = 'x';
+            out[o++] = hex[c >> 4];
+            out[o++] = hex[c & 15];
+        }
+    }
+    out[o] = '\0';
+    return out;
+}
+
+/* Reads a whole file of at most max bytes into *data (malloc'd, *len bytes).
+ * 0, an errno value, or -1 if it holds more than max bytes. */
+static int read_whole(const char *path, size_t max, char **data, size_t *len)
+{
+    FILE *f = fopen(path, "rb");
+    *data = NULL;
+    *len = 0;
+    if (!f)
+        return errno;
+    size_t cap = 0, n = 0;
+    char *buf = NULL;
+    int err = 0;
+    for (;;) {
+        if (n == cap) {
+            size_t ncap = cap ? cap * 2 : 65536;
+            if (cap > max) {
+                err = -1;
+                break;
+            }
+            char *nb = realloc(buf, ncap);
+            if (!nb) {
+                err = ENOMEM;
+                break;
+            }
+            buf = nb;
+            cap = ncap;
+        }
+        size_t got = fread(buf + n, 1, cap - n, f);
+        n += got;
+        if (got == 0) {
+            if (ferror(f))
+                err = errno ? errno : EIO;
+            break;
+        }
+    }
+    fclose(f);
+    if (!err && n > max)
+        err = -1;
+    if (err) {
+        free(buf);
+        return err;
+    }
+    *data = buf;
+    *len = n;
+    return 0;
+}
+
+/* Reads the map YAML o->input, its image and converts it; 0 or an exit code. */
+static int load_map(const options *o, map_input *m)
+{
+    char *text;
+    size_t len;
+    int err = read_whole(o->input, MAPFILE_MAX_YAML_BYTES, &text, &len);
+    if (err < 0)
+        return complain(EXIT_INPUT, "%s: larger than %u bytes: not a map YAML", o->input,
+                        MAPFILE_MAX_YAML_BYTES);
+    if (err)
+        return complain(EXIT_INPUT, "%s: %s", o->input, strerror(err));
+    int bad = mapfile_yaml_parse(&m->yaml, text, len, o->input);
+    free(text);
+    if (bad)
+        return complain(EXIT_INPUT, "%s", m->yaml.error);
+    if (!(m->image_path = mapfile_image_path(o->input, m->yaml.image)))
+        return complain(EXIT_INPUT, "out of memory");
+    char *shown = printable(m->image_path);
+    if (!shown)
+        return complain(EXIT_INPUT, "out of memory");
+    err = read_whole(m->image_path, MAPFILE_MAX_PGM_BYTES, &text, &len);
+    if (err) {
+        int rc = err < 0 ? complain(EXIT_INPUT, "%s:%u: image %s: larger than %u bytes", o->input,
+                                    (unsigned)m->yaml.image_line, shown, MAPFILE_MAX_PGM_BYTES)
+                         : complain(EXIT_INPUT, "%s:%u: image %s: %s", o->input,
+                                    (unsigned)m->yaml.image_line, shown, strerror(err));
+        free(shown);
+        return rc;
+    }
+    bad = mapfile_pgm_parse(&m->pgm, (const uint8_t *)text, len, shown);
+    free(text);
+    free(shown);
+    if (bad)
+        return complain(EXIT_INPUT, "%s", m->pgm.error);
+    size_t cells = (size_t)m->pgm.width * m->pgm.height;
+    if (!(m->cells = malloc(cells)))
+        return complain(EXIT_MEMORY, "memory budget too small: need %zu bytes for the map's cells",
+                        cells);
+    mapfile_to_cells(&m->pgm, &m->yaml, m->cells);
+    mapfile_pgm_free(&m->pgm);            /* the samples are not needed any more */
+    polyc_occupancy_grid *g = &m->grid;
+    g->width = m->pgm.width;
+    g->height = m->pgm.height;
+    g->resolution_m = (float)m->yaml.resolution_m;
+    g->reserved = 0;
+    g->origin_x_m = m->yaml.origin_x_m;
+    g->origin_y_m = m->yaml.origin_y_m;
+    g->origin_yaw_rad = m->yaml.origin_yaw_rad;
+    g->cells = m->cells;
+    double occ = 100.0 * (double)o->config.occupied_thresh;
+    double fre = 100.0 * (double)o->config.free_thresh;
+    for (size_t i = 0; i < cells; i++) {
+        int8_t v = m->cells[i];
+        if (v >= 0 && (double)v >= occ)
+            m->occupied++;
+        else if (v >= 0 && (double)v <= fre)
+            m->free_cells++;
+        else
+            m->unknown++;
+    }
+    return 0;
+}
+
+/* The library refused the map's grid (polyc_limits_for_grid, polyc_add_grid). */
+static int map_fail(const options *o, const map_input *m, polyc_status st, const polyc_ctx *ctx,
+                    size_t block)
+{
+    const polyc_config *c = &o->config;
+    if (st == POLYC_ERR_EXTENT)
+        return complain(EXIT_INPUT, "%s:%u: the map spans %.1f x %.1f m (%u x %u cells of %g m):"
+                                    " more than the grid's limit of %g m",
+                        o->input, (unsigned)m->yaml.resolution_line,
+                        m->grid.width * m->yaml.resolution_m, m->grid.height * m->yaml.resolution_m,
+                        (unsigned)m->grid.width, (unsigned)m->grid.height, m->yaml.resolution_m,
+                        (double)c->max_extent_m);
+    return library_fail("map", st, ctx, block);
+}
+
+/* ---- the map out ---- */
+
 static int make_map(const options *o, run *r, double t_start, mapout_times *t)
 {
     polyc_config cfg = o->config;
     polyc_limits lim;
     polyc_ctx *ctx = NULL;
-    polyc_status st = polyc_limits_for_scans(&cfg, r->log.scans, r->log.count, &lim);
+    const polyc_occupancy_grid *grid = r->map ? &r->map->grid : NULL;
+    polyc_status st = grid ? polyc_limits_for_grid(&cfg, grid, &lim)
+                           : polyc_limits_for_scans(&cfg, r->log.scans, r->log.count, &lim);
     double t4 = 0.0;
+    if (grid && st != POLYC_OK)
+        return map_fail(o, r->map, st, NULL, 0);
     if (st == POLYC_ERR_EXTENT)
         return extent_fail(o, &r->log, &cfg);
     if (st != POLYC_OK)
@@ -556,7 +873,7 @@ static int make_map(const options *o, run *r, double t_start, mapout_times *t)
      * contour; a map that needs more is run again with the worst-case bound */
     size_t size = 0;
     for (int attempt = 0;; attempt++) {
-        int retry = attempt == 0 && (lim.max_vertices != 0 || lim.max_points != 0);
+        int retry = !grid && attempt == 0 && (lim.max_vertices != 0 || lim.max_points != 0);
         size = polyc_memory_size(&cfg, &lim);
         if (size == 0)
             return complain(EXIT_MEMORY, "memory budget too small: need more than %zu bytes",
@@ -572,27 +889,40 @@ static int make_map(const options *o, run *r, double t_start, mapout_times *t)
             return library_fail("init", st, ctx, size);
 
         double t0 = now_ms();
-        for (uint32_t i = 0; i < r->log.count; i++)
-            if ((st = polyc_add_scan(ctx, &r->log.scans[i])) != POLYC_OK) {
-                if (st == POLYC_ERR_SCAN)
-                    return complain(EXIT_INPUT, "%s:%llu: scan rejected by the library: %s",
-                                    input_name(o), (unsigned long long)r->log.line_of_scan[i],
-                                    polyc_last_error(ctx));
-                return library_fail("add scan", st, ctx, size);
-            }
+        if (grid) {
+            /* the grid and its contour come with the map */
+            progress_stage("map cells");
+            if ((st = polyc_add_grid(ctx, grid)) != POLYC_OK)
+                return map_fail(o, r->map, st, ctx, size);
+        } else {
+            progress_stage("adding scans");
+            for (uint32_t i = 0; i < r->log.count; i++)
+                if ((st = polyc_add_scan(ctx, &r->log.scans[i])) != POLYC_OK) {
+                    if (st == POLYC_ERR_SCAN)
+                        return complain(EXIT_INPUT, "%s:%llu: scan rejected by the library: %s",
+                                        input_name(o), (unsigned long long)r->log.line_of_scan[i],
+                                        polyc_last_error(ctx));
+                    return library_fail("add scan", st, ctx, size);
+                }
+        }
         double t1 = now_ms();
         t->add_ms = t1 - t0;
-        if ((st = polyc_build_grid(ctx)) != POLYC_OK)
-            return library_fail("grid", st, ctx, size);
+        if (!grid) {
+            progress_stage("grid");
+            if ((st = polyc_build_grid(ctx)) != POLYC_OK)
+                return library_fail("grid", st, ctx, size);
+        }
         double t2 = now_ms();
         t->grid_ms = t2 - t1;
         /* one scan's polylines come from its beam order (polyc_build skips
          * the contour too): it is needed only to trace it or to draw it */
-        int want_contour = r->log.count != 1 || o->grid || (cfg.flags & POLYC_FLAG_GRID_TRACE);
+        int want_contour = !grid && (r->log.count != 1 || o->grid || (cfg.flags & POLYC_FLAG_GRID_TRACE));
+        progress_stage("contour");
         if (want_contour && (st = polyc_extract_contour(ctx)) != POLYC_OK)
             return library_fail("contour", st, ctx, size);
         double t3 = now_ms();
         t->contour_ms = t3 - t2;
+        progress_stage("trace");
         st = polyc_trace(ctx);
         if (st == POLYC_ERR_NOMEM && retry) {
             lim.max_vertices = lim.max_points = 0;
@@ -608,7 +938,8 @@ static int make_map(const options *o, run *r, double t_start, mapout_times *t)
             fputs("# iteration bic best_bic vertices polylines noise_m\n", r->trace.f);
         }
         if (!o->no_optimize && cfg.max_iterations > 0) {
-            st = polyc_optimize(ctx, o->trace ? on_iteration : NULL, r->trace.f);
+            progress_stage("optimize");
+            st = polyc_optimize(ctx, o->trace || prog.on ? on_iteration : NULL, r->trace.f);
             if (st == POLYC_ERR_NOMEM && retry) {
                 lim.max_vertices = lim.max_points = 0;
                 if (r->trace.f)
@@ -622,6 +953,7 @@ static int make_map(const options *o, run *r, double t_start, mapout_times *t)
     }
     double t5 = now_ms();
     t->optimize_ms = t5 - t4;
+    progress_stage("writing");
 
     polyc_stats stats;
     double bic = 0, error_sq_m2 = 0;
@@ -667,6 +999,7 @@ static int make_map(const options *o, run *r, double t_start, mapout_times *t)
     int rc = emit_prepare(&map_out, o->output, r->out.data, r->out.len);
     if (!rc && o->trace)
         rc = emit_prepare(&trace_out, o->trace, r->trace.data, r->trace.len);
+    progress_clear();                     /* before stdout, which may be the terminal */
     if (!rc)
         rc = emit_commit(&map_out);
     if (!rc && o->trace)
@@ -675,42 +1008,236 @@ static int make_map(const options *o, run *r, double t_start, mapout_times *t)
     emit_abort(&trace_out);
     double t6 = now_ms();
     if (o->stats)
-        print_stats(o, &r->log, &stats, t, t6 - t5, t6 - t_start);
+        print_stats(o, r, &stats, t, t6 - t5, t6 - t_start);
     return rc;
+}
+
+/* ---- polyc grid: the hit/miss grid as map_saver's files ---- */
+
+static int grid_files(const options *o, run *r, double t_start)
+{
+    polyc_config cfg = o->config;
+    polyc_limits lim;
+    polyc_ctx *ctx = NULL;
+    polyc_status st = polyc_limits_for_scans(&cfg, r->log.scans, r->log.count, &lim);
+    if (st == POLYC_ERR_EXTENT)
+        return extent_fail(o, &r->log, &cfg);
+    if (st != POLYC_OK)
+        return library_fail("sizing", st, NULL, 0);
+    size_t size = polyc_memory_size(&cfg, &lim);
+    if (size == 0)
+        return complain(EXIT_MEMORY, "memory budget too small: need more than %zu bytes",
+                        (size_t)SIZE_MAX);
+    if (o->memory_mb > 0 && (double)size > o->memory_mb * 1048576.0)
+        return complain(EXIT_MEMORY, "memory budget too small: need %zu bytes", size);
+    if (!(r->block = malloc(size)))
+        return complain(EXIT_MEMORY, "memory budget too small: need %zu bytes (malloc failed)",
+                        size);
+    if ((st = polyc_init(r->block, size, &cfg, &lim, &ctx)) != POLYC_OK)
+        return library_fail("init", st, ctx, size);
+    progress_stage("adding scans");
+    for (uint32_t i = 0; i < r->log.count; i++)
+        if ((st = polyc_add_scan(ctx, &r->log.scans[i])) != POLYC_OK) {
+            if (st == POLYC_ERR_SCAN)
+                return complain(EXIT_INPUT, "%s:%llu: scan rejected by the library: %s",
+                                input_name(o), (unsigned long long)r->log.line_of_scan[i],
+                                polyc_last_error(ctx));
+            return library_fail("add scan", st, ctx, size);
+        }
+    progress_stage("grid");
+    if ((st = polyc_build_grid(ctx)) != POLYC_OK)
+        return library_fail("grid", st, ctx, size);
+    double ox, oy;
+    float cell;
+    uint32_t w, h;
+    if ((st = polyc_grid_info(ctx, &ox, &oy, &cell, &w, &h)) != POLYC_OK)
+        return library_fail("grid", st, ctx, size);
+    if ((uint64_t)w * h > MAPFILE_MAX_CELLS || w == 0 || h == 0)
+        return complain(EXIT_INPUT, "%s: the grid is %u x %u cells of %g m: more than the %u a"
+                                    " map may have (try a larger --cell)",
+                        input_name(o), (unsigned)w, (unsigned)h, (double)cell, MAPFILE_MAX_CELLS);
+    progress_stage("writing");
+    if (!(r->pixels = malloc((size_t)w * h)))
+        return complain(EXIT_INPUT, "out of memory for %u x %u pixels", (unsigned)w, (unsigned)h);
+    uint64_t counts[256] = {0};
+    for (uint32_t row = 0; row < h; row++) {   /* the PGM's first row is the top */
+        uint32_t iy = h - 1 - row;
+        for (uint32_t ix = 0; ix < w; ix++) {
+            uint32_t hits = 0, misses = 0;
+            if ((st = polyc_grid_cell(ctx, ix, iy, &hits, &misses, NULL)) != POLYC_OK)
+                return library_fail("grid", st, ctx, size);
+            uint8_t px = mapfile_grid_pixel(hits, misses);
+            r->pixels[(size_t)row * w + ix] = px;
+            counts[px]++;
+        }
+    }
+    /* PREFIX.pgm and PREFIX.yaml; the YAML names the image by its base name */
+    size_t plen = strlen(o->output);
+    char *pgm_path = malloc(plen + 6), *yaml_path = malloc(plen + 6);
+    int rc = 0;
+    if (!pgm_path || !yaml_path) {
+        rc = complain(EXIT_INPUT, "out of memory");
+    } else {
+        snprintf(pgm_path, plen + 6, "%s.pgm", o->output);
+        snprintf(yaml_path, plen + 6, "%s.yaml", o->output);
+        const char *slash = strrchr(pgm_path, '/');
+        const char *image = slash ? slash + 1 : pgm_path;
+        for (const char *q = image; *q && !rc; q++)
+            if ((unsigned char)*q < 0x20 || *q == 0x7f)
+                rc = complain(EXIT_USAGE, "-o PREFIX holds a control character");
+        if (!rc && (membuf_open(&r->pgm) || membuf_open(&r->yaml)))
+            rc = EXIT_INPUT;
+        if (!rc) {
+            int bad = mapfile_write_pgm(r->pgm.f, r->pixels, w, h, (double)cell);
+            rc = membuf_close(&r->pgm, bad);
+        }
+        if (!rc) {
+            int bad = mapfile_write_yaml(r->yaml.f, image, (double)cell, ox, oy);
+            rc = membuf_close(&r->yaml, bad);
+        }
+        /* both files or neither; the image first, so that the YAML never
+         * names a missing one */
+        pending pgm_out, yaml_out;
+        memset(&pgm_out, 0, sizeof pgm_out);
+        memset(&yaml_out, 0, sizeof yaml_out);
+        if (!rc)
+            rc = emit_prepare(&pgm_out, pgm_path, r->pgm.data, r->pgm.len);
+        if (!rc)
+            rc = emit_prepare(&yaml_out, yaml_path, r->yaml.data, r->yaml.len);
+        if (!rc)
+            rc = emit_commit(&pgm_out);
+        if (!rc)
+            rc = emit_commit(&yaml_out);
+        emit_abort(&pgm_out);
+        emit_abort(&yaml_out);
+    }
+    free(pgm_path);
+    free(yaml_path);
+    progress_clear();
+    if (!rc && o->stats) {
+        print_input_stats(&r->log);
+        fprintf(stderr, "grid           %u x %u cells of %.4f m, origin %.6f %.6f m\n",
+                (unsigned)w, (unsigned)h, (double)cell, ox, oy);
+        fprintf(stderr, "pixels         occupied %llu, free %llu, unknown %llu\n",
+                (unsigned long long)counts[MAPFILE_PIXEL_OCCUPIED],
+                (unsigned long long)counts[MAPFILE_PIXEL_FREE],
+                (unsigned long long)counts[MAPFILE_PIXEL_UNKNOWN]);
+        fprintf(stderr, "time ms        total %.1f\n", now_ms() - t_start);
+    }
+    return rc;
+}
+
+/* ---- which input ---- */
+
+enum input_kind { INPUT_LOG, INPUT_MAP_YAML, INPUT_IMAGE };
+
+/* A map YAML or an image is told from a log by its first bytes. Only a
+ * regular file is looked at (a pipe would lose what is read); anything
+ * unreadable is left to the log reader, which reports it. */
+static enum input_kind sniff(const char *path)
+{
+    char head[65536];
+    struct stat st;
+    if (stat(path, &st) != 0 || !S_ISREG(st.st_mode))
+        return INPUT_LOG;
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return INPUT_LOG;
+    size_t n = fread(head, 1, sizeof head, f);
+    fclose(f);
+    if (n >= 3 && head[0] == 'P' && (head[1] == '5' || head[1] == '2') &&
+        (head[2] == ' ' || head[2] == '\n' || head[2] == '\r' || head[2] == '\t' || head[2] == '#'))
+        return INPUT_IMAGE;
+    if (n >= 8 && memcmp(head, "\x89PNG\r\n\x1a\n", 8) == 0)
+        return INPUT_IMAGE;
+    return mapfile_is_yaml(head, n) ? INPUT_MAP_YAML : INPUT_LOG;
+}
+
+/* Refuses (usage) the options given that are not in `allowed`. */
+static int refuse_options(const options *o, unsigned allowed, const char *why)
+{
+    unsigned bad = o->given & ~allowed;
+    for (size_t i = 0; bad && i < sizeof option_bits / sizeof option_bits[0]; i++)
+        if (bad & option_bits[i].bit)
+            return complain(EXIT_USAGE, "%s does not apply to %s", option_bits[i].name, why);
+    return 0;
 }
 
 int main(int argc, char **argv)
 {
     options o;
     run r;
+    map_input map;
     int rc = parse_args(argc, argv, &o);
     if (rc)
         return rc < 0 ? 0 : rc;
     if (!struct_sizes_match())
         return complain(EXIT_INPUT, "libpolyc's structs differ from polyc.h (rebuild)");
     memset(&r, 0, sizeof r);
+    memset(&map, 0, sizeof map);
     mapout_times t = {0, 0, 0, 0, 0, 0};
     double t_start = now_ms();
-    FILE *in = strcmp(o.input, "-") == 0 ? stdin : fopen(o.input, "rb");
-    if (!in)
-        return complain(EXIT_INPUT, "%s: %s", o.input, strerror(errno));
-    scanlog_opts so = {o.max_range_m};
-    int bad = scanlog_read(&r.log, in, strcmp(o.input, "-") == 0 ? "<stdin>" : o.input, &so);
-    if (in != stdin)
-        fclose(in);
-    t.parse_ms = now_ms() - t_start;
-    if (bad)
-        rc = complain(EXIT_INPUT, "%s", r.log.error);
-    else
-        rc = o.convert ? convert(&o, &r) : make_map(&o, &r, t_start, &t);
-    if (r.trace.f)
-        fclose(r.trace.f);
-    if (r.out.f)
-        fclose(r.out.f);
-    free(r.trace.data);
-    free(r.out.data);
+    prog.on = !o.quiet && isatty(STDERR_FILENO);
+    prog.start_ms = prog.last_ms = t_start;
+    enum input_kind kind = strcmp(o.input, "-") == 0 ? INPUT_LOG : sniff(o.input);
+    if (kind == INPUT_IMAGE) {
+        rc = complain(EXIT_INPUT, "%s: an image: give the map's YAML file (map_server's"
+                                  " map.yaml), which names the image", o.input);
+    } else if (kind == INPUT_MAP_YAML) {
+        progress_stage("reading the map");
+        if (o.command != CMD_MAP)
+            rc = complain(EXIT_INPUT, "%s: a map YAML: polyc %s takes a laser log", o.input,
+                          o.command == CMD_CONVERT ? "convert" : "grid");
+        else if (!(rc = refuse_options(&o, ~(unsigned)OPTS_LOG_ONLY,
+                                       "a map YAML (it acts on laser scans; a map's cells are its own)")) &&
+                 !(rc = load_map(&o, &map))) {
+            r.map = &map;
+            t.parse_ms = now_ms() - t_start;
+            if (o.grid && map.yaml.origin_yaw_rad != 0.0)
+                rc = complain(EXIT_USAGE, "--grid draws the grid unrotated: not for a map whose"
+                                          " origin has a yaw");
+            else
+                rc = make_map(&o, &r, t_start, &t);
+        }
+    } else {
+        rc = o.command == CMD_GRID ? refuse_options(&o, OPTS_GRID_CMD, "polyc grid")
+             : o.command == CMD_MAP ? refuse_options(&o, ~(unsigned)OPTS_MAP_ONLY, "a laser log")
+                                    : 0;
+        FILE *in = NULL;
+        if (!rc) {
+            progress_stage("reading the log");
+            in = strcmp(o.input, "-") == 0 ? stdin : fopen(o.input, "rb");
+            if (!in)
+                rc = complain(EXIT_INPUT, "%s: %s", o.input, strerror(errno));
+        }
+        if (!rc) {
+            scanlog_opts so = {o.max_range_m};
+            int bad = scanlog_read(&r.log, in, strcmp(o.input, "-") == 0 ? "<stdin>" : o.input, &so);
+            if (in != stdin)
+                fclose(in);
+            t.parse_ms = now_ms() - t_start;
+            if (bad)
+                rc = complain(EXIT_INPUT, "%s", r.log.error);
+            else
+                rc = o.command == CMD_CONVERT ? convert(&o, &r)
+                     : o.command == CMD_GRID  ? grid_files(&o, &r, t_start)
+                                              : make_map(&o, &r, t_start, &t);
+        }
+    }
+    progress_clear();
+    membuf *bufs[] = {&r.trace, &r.out, &r.pgm, &r.yaml};
+    for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; i++) {
+        if (bufs[i]->f)
+            fclose(bufs[i]->f);
+        free(bufs[i]->data);
+    }
     free(r.lines);
     free(r.block);
+    free(r.pixels);
     scanlog_free(&r.log);
+    mapfile_yaml_free(&map.yaml);
+    mapfile_pgm_free(&map.pgm);
+    free(map.image_path);
+    free(map.cells);
     return rc;
 }
