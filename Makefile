@@ -12,10 +12,16 @@ LDLIBS  = -lm
 
 LIB_SRC  = $(wildcard src/*.c)
 LIB_OBJ  = $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
-# tools/ modules shared by the CLI, the tests and the benchmark
-TOOL_MOD = $(filter-out tools/polyc.c tools/bench.c tools/sweep.c,$(wildcard tools/*.c))
+# tools/: the shipped tool (polyc.c) and its modules (log reader, map
+# files, SVG/JSON/TXT output). tools/eval/: the evaluation harness (bench,
+# sweep, simulator, ground-truth and topology scores), which the tests and
+# the benchmark use and the tool does not.
+TOOL_MOD = $(filter-out tools/polyc.c,$(wildcard tools/*.c))
 TOOL_OBJ = $(TOOL_MOD:tools/%.c=$(BUILD)/tobj/%.o)
+EVAL_MOD = $(filter-out tools/eval/bench.c tools/eval/sweep.c,$(wildcard tools/eval/*.c))
+EVAL_OBJ = $(EVAL_MOD:tools/eval/%.c=$(BUILD)/eobj/%.o)
 TOOL_CFLAGS = $(WARN) $(OPT) $(CFLAGS) -Iinclude -Itools -D_POSIX_C_SOURCE=200809L
+EVAL_CFLAGS = $(TOOL_CFLAGS) -Itools/eval
 
 .PHONY: all lib test unit bench sweep clean install cross deps check test-cxx test-install test-python test-embedded
 .PHONY: test-cli test-fuzz-replay test-asan test-valgrind fuzz fuzz-merge
@@ -30,6 +36,9 @@ $(BUILD)/obj/%.o: src/%.c include/polyc.h $(wildcard src/*.h)
 $(BUILD)/tobj/%.o: tools/%.c include/polyc.h $(wildcard tools/*.h)
 	@mkdir -p $(dir $@)
 	$(CC) $(TOOL_CFLAGS) -c $< -o $@
+$(BUILD)/eobj/%.o: tools/eval/%.c include/polyc.h $(wildcard tools/*.h tools/eval/*.h)
+	@mkdir -p $(dir $@)
+	$(CC) $(EVAL_CFLAGS) -c $< -o $@
 $(BUILD)/libpolyc.a: $(LIB_OBJ)
 	rm -f $@ && ar rcs $@ $^
 $(BUILD)/polyc: tools/polyc.c $(TOOL_OBJ) $(BUILD)/libpolyc.a
@@ -59,9 +68,9 @@ install: all
 # Unit and end-to-end tests: one cmocka binary per tests/test_*.c
 TEST_SRC = $(wildcard tests/test_*.c)
 TEST_BIN = $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
-$(BUILD)/tests/%: tests/%.c $(TOOL_OBJ) $(BUILD)/libpolyc.a $(wildcard tests/*.h)
+$(BUILD)/tests/%: tests/%.c $(TOOL_OBJ) $(EVAL_OBJ) $(BUILD)/libpolyc.a $(wildcard tests/*.h)
 	@mkdir -p $(dir $@)
-	$(CC) $(TOOL_CFLAGS) -Isrc -Itests $< $(TOOL_OBJ) $(BUILD)/libpolyc.a -o $@ -lcmocka $(LDLIBS)
+	$(CC) $(EVAL_CFLAGS) -Isrc -Itests $< $(TOOL_OBJ) $(EVAL_OBJ) $(BUILD)/libpolyc.a -o $@ -lcmocka $(LDLIBS)
 
 # every suite runs even when an earlier one fails; the target fails at the end
 unit: $(TEST_BIN) $(BUILD)/polyc
@@ -202,7 +211,7 @@ cross: $(XBUILD)/libpolyc.a $(XBUILD)/embedded_scan.elf
 	@bad=$$($(CROSS)nm $(XBUILD)/embedded_scan.elf | awk '{print $$3}' | grep -Ex '$(X_ALLOC)|$(X_STDIO)' | sort -u); \
 	if [ -n "$$bad" ]; then echo "cross: FAIL: the linked example contains" $$bad; exit 1; fi
 	@echo "cross: no allocator and no stdio in the library or the linked example"
-	python3 tools/stack_usage.py --cross $(CROSS) --elf $(XBUILD)/embedded_scan.elf \
+	python3 tools/eval/stack_usage.py --cross $(CROSS) --elf $(XBUILD)/embedded_scan.elf \
 	    $(XOBJ:.o=.ci) $(XBUILD)/embedded_scan.ci
 $(XBUILD)/%.o: src/%.c include/polyc.h $(wildcard src/*.h)
 	@mkdir -p $(dir $@)
@@ -222,8 +231,8 @@ BENCH_ARGS ?=
 bench:
 	$(MAKE) BUILD=build-bench OPT='-O3 -march=native -DNDEBUG' build-bench/bench
 	build-bench/bench $(BENCH_ARGS) $(DATA)
-$(BUILD)/bench: tools/bench.c $(TOOL_OBJ) $(BUILD)/libpolyc.a
-	$(CC) $(TOOL_CFLAGS) $^ -o $@ $(LDLIBS)
+$(BUILD)/bench: tools/eval/bench.c $(EVAL_OBJ) $(TOOL_OBJ) $(BUILD)/libpolyc.a
+	$(CC) $(EVAL_CFLAGS) $^ -o $@ $(LDLIBS)
 
 # Simulated scenes of every kind over several seeds, each scored against its
 # own ground truth (docs/evaluation.md). `make sweep SWEEP_ARGS='--seeds 1-20
@@ -232,15 +241,15 @@ SWEEP_ARGS ?=
 sweep:
 	$(MAKE) BUILD=build-bench OPT='-O3 -march=native -DNDEBUG' build-bench/sweep
 	build-bench/sweep $(SWEEP_ARGS)
-$(BUILD)/sweep: tools/sweep.c $(TOOL_OBJ) $(BUILD)/libpolyc.a
-	$(CC) $(TOOL_CFLAGS) $^ -o $@ $(LDLIBS)
+$(BUILD)/sweep: tools/eval/sweep.c $(EVAL_OBJ) $(TOOL_OBJ) $(BUILD)/libpolyc.a
+	$(CC) $(EVAL_CFLAGS) $^ -o $@ $(LDLIBS)
 
 # Regenerate the bundled example (examples/office.*) with the simulator
 .PHONY: examples
 examples: $(BUILD)/gen_example
 	$(BUILD)/gen_example examples/office.log examples/office.gt.txt
-$(BUILD)/gen_example: tests/gen_example.c $(TOOL_OBJ) $(BUILD)/libpolyc.a
-	$(CC) $(TOOL_CFLAGS) $^ -o $@ $(LDLIBS)
+$(BUILD)/gen_example: tests/gen_example.c $(EVAL_OBJ) $(TOOL_OBJ) $(BUILD)/libpolyc.a
+	$(CC) $(EVAL_CFLAGS) $^ -o $@ $(LDLIBS)
 
 clean:
 	rm -rf $(BUILD) build-*

@@ -1,6 +1,6 @@
 /* small_scene.h - a small known-good scene for the robustness tests
  * (test_api_errors.c, test_exhaustion.c): a 3 m x 2 m room seen from three
- * poses by a 91-beam laser, simulated by tools/scansim. Building it must
+ * poses by a 91-beam laser, simulated by tools/eval/scansim. Building it must
  * give a map; the tests run it after every error to show that the context
  * still works. */
 #ifndef SMALL_SCENE_H

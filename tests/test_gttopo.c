@@ -1,5 +1,5 @@
-/* test_gttopo.c - the topology figures (tools/gttopo.h) and the core
- * precision (tools/gtscore.h) on hand-made maps whose values are known
+/* test_gttopo.c - the topology figures (tools/eval/gttopo.h) and the core
+ * precision (tools/eval/gtscore.h) on hand-made maps whose values are known
  * exactly. Points lie at odd half centimetres (0.005 + 0.02 i) so that no
  * 1 cm map sample is exactly 5 cm from one. */
 #include <stdarg.h>

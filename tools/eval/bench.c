@@ -5,7 +5,7 @@
  * Takes DATA_DIR/sim/NAME.log (+ NAME.gt.txt ground truth) and
  * DATA_DIR/carmen/NAME.log. Prints one table: per scene the input size, the
  * median time of each stage over N runs, memory, and accuracy (scored by
- * tools/gtscore), a second table of topology figures (tools/gttopo), then a
+ * tools/eval/gtscore), a second table of topology figures (tools/eval/gttopo), then a
  * single-scan section on the real logs. Logs are read
  * with tools/scanlog, the same reader as the CLI. Exit codes: 0 ok, 1 some
  * scene failed, 2 usage or no data directory.
@@ -55,7 +55,7 @@ static const char usage_text[] =
     "= the context's memory block and its high-water mark; rss = peak resident\n"
     "size of the process so far. Accuracy (shared/data/README.md): sim scenes\n"
     "precision RMS / p95 in mm, the line-fit floor (the precision straight lines\n"
-    "fitted to each seen wall side's endpoints would score, tools/gtfloor.c),\n"
+    "fitted to each seen wall side's endpoints would score, tools/eval/gtfloor.c),\n"
     "the ideal fit (the precision of the ideal map, one segment per seen run of\n"
     "each wall side, fitted to that run's endpoints),\n"
     "completeness, vertices / ideal; real logs the\n"
@@ -64,7 +64,7 @@ static const char usage_text[] =
     "times, and how many scans took over 2 ms (issue 4's budget for one scan);\n"
     "cross = crossings summed over the scan maps, maps = scan maps with one or\n"
     "more, uns20 = unsupported runs over 20 cm summed (each against its scan).\n"
-    "Topology (second table, tools/gttopo.h, against the log's scan endpoints):\n"
+    "Topology (second table, tools/eval/gttopo.h, against the log's scan endpoints):\n"
     "len = map length (m); dcov = doubly covered length in runs over 20 cm (m,\n"
     "and % of len); cross = pairs of segments crossing; uns20, uns10 = runs of\n"
     "map over 20 / 10 cm with no endpoint within 5 cm; loose = open ends 3-15 cm\n"
@@ -201,7 +201,7 @@ static int read_log(const char *path, scanlog *log, double *ms)
     return rc;
 }
 
-/* ---- one pipeline run (tools/pipeline.h) --------------------------------- */
+/* ---- one pipeline run (tools/eval/pipeline.h) --------------------------------- */
 
 /* The library's configuration with the options' overrides. */
 static void bench_config(const options *o, polyc_config *c)
@@ -431,7 +431,7 @@ static int bench_scene(const options *o, const scene *s, topo_row *row)
 static void print_topology(const topo_row *rows, size_t count)
 {
     size_t i;
-    printf("\ntopology (tools/gttopo.h): the map against its log's scan endpoints; "
+    printf("\ntopology (tools/eval/gttopo.h): the map against its log's scan endpoints; "
            "rms and core (the\nsamples within 0.5 m of a true wall) are precision RMS, "
            "sim scenes only\n");
     printf("%-24s %9s %8s %6s %6s %6s %6s %6s | %6s %6s | %7s\n", "scene", "len", "dcov",
@@ -674,7 +674,7 @@ int main(int argc, char **argv)
     if (o.single > 0 && reals > 0) {
         printf("\nsingle scans: a map from one scan; f = share of reflected beams whose ray "
                "meets the map,\nray RMSE = measured minus map range over those beams "
-               "(tools/gtscore.h)\n");
+               "(tools/eval/gtscore.h)\n");
         printf("%-24s %6s %8s %9s %9s %9s %9s %7s %6s %6s | %6s %7s %6s %8s | %6s %6s %6s\n",
                "log", "scans", "mean f", "rayRMSE", "verts", "verts", "ms/scan", "slowest",
                "over", "cold", "grid", "contour", "trace", "optimise", "cross", "maps", "uns20");

@@ -139,7 +139,7 @@ int scansim_scene_builtin(scansim_scene *scene, const char *name, uint64_t seed)
 /* NULL-terminated list of the built-in names. */
 const char *const *scansim_builtin_names(void);
 
-/* The randomised kinds (tools/scansim_kinds.c), as scansim_scene_builtin
+/* The randomised kinds (tools/eval/scansim_kinds.c), as scansim_scene_builtin
  * calls them: each fills a scene fresh from scansim_scene_init from its
  * scene->seed. 0, or -1 when out of memory. */
 int scansim_kind_hall(scansim_scene *scene);

@@ -165,7 +165,7 @@ void gtscore_endpoints_within(const gtscore_index *map, const polyc_scan *scans,
                               uint32_t scan_count, double d_m, uint64_t *within,
                               uint64_t *total);
 
-/* The line-fit floor of a simulated scene (tools/gtfloor.c): the precision
+/* The line-fit floor of a simulated scene (tools/eval/gtfloor.c): the precision
  * RMS that straight lines fitted by least squares to each seen side of
  * each true wall segment would score, given these scans; *floor_m < 0 if no
  * side holds enough endpoints (the circles' 720-gons: 1 cm to 6 cm sides).
@@ -173,7 +173,7 @@ void gtscore_endpoints_within(const gtscore_index *map, const polyc_scan *scans,
 int gtscore_line_floor(const gtscore_truth *truth, const polyc_scan *scans, uint32_t scan_count,
                        double *floor_m);
 
-/* The ideal-map fit of a simulated scene (tools/gtfloor.c): the precision
+/* The ideal-map fit of a simulated scene (tools/eval/gtfloor.c): the precision
  * RMS of the map `ideal` counts, one straight segment per run of seen
  * samples (>= 20 cm) on each true wall segment, each fitted by least
  * squares to the endpoints within 6 cm of its stretch, measured at the

@@ -3,9 +3,9 @@
  *
  *   sweep [--seeds A-B] [--kinds a,b,...] [--save DIR] [--svg DIR]
  *
- * Takes nothing from disk: every scene is simulated (tools/scansim.h), its
- * ground truth written to memory and read back by tools/gtscore.h, its scans
- * mapped by the whole pipeline (tools/pipeline.h: polyc_config_default,
+ * Takes nothing from disk: every scene is simulated (tools/eval/scansim.h), its
+ * ground truth written to memory and read back by tools/eval/gtscore.h, its scans
+ * mapped by the whole pipeline (tools/eval/pipeline.h: polyc_config_default,
  * polyc_limits_for_scans, one malloc'ed block). Gives one row per scene,
  * then per kind and over all the median and the worst of every figure, and
  * whether each scene meets the targets. Exit codes: 0 every scene ran (met
