@@ -439,6 +439,8 @@ static int supports(const polyc__opt *o, int32_t i, int32_t sg)
 /* The length a stretch without data must exceed at (x, y) to be cut.
  * Sparse data (far from every pose) have gaps of a few beam spacings
  * between neighbouring points: those are no gaps. */
+#define TIP_GAP_M 0.03f /* a sharp vertex this far past its data is pulled back */
+
 static float gap_needed(const polyc__opt *o, float x, float y)
 {
     float gap_min = o->cfg->split_gap_m;
@@ -447,10 +449,12 @@ static float gap_needed(const polyc__opt *o, float x, float y)
     return polyc__maxf(gap_min, sparse) + 0.5f * o->point_span_m;
 }
 
-/* Cuts out the stretch around vertex v from gap_tail[p] before it (p its
- * predecessor) to gap_head[v] after it, where neither segment has data:
- * the tip of a spike. 0 if there was no room. */
-static int cut_around(polyc__opt *o, int32_t v)
+/* Takes vertex v out between the last data on its two segments: from
+ * gap_tail[p] before it (p its predecessor) to gap_head[v] after it, and
+ * either cuts the polyline there (cut: the tip of a spike, with no data
+ * over a gap) or joins the two new vertices (a tip pulled back to the
+ * data). 0 if there was no room. */
+static int take_out_tip(polyc__opt *o, int32_t v, int cut)
 {
     polyc__store *s = o->s;
     int32_t p = s->v[v].prev, n = s->v[v].next;
@@ -470,7 +474,7 @@ static int cut_around(polyc__opt *o, int32_t v)
         ok = 0;
     if (ok) {
         polyc__op_remove(o, v); /* a -> b */
-        if (s->v[a].line != POLYC__NONE && s->v[a].next == b)
+        if (cut && s->v[a].line != POLYC__NONE && s->v[a].next == b)
             polyc__op_cut(o, a);
     }
     polyc__chg_commit(o);
@@ -596,16 +600,22 @@ int polyc__op_split(polyc__opt *o)
         int32_t p = c->prev;
         if (due[p] || due[v] || s->l[c->line].count < 3)
             continue;
-        if (!(o->gap_tail[p] + o->gap_head[v] > gap_needed(o, c->x, c->y)))
-            continue;
-        /* only a spike (the polyline turns back by more than 120 degrees):
-         * at a corner of a wall seen from one side the data stop short of
-         * the corner on the unseen face, and the corner is real */
         const polyc__vertex *a = &s->v[p], *b = &s->v[c->next];
         float ux = c->x - a->x, uy = c->y - a->y, wx = b->x - c->x, wy = b->y - c->y;
-        if (ux * wx + uy * wy < -0.5f * sqrtf((ux * ux + uy * uy) * (wx * wx + wy * wy)) &&
-            cut_around(o, v))
-            n_cut++;
+        float dot = ux * wx + uy * wy, lens = sqrtf((ux * ux + uy * uy) * (wx * wx + wy * wy));
+        /* only where the polyline turns by more than 120 degrees (a
+         * spike): at a corner of a wall seen from one side the data stop
+         * short of the corner on the unseen face, and the corner is real */
+        if (dot < -0.5f * lens && o->gap_tail[p] + o->gap_head[v] > gap_needed(o, c->x, c->y)) {
+            n_cut += take_out_tip(o, v, 1);
+            continue;
+        }
+        /* a spike past the data on both its segments, as at the end of a
+         * wall seen from both sides where one face's line overshoots to
+         * meet the end's: pulled back to the data, as an open end is
+         * (nothing in the BIC holds it there) */
+        if (dot < -0.5f * lens && o->gap_tail[p] >= TIP_GAP_M && o->gap_head[v] >= TIP_GAP_M)
+            n_cut += take_out_tip(o, v, 0);
     }
     return n_cut;
 }
