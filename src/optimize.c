@@ -211,6 +211,7 @@ static polyc_status restore_best(polyc__opt *o, polyc_status st)
 static polyc_status polish(polyc__opt *o, double best)
 {
     polyc_status st;
+    o->untangle_mark = o->zip_mark = 0; /* the best map is a fresh store */
     polyc__op_merge(o);
     polyc__op_remove_vertices(o, 0);
     if (polyc__bic(o) > best) {
@@ -218,6 +219,7 @@ static polyc_status polish(polyc__opt *o, double best)
             return polyc__fail(o->ctx, POLYC_ERR_NOMEM, "no room to restore the best map");
         if ((st = polyc__rebuild(o)) != POLYC_OK)
             return st;
+        o->untangle_mark = o->zip_mark = 0;
     }
     for (int k = 0; k < 8 && polyc__op_split(o) > 0; k++)
         ;
@@ -258,6 +260,7 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
             noise = 0.0; /* single scan: see docs/algorithm.md */
         if (noise > 0.0) {
             polyc__op_noise(&o, noise);
+            o.untangle_mark = o.zip_mark = 0; /* every segment moved */
             if ((st = polyc__rebuild(&o)) != POLYC_OK)
                 return restore_best(&o, st);
         }

@@ -112,6 +112,8 @@ typedef struct polyc__opt {
     uint32_t work_stamp;
     uint32_t *v_touch;             /* per vertex: touch_stamp of the last edit near it */
     uint32_t touch_stamp;
+    uint32_t untangle_mark, zip_mark; /* touch_stamp of their last passes: a segment
+                                    * edited since is looked at again */
     polyc__rng rng;
     polyc__flat best;
     double noise_m;

@@ -173,13 +173,24 @@ static int apply(polyc__opt *o, const fix *f)
     return c != POLYC__NONE;
 }
 
+/* Whether segment v (live) was edited since the touch stamp `since`: a
+ * crossing or a doubly covered stretch that is new has a new or moved
+ * segment on one side, so a pass needs to look only at those. */
+static int edited(const polyc__opt *o, int32_t v, uint32_t since)
+{
+    return o->v_touch[v] >= since || o->v_touch[o->s->v[v].next] >= since;
+}
+
 int polyc__op_untangle(polyc__opt *o)
 {
     polyc__store *s = o->s;
     int fixed = 0;
+    uint32_t since = o->untangle_mark;
+    o->untangle_mark = ++o->touch_stamp;
     for (int32_t v = 0; v < s->v_high; v++) {
         for (int k = 0; k < FIXES_PER_SEGMENT; k++) {
-            if (s->v[v].line == POLYC__NONE || s->v[v].next == POLYC__NONE)
+            if (s->v[v].line == POLYC__NONE || s->v[v].next == POLYC__NONE ||
+                (k == 0 && !edited(o, v, since)))
                 break;
             int32_t w = s->v[v].next;
             const float xy[4] = {s->v[v].x, s->v[v].y, s->v[w].x, s->v[w].y};
@@ -357,9 +368,12 @@ int polyc__op_zip(polyc__opt *o)
     int zipped = 0;
     if (!(o->cfg->overlap_m > 0.0f))
         return 0;
+    uint32_t since = o->zip_mark;
+    o->zip_mark = ++o->touch_stamp;
     for (int32_t v = 0; v < s->v_high; v++) {
         for (int k = 0; k < FIXES_PER_SEGMENT; k++) {
-            if (s->v[v].line == POLYC__NONE || s->v[v].next == POLYC__NONE)
+            if (s->v[v].line == POLYC__NONE || s->v[v].next == POLYC__NONE ||
+                (k == 0 && !edited(o, v, since)))
                 break;
             float t0, t1;
             if (!covered_run(o, v, &t0, &t1))
