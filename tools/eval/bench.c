@@ -1,12 +1,14 @@
 /* bench.c - measure libpolyc on the shared data sets (not in the repo).
  *
- *   bench [--runs N] [--only NAMES] [--single K] [--iterations N] DATA_DIR
+ *   bench [--runs N] [--only NAMES] [--single K] [--iterations N] [--occupancy-only] DATA_DIR
  *
  * Takes DATA_DIR/sim/NAME.log (+ NAME.gt.txt ground truth) and
  * DATA_DIR/carmen/NAME.log. Prints one table: per scene the input size, the
  * median time of each stage over N runs, memory, and accuracy (scored by
  * tools/eval/gtscore), a second table of topology figures (tools/eval/gttopo), then a
- * single-scan section on the real logs. Logs are read
+ * single-scan section on the real logs, then the occupancy-map section (the
+ * library and a findContours-style baseline on grids, and a speed row on a
+ * 2,000 x 2,000-cell map file). Logs are read
  * with tools/scanlog, the same reader as the CLI. Exit codes: 0 ok, 1 some
  * scene failed, 2 usage or no data directory.
  */
@@ -54,6 +56,7 @@ static const char usage_text[] =
     "                   override polyc_config's alpha, gamma, cell_m,\n"
     "                   grazing_cells, data_min_m (default: the library's)\n"
     "  --seed N         the optimiser's PRNG seed (default: the library's)\n"
+    "  --occupancy-only only the occupancy-map section\n"
     "  -h, --help       this text\n"
     "Columns: stage times in ms (parse = reading the log, add = polyc_add_scan,\n"
     "grid, contour, trace, optimise, output = JSON to /dev/null); block and used\n"
@@ -76,6 +79,20 @@ static const char usage_text[] =
     "from another part of the map; sim scenes: rms = precision RMS, core = the\n"
     "precision RMS of the samples within 0.5 m of a true wall (mm); ms = the\n"
     "topology scorers' time.\n"
+    "Occupancy maps (last section, docs/evaluation.md): sim scenes but the circles\n"
+    "through the log-odds mapper at 5 cm (tools/eval/occmap.h), intel, fhw and aces\n"
+    "as their hit/miss grid at 5 cm written and read back as `polyc grid` writes it;\n"
+    "each grid mapped by the library (libpolyc: polyc_add_grid, polyc_build) and by\n"
+    "the baseline (contours: findContours + approxPolyDP at one cell,\n"
+    "tools/eval/gridtrace.h). grid = occmap or hit/miss, cells = width x height,\n"
+    "occ = occupied cells, gridms = time to make the grid; lines, verts, ideal,\n"
+    "x = verts / ideal; core = core precision (0.5 m, mm), compl = completeness\n"
+    "(sim); occ1 = share of occupied cells within one cell (5 cm) of the map;\n"
+    "dcov (m), dcov%, cross against the occupied cells' centres; ms = grid to\n"
+    "polylines. maze: a 2,000 x 2,000-cell maze at 5 cm written as PGM + YAML to\n"
+    "a temporary folder, then read, converted to cells, mapped and written as JSON\n"
+    "(to /dev/null) as `polyc map.yaml` does, each timed (target: under 1 s); it\n"
+    "runs unless --only leaves out `maze`.\n"
     "Exit: 0 ok; 1 a scene failed (its row says why); 2 usage error, or\n"
     "DATA_DIR missing: 'bench: data directory DIR not found (pass DATA=path)'.\n";
 

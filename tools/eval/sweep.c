@@ -1,14 +1,16 @@
 /* sweep.c - the library's maps on simulated scenes of every kind and many
  * seeds, scored against each scene's own ground truth.
  *
- *   sweep [--seeds A-B] [--kinds a,b,...] [--save DIR] [--svg DIR]
+ *   sweep [--seeds A-B] [--kinds a,b,...] [--save DIR] [--svg DIR] [--occupancy]
  *
  * Takes nothing from disk: every scene is simulated (tools/eval/scansim.h), its
  * ground truth written to memory and read back by tools/eval/gtscore.h, its scans
  * mapped by the whole pipeline (tools/eval/pipeline.h: polyc_config_default,
  * polyc_limits_for_scans, one malloc'ed block). Gives one row per scene,
  * then per kind and over all the median and the worst of every figure, and
- * whether each scene meets the targets. Exit codes: 0 every scene ran (met
+ * whether each scene meets the targets. --occupancy maps each scene's
+ * occupancy grid (tools/eval/occmap.h) through polyc_add_grid instead.
+ * Exit codes: 0 every scene ran (met
  * its targets or not), 1 some scene failed to run, 2 usage error.
  */
 #include <errno.h>
