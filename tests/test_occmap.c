@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include "occmap.h"
+#include "pipeline.h"
 
 #define RES 0.1
 #define WALL_X 1.05
@@ -214,6 +215,52 @@ static void test_no_return(void **state)
     assert_int_equal(occmap_build(&m, &c, scans, 5), -1);
 }
 
+/* The grid as the bench feeds it to the library (pipeline_run_grid): a
+ * 3 m wall at x = 2.013 seen from 2 m by a fan of beams at 5 cm cells
+ * comes out as one polyline along it. */
+static void test_library_on_grid(void **state)
+{
+    enum { SCANS = 8, BEAMS = 181 };
+    static float ranges[SCANS][BEAMS];
+    polyc_scan scans[SCANS];
+    occmap_config c;
+    occmap m;
+    polyc_occupancy_grid g;
+    polyc_config config;
+    pipeline p;
+    double ms;
+    uint32_t count = 0;
+    (void)state;
+    for (int s = 0; s < SCANS; s++) {
+        double py = -0.4 + 0.1 * s;
+        for (int i = 0; i < BEAMS; i++) {
+            double a = -0.9 + 1.8 * i / (BEAMS - 1), t = cos(a) > 0.0 ? 2.013 / cos(a) : 99.0;
+            double y = py + t * sin(a);
+            ranges[s][i] = (float)(fabs(y) <= 1.5 ? t : 30.0);  /* no return past the wall */
+        }
+        scans[s] = one_beam(0.0, py, -0.9, ranges[s]);
+        scans[s].angle_step_rad = (float)(1.8 / (BEAMS - 1));
+        scans[s].beam_count = BEAMS;
+    }
+    occmap_config_default(&c);
+    assert_int_equal(occmap_build(&m, &c, scans, SCANS), 0);
+    assert_true(m.occupied >= 55u && m.occupied <= 130u);   /* 3 m of 5 cm cells, 1-2 deep */
+    occmap_grid(&m, &g);
+    polyc_config_default(&config);
+    assert_int_equal(pipeline_run_grid(&p, &config, &g, &ms), 0);
+    polyc_polyline *lines = pipeline_lines(&p, &count);
+    assert_non_null(lines);
+    assert_int_equal(count, 1);
+    assert_int_equal(lines[0].point_count, 2);
+    for (uint32_t k = 0; k < lines[0].point_count; k++) {
+        assert_near(lines[0].xy_m[2u * k], 2.013, 0.05);
+        assert_true(fabs((double)lines[0].xy_m[2u * k + 1u]) <= 1.6);
+    }
+    free(lines);
+    pipeline_close(&p);
+    occmap_free(&m);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -221,6 +268,7 @@ int main(void)
         cmocka_unit_test(test_wall),
         cmocka_unit_test(test_traversal),
         cmocka_unit_test(test_no_return),
+        cmocka_unit_test(test_library_on_grid),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -10,8 +10,8 @@
  * then per kind and over all the median and the worst of every figure, and
  * whether each scene meets the targets. --occupancy maps each scene's
  * occupancy grid (tools/eval/occmap.h) through polyc_add_grid instead.
- * Exit codes: 0 every scene ran (met
- * its targets or not), 1 some scene failed to run, 2 usage error.
+ * Exit codes: 0 every scene ran (met its targets or not), 1 some scene
+ * failed to run, 2 usage error.
  */
 #include <errno.h>
 #include <math.h>
