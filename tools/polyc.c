@@ -17,6 +17,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "gridimage.h"
 #include "mapfile.h"
 #include "mapout.h"
 #include "polyc.h"
@@ -524,7 +525,7 @@ typedef struct run {
     void *block;
     polyc_polyline *lines;
     membuf out, trace;
-    uint8_t *pixels;           /* polyc grid */
+    gridimage image;           /* polyc grid */
     membuf pgm, yaml;
 } run;
 
@@ -1047,30 +1048,23 @@ static int grid_files(const options *o, run *r, double t_start)
     progress_stage("grid");
     if ((st = polyc_build_grid(ctx)) != POLYC_OK)
         return library_fail("grid", st, ctx, size);
-    double ox, oy;
-    float cell;
-    uint32_t w, h;
-    if ((st = polyc_grid_info(ctx, &ox, &oy, &cell, &w, &h)) != POLYC_OK)
+    gridimage *img = &r->image;
+    int made = gridimage_make(ctx, img, &st);
+    if (made == GRIDIMAGE_LIBRARY)
         return library_fail("grid", st, ctx, size);
-    if ((uint64_t)w * h > MAPFILE_MAX_CELLS || w == 0 || h == 0)
+    if (made == GRIDIMAGE_TOO_LARGE)
         return complain(EXIT_INPUT, "%s: the grid is %u x %u cells of %g m: more than the %u a"
                                     " map may have (try a larger --cell)",
-                        input_name(o), (unsigned)w, (unsigned)h, (double)cell, MAPFILE_MAX_CELLS);
+                        input_name(o), (unsigned)img->width, (unsigned)img->height,
+                        (double)img->cell_m, MAPFILE_MAX_CELLS);
+    if (made != GRIDIMAGE_OK)
+        return complain(EXIT_INPUT, "out of memory for %u x %u pixels", (unsigned)img->width,
+                        (unsigned)img->height);
     progress_stage("writing");
-    if (!(r->pixels = malloc((size_t)w * h)))
-        return complain(EXIT_INPUT, "out of memory for %u x %u pixels", (unsigned)w, (unsigned)h);
-    uint64_t counts[256] = {0};
-    for (uint32_t row = 0; row < h; row++) {   /* the PGM's first row is the top */
-        uint32_t iy = h - 1 - row;
-        for (uint32_t ix = 0; ix < w; ix++) {
-            uint32_t hits = 0, misses = 0;
-            if ((st = polyc_grid_cell(ctx, ix, iy, &hits, &misses, NULL)) != POLYC_OK)
-                return library_fail("grid", st, ctx, size);
-            uint8_t px = mapfile_grid_pixel(hits, misses);
-            r->pixels[(size_t)row * w + ix] = px;
-            counts[px]++;
-        }
-    }
+    uint32_t w = img->width, h = img->height;
+    float cell = img->cell_m;
+    double ox = img->origin_x_m, oy = img->origin_y_m;
+    const uint64_t *counts = img->counts;
     /* PREFIX.pgm and PREFIX.yaml; the YAML names the image by its base name */
     size_t plen = strlen(o->output);
     char *pgm_path = malloc(plen + 6), *yaml_path = malloc(plen + 6);
@@ -1088,7 +1082,7 @@ static int grid_files(const options *o, run *r, double t_start)
         if (!rc && (membuf_open(&r->pgm) || membuf_open(&r->yaml)))
             rc = EXIT_INPUT;
         if (!rc) {
-            int bad = mapfile_write_pgm(r->pgm.f, r->pixels, w, h, (double)cell);
+            int bad = mapfile_write_pgm(r->pgm.f, img->pixels, w, h, (double)cell);
             rc = membuf_close(&r->pgm, bad);
         }
         if (!rc) {
@@ -1233,7 +1227,7 @@ int main(int argc, char **argv)
     }
     free(r.lines);
     free(r.block);
-    free(r.pixels);
+    gridimage_free(&r.image);
     scanlog_free(&r.log);
     mapfile_yaml_free(&map.yaml);
     mapfile_pgm_free(&map.pgm);

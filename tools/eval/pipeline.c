@@ -98,6 +98,30 @@ int pipeline_run(pipeline *p, const polyc_scan *scans, uint32_t n, double *times
     return 0;
 }
 
+int pipeline_run_grid(pipeline *p, const polyc_config *config, const polyc_occupancy_grid *grid,
+                      double *ms)
+{
+    double t = pipeline_now_ms();
+    memset(p, 0, sizeof *p);
+    p->config = *config;
+    *ms = 0.0;
+    if (step(p, polyc_limits_for_grid(&p->config, grid, &p->limits), "polyc_limits_for_grid"))
+        return -1;
+    p->block_size = polyc_memory_size(&p->config, &p->limits);
+    if (p->block_size == 0)
+        return step(p, POLYC_ERR_CONFIG, "polyc_memory_size");
+    p->block = malloc(p->block_size);
+    if (!p->block)
+        return step(p, POLYC_ERR_NOMEM, "malloc of the block");
+    if (step(p, polyc_init(p->block, p->block_size, &p->config, &p->limits, &p->ctx),
+             "polyc_init") ||
+        step(p, polyc_add_grid(p->ctx, grid), "polyc_add_grid") ||
+        step(p, polyc_build(p->ctx, NULL, NULL), "polyc_build"))
+        return -1;
+    *ms = pipeline_now_ms() - t;
+    return 0;
+}
+
 polyc_polyline *pipeline_lines(pipeline *p, uint32_t *count)
 {
     uint32_t i, n = polyc_polyline_count(p->ctx);

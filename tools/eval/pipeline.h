@@ -40,6 +40,12 @@ void pipeline_close(pipeline *p);
  * stage. A map that needs more vertices or points than the usual limits
  * runs again with the worst-case limits, as the polyc tool does. */
 int pipeline_run(pipeline *p, const polyc_scan *scans, uint32_t n, double *times);
+/* The library on an occupancy grid, as `polyc map.yaml` runs it: limits
+ * (polyc_limits_for_grid), one malloc'ed block, init, polyc_add_grid,
+ * polyc_build. *ms gets the time of it all. Call pipeline_close after,
+ * whatever the result. */
+int pipeline_run_grid(pipeline *p, const polyc_config *config, const polyc_occupancy_grid *grid,
+                      double *ms);
 /* The current map as an array of polylines (malloc'ed; NULL on failure). */
 polyc_polyline *pipeline_lines(pipeline *p, uint32_t *count);
 

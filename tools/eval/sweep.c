@@ -1,15 +1,17 @@
 /* sweep.c - the library's maps on simulated scenes of every kind and many
  * seeds, scored against each scene's own ground truth.
  *
- *   sweep [--seeds A-B] [--kinds a,b,...] [--save DIR] [--svg DIR]
+ *   sweep [--seeds A-B] [--kinds a,b,...] [--save DIR] [--svg DIR] [--occupancy]
  *
  * Takes nothing from disk: every scene is simulated (tools/eval/scansim.h), its
  * ground truth written to memory and read back by tools/eval/gtscore.h, its scans
  * mapped by the whole pipeline (tools/eval/pipeline.h: polyc_config_default,
  * polyc_limits_for_scans, one malloc'ed block). Gives one row per scene,
  * then per kind and over all the median and the worst of every figure, and
- * whether each scene meets the targets. Exit codes: 0 every scene ran (met
- * its targets or not), 1 some scene failed to run, 2 usage error.
+ * whether each scene meets the targets. --occupancy maps each scene's
+ * occupancy grid (tools/eval/occmap.h) through polyc_add_grid instead.
+ * Exit codes: 0 every scene ran (met its targets or not), 1 some scene
+ * failed to run, 2 usage error.
  */
 #include <errno.h>
 #include <math.h>
@@ -20,6 +22,7 @@
 
 #include "gtscore.h"
 #include "gttopo.h"
+#include "occmap.h"
 #include "pipeline.h"
 #include "polyc.h"
 #include "scansim.h"
@@ -37,6 +40,13 @@
  * map over 20 cm without a scan endpoint within 5 cm */
 #define TARGET_DCOV_M 0.25
 #define CORE_M 0.5                 /* core precision: map samples this near a true wall */
+/* --occupancy: the scenes through the mapper at 5 cm (tools/eval/occmap.h)
+ * and the library's polyc_add_grid; its targets: core precision at most
+ * 12 mm, 97 % of the seen walls, 1.5 x ideal vertices, no crossing */
+#define OCC_CELL_M 0.05
+#define OCC_MIN 65                 /* an occupied cell: value >= 100 x occupied_thresh */
+#define OCC_TARGET_CORE_M 0.012
+#define OCC_TARGET_COMPLETENESS 0.97
 
 static const char usage_text[] =
     "usage: sweep [options]\n"
@@ -50,7 +60,14 @@ static const char usage_text[] =
     "  --save DIR       write DIR/KIND-sSEED.log and .gt.txt (for build/polyc)\n"
     "  --svg DIR        write DIR/KIND-sSEED.svg: true walls (grey), the robot's\n"
     "                   path (blue), people (pink), the map (black, dots on vertices;\n"
-    "                   red where a segment strays over 5 cm from every true wall)\n"
+    "                   red where a segment strays over 5 cm from every true wall;\n"
+    "                   with --occupancy the occupied cells, green)\n"
+    "  --occupancy      map each scene's occupancy grid instead of its scans: the\n"
+    "                   log-odds mapper at 5 cm (tools/eval/occmap.h), then\n"
+    "                   polyc_add_grid and polyc_build; ms is that library run,\n"
+    "                   dcov and uns20 are measured against the occupied cells'\n"
+    "                   centres, and the targets are P core > 12 mm, C compl <\n"
+    "                   0.97, V verts > 1.5 x ideal, T any crossing\n"
     "  -h, --help       this text\n"
     "Columns: scans, beams (all scans), ms (the pipeline from polyc_init to the\n"
     "optimised map), verts (map vertices), ideal, ratio (verts / ideal), rms\n"
@@ -70,6 +87,7 @@ typedef struct options {
     unsigned kind_count;
     const char *save_dir;      /* NULL: none */
     const char *svg_dir;       /* NULL: none */
+    int occupancy;             /* --occupancy */
 } options;
 
 /* ---- the figures ----------------------------------------------------------- */
@@ -140,9 +158,12 @@ static int truth_of(const scansim_scene *sc, gtscore_truth *truth, char *err, si
 }
 
 /* Every figure of one map and the targets it misses: the one place that
- * scores a scene. */
+ * scores a scene. The topology's data: the occupied cells' centres of
+ * `grid` when it is given (--occupancy, whose targets then apply), else the
+ * scans' endpoints. */
 static int score_scene(const scansim_scene *sc, const gtscore_truth *truth,
-                       const polyc_polyline *lines, uint32_t count, double pipeline_ms, row *r)
+                       const polyc_polyline *lines, uint32_t count, double pipeline_ms,
+                       const polyc_occupancy_grid *grid, row *r)
 {
     gtscore_map_score score;
     gttopo_score topo;
@@ -154,8 +175,10 @@ static int score_scene(const scansim_scene *sc, const gtscore_truth *truth,
     if (gtscore_score_map(truth, lines, count, &score) != 0 ||
         gtscore_core_precision(truth, lines, count, CORE_M, &core_m) != 0 ||
         gtscore_ideal_fit(truth, sc->scans, sc->scan_count, &fit_m) != 0 ||
-        gtscore_line_floor(truth, sc->scans, sc->scan_count, &floor_m) != 0 ||
-        gttopo_scan_points(sc->scans, sc->scan_count, &hits, &hit_count) != 0)
+        gtscore_line_floor(truth, sc->scans, sc->scan_count, &floor_m) != 0)
+        return -1;
+    if (grid ? occmap_cell_points(grid, OCC_MIN, &hits, &hit_count) != 0
+             : gttopo_scan_points(sc->scans, sc->scan_count, &hits, &hit_count) != 0)
         return -1;
     int topo_rc = gttopo_score_map(lines, count, hits, hit_count, &topo);
     free(hits);
@@ -176,6 +199,17 @@ static int score_scene(const scansim_scene *sc, const gtscore_truth *truth,
     r->fig[FIG_FLOOR] = floor_m >= 0.0 ? floor_m : (double)NAN;
     r->fig[FIG_COMPL] = score.completeness;
     r->missed = 0;
+    if (grid) {
+        if (core_m > OCC_TARGET_CORE_M)
+            r->missed |= MISS_PRECISION;
+        if (topo.crossings > 0)
+            r->missed |= MISS_TOPOLOGY;
+        if (score.completeness < OCC_TARGET_COMPLETENESS)
+            r->missed |= MISS_COMPLETENESS;
+        if (score.ideal && (double)score.vertices > TARGET_RATIO * (double)score.ideal)
+            r->missed |= MISS_VERTICES;
+        return 0;
+    }
     if (fit_m >= 0.0 && core_m > fmax(TARGET_FIT_FACTOR * fit_m, fit_m + TARGET_FIT_MARGIN_M))
         r->missed |= MISS_PRECISION;
     if (topo.double_cover_m > TARGET_DCOV_M || topo.crossings > 0 || topo.unsupported_20 > 0)
@@ -205,7 +239,8 @@ static int segment_off(const gtscore_truth *truth, const float *a, const float *
 /* The scene's true walls, the robot's path, its people and the map (a
  * segment in red where it strays over 5 cm from every true wall). */
 static int write_svg(const char *path, const scansim_scene *sc, const gtscore_truth *truth,
-                     const polyc_polyline *lines, uint32_t count)
+                     const polyc_polyline *lines, uint32_t count,
+                     const polyc_occupancy_grid *grid)
 {
     double x0 = HUGE_VAL, y0 = HUGE_VAL, x1 = -HUGE_VAL, y1 = -HUGE_VAL;
     uint32_t i, j, w;
@@ -233,6 +268,16 @@ static int write_svg(const char *path, const scansim_scene *sc, const gtscore_tr
             fprintf(f, "%.3f,%.3f ", sc->wall_xy_m[2u * (wall->first_point + j)],
                     -sc->wall_xy_m[2u * (wall->first_point + j) + 1u]);
         fprintf(f, "\"/>\n");
+    }
+    if (grid) {                /* --occupancy: the occupied cells, under the map */
+        double res = (double)grid->resolution_m;
+        for (j = 0; j < grid->height; j++)
+            for (i = 0; i < grid->width; i++)
+                if (grid->cells[(size_t)j * grid->width + i] >= OCC_MIN)
+                    fprintf(f, "<rect x=\"%.4f\" y=\"%.4f\" width=\"%.4f\" height=\"%.4f\" "
+                               "fill=\"#8c8\" opacity=\"0.6\"/>\n",
+                            grid->origin_x_m + res * i, -(grid->origin_y_m + res * (j + 1u)),
+                            res, res);
     }
     fprintf(f, "<polyline fill=\"none\" stroke=\"#48f\" stroke-width=\"0.02\" points=\"");
     for (i = 0; i < sc->pose_count; i++)
@@ -292,6 +337,8 @@ static int sweep_scene(const options *o, const char *kind, uint64_t seed, row *r
 {
     scansim_scene sc;
     gtscore_truth truth;
+    occmap occ;
+    polyc_occupancy_grid grid;
     pipeline p;
     polyc_config config;
     polyc_polyline *lines = NULL;
@@ -306,6 +353,7 @@ static int sweep_scene(const options *o, const char *kind, uint64_t seed, row *r
     snprintf(label, sizeof label, "%-10s %4llu", kind, (unsigned long long)seed);
     memset(&truth, 0, sizeof truth);
     memset(&p, 0, sizeof p);
+    memset(&occ, 0, sizeof occ);
     if (scansim_scene_builtin(&sc, kind, seed) != 0) {
         printf("%s error: out of memory\n", label);
         return -1;
@@ -319,16 +367,35 @@ static int sweep_scene(const options *o, const char *kind, uint64_t seed, row *r
         goto done;
     }
     polyc_config_default(&config);
-    if (pipeline_open(&p, &config, sc.scans, sc.scan_count) != 0 ||
-        pipeline_run(&p, sc.scans, sc.scan_count, times) != 0 ||
-        (lines = pipeline_lines(&p, &count)) == NULL) {
-        printf("%s error in %s: %s (%s)\n", label, p.failed_at ? p.failed_at : "pipeline_lines",
-               polyc_status_str(p.status), p.ctx ? polyc_last_error(p.ctx) : "");
-        goto done;
+    if (o->occupancy) {
+        occmap_config oc;
+        occmap_config_default(&oc);
+        oc.resolution_m = OCC_CELL_M;
+        if (occmap_build(&occ, &oc, sc.scans, sc.scan_count) != 0) {
+            printf("%s error: the occupancy mapper failed\n", label);
+            goto done;
+        }
+        occmap_grid(&occ, &grid);
+        if (pipeline_run_grid(&p, &config, &grid, &ms) != 0 ||
+            (lines = pipeline_lines(&p, &count)) == NULL) {
+            printf("%s error in %s: %s (%s)\n", label,
+                   p.failed_at ? p.failed_at : "pipeline_lines", polyc_status_str(p.status),
+                   p.ctx ? polyc_last_error(p.ctx) : "");
+            goto done;
+        }
+    } else {
+        if (pipeline_open(&p, &config, sc.scans, sc.scan_count) != 0 ||
+            pipeline_run(&p, sc.scans, sc.scan_count, times) != 0 ||
+            (lines = pipeline_lines(&p, &count)) == NULL) {
+            printf("%s error in %s: %s (%s)\n", label,
+                   p.failed_at ? p.failed_at : "pipeline_lines", polyc_status_str(p.status),
+                   p.ctx ? polyc_last_error(p.ctx) : "");
+            goto done;
+        }
+        for (i = 0; i < PIPELINE_STAGES; i++)
+            ms += times[i];
     }
-    for (i = 0; i < PIPELINE_STAGES; i++)
-        ms += times[i];
-    if (score_scene(&sc, &truth, lines, count, ms, r) != 0) {
+    if (score_scene(&sc, &truth, lines, count, ms, o->occupancy ? &grid : NULL, r) != 0) {
         printf("%s error: scoring ran out of memory\n", label);
         goto done;
     }
@@ -347,13 +414,15 @@ static int sweep_scene(const options *o, const char *kind, uint64_t seed, row *r
                  kind, (unsigned long long)seed);
         if (o->save_dir && scansim_save(&sc, log_path, gt_path) != 0)
             fprintf(stderr, "sweep: cannot write %s: %s\n", log_path, strerror(errno));
-        if (o->svg_dir && write_svg(svg_path, &sc, &truth, lines, count) != 0)
+        if (o->svg_dir && write_svg(svg_path, &sc, &truth, lines, count,
+                                    o->occupancy ? &grid : NULL) != 0)
             fprintf(stderr, "sweep: cannot write %s: %s\n", svg_path, strerror(errno));
     }
     rc = 0;
 done:
     free(lines);
     pipeline_close(&p);
+    occmap_free(&occ);
     gtscore_truth_free(&truth);
     scansim_scene_free(&sc);
     return rc;
@@ -461,6 +530,8 @@ static int parse_options(int argc, char **argv, options *o)
                 return -1;
         } else if (strcmp(a, "--save") == 0 && i + 1 < argc) {
             o->save_dir = argv[++i];
+        } else if (strcmp(a, "--occupancy") == 0) {
+            o->occupancy = 1;
         } else if (strcmp(a, "--svg") == 0 && i + 1 < argc) {
             o->svg_dir = argv[++i];
         } else
@@ -490,12 +561,22 @@ int main(int argc, char **argv)
         fprintf(stderr, "sweep: out of memory\n");
         return EXIT_FAILED;
     }
-    printf("libpolyc %u.%u.%u sweep: seeds %llu-%llu, targets: P core <= max(%.2f x fit, fit + "
-           "%.1f mm), C compl >= %.2f, V verts <= %.1f x ideal, T dcov <= %.2f m, 0 cross, "
-           "0 uns20\n",
-           polyc_version() / 10000u, polyc_version() / 100u % 100u, polyc_version() % 100u,
-           (unsigned long long)o.seed_first, (unsigned long long)o.seed_last, TARGET_FIT_FACTOR,
-           1e3 * TARGET_FIT_MARGIN_M, TARGET_COMPLETENESS, TARGET_RATIO, TARGET_DCOV_M);
+    if (o.occupancy)
+        printf("libpolyc %u.%u.%u sweep --occupancy: seeds %llu-%llu, each scene's log-odds map at "
+               "%.0f cm through polyc_add_grid; targets: P core <= %.0f mm, C compl >= %.2f, V "
+               "verts <= %.1f x ideal, T 0 cross (dcov, uns20 against the occupied cells)\n",
+               polyc_version() / 10000u, polyc_version() / 100u % 100u, polyc_version() % 100u,
+               (unsigned long long)o.seed_first, (unsigned long long)o.seed_last,
+               100.0 * OCC_CELL_M, 1e3 * OCC_TARGET_CORE_M, OCC_TARGET_COMPLETENESS,
+               TARGET_RATIO);
+    else
+        printf("libpolyc %u.%u.%u sweep: seeds %llu-%llu, targets: P core <= max(%.2f x fit, fit + "
+               "%.1f mm), C compl >= %.2f, V verts <= %.1f x ideal, T dcov <= %.2f m, 0 cross, "
+               "0 uns20\n",
+               polyc_version() / 10000u, polyc_version() / 100u % 100u, polyc_version() % 100u,
+               (unsigned long long)o.seed_first, (unsigned long long)o.seed_last,
+               TARGET_FIT_FACTOR, 1e3 * TARGET_FIT_MARGIN_M, TARGET_COMPLETENESS, TARGET_RATIO,
+               TARGET_DCOV_M);
     printf("%-10s %4s", "kind", "seed");
     for (f = 0; f < FIG_COUNT; f++)
         printf(" %*s", figures[f].width, figures[f].name);
