@@ -319,6 +319,9 @@ void polyc__traverse(const polyc__beam *b, polyc__cell_fn visit, void *u);
 
 /* occupancy.c: the grid and contour stages of an occupancy grid, at once */
 polyc_status polyc__occ_add(polyc_ctx *ctx, const polyc_occupancy_grid *grid);
+/* whether the cell at (x, y), in the optimiser's frame, is free (stored
+ * tiles only: others read as unknown) */
+int polyc__occ_free_at(const polyc_ctx *ctx, float x, float y);
 
 /* contour.c */
 /* entries the grid's tile directory may have under the limits */

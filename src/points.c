@@ -187,13 +187,28 @@ static polyc_status collect_raw(polyc__opt *o, polyc__point *tmp, int32_t cap, i
     return POLYC_OK;
 }
 
-/* An occupancy grid's data: one point per occupied cell (a hit in its
- * tile, occupancy.c), at the cell's centre, of weight OCC_WEIGHT and no
- * spread. */
+/* An occupancy grid's data: one point at the centre of each occupied cell
+ * that faces free space (its side neighbour free, or unknown with a free
+ * cell beyond it, as occupancy.c's contour), weight 1. The other occupied
+ * cells are inside a wall or behind one, not its surface: with them the
+ * lines lie in the middle of the occupied bands a mapper leaves (1-3 cells),
+ * half a cell or more behind the walls. The centre, not the side facing free
+ * space: a hit's cell holds the wall anywhere across it, and its free side
+ * lies half a cell in front of the wall on average. */
 #define OCC_WEIGHT 1.0f
+
+static int cell_class(const polyc__grid *g, int32_t ix, int32_t iy)
+{
+    const polyc__tile *t = polyc__grid_tile(g, ix, iy);
+    if (!t)
+        return 0; /* unknown */
+    int k = polyc__cell_index(ix, iy);
+    return t->hits[k] ? 2 : (t->misses[k] ? 1 : 0);
+}
 
 static polyc_status collect_occupied(polyc__opt *o, polyc__point *tmp, int32_t cap, int32_t *n_out)
 {
+    static const int8_t side[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
     polyc_ctx *ctx = o->ctx;
     const polyc__grid *g = &ctx->grid;
     int32_t n = 0, dir_n = g->tiles_x * g->tiles_y;
@@ -205,12 +220,20 @@ static polyc_status collect_occupied(polyc__opt *o, polyc__point *tmp, int32_t c
         for (int32_t k = 0; k < POLYC__TILE_CELLS; k++) {
             if (!t->hits[k])
                 continue;
+            int32_t ix = tx + (k & (POLYC__TILE_SIDE - 1)), iy = ty + (k >> POLYC__TILE_SHIFT);
+            int faces = 0;
+            for (int e = 0; e < 4 && !faces; e++) {
+                int a = cell_class(g, ix + side[e][0], iy + side[e][1]);
+                faces = a == 1 || (a == 0 && cell_class(g, ix + 2 * side[e][0], iy + 2 * side[e][1]) == 1);
+            }
+            if (!faces)
+                continue; /* inside or behind a wall */
             if (n >= cap)
                 return polyc__fail(ctx, POLYC_ERR_NOMEM, "more data points than limits.max_points");
             polyc__point *p = &tmp[n++];
             memset(p, 0, sizeof *p);
-            p->x = cell_centre(0.0, tx + (k & (POLYC__TILE_SIDE - 1)), g->cell_m);
-            p->y = cell_centre(0.0, ty + (k >> POLYC__TILE_SHIFT), g->cell_m);
+            p->x = cell_centre(0.0, ix, g->cell_m);
+            p->y = cell_centre(0.0, iy, g->cell_m);
             p->w = OCC_WEIGHT;
         }
     }

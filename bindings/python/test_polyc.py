@@ -227,7 +227,14 @@ class Grid(unittest.TestCase):
         # every vertex of the pillar's polyline within a cell and a half of its square
         for x, y in pillar[0].points:
             self.assertLess(max(abs(x - 2.15), abs(y - 1.15)), 0.15 + 0.075)
-        self.assertEqual(result.stats["data_points"], cells.count(100))
+        # the data: the occupied cells that face free space (a free side
+        # neighbour, or an unknown one with a free cell beyond it)
+        def at(i, j):
+            return cells[j * width + i] if 0 <= i < width and 0 <= j < height else -1
+        facing = sum(1 for j in range(height) for i in range(width) if at(i, j) == 100 and any(
+            at(i + di, j + dj) == 0 or (at(i + di, j + dj) == -1 and at(i + 2 * di, j + 2 * dj) == 0)
+            for di, dj in ((1, 0), (-1, 0), (0, 1), (0, -1))))
+        self.assertEqual(result.stats["data_points"], facing)
         self.assertEqual(result.stats["scans"], 0)
         self.assertEqual(result.stats["grid_width"], width)
         self.assertEqual(result.stats["vertices"], len(vertices))
