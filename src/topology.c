@@ -111,9 +111,12 @@ static void try_remove(polyc__opt *o, int32_t v, fix *best)
         if (first_crossing(o, xy, p, n, &t, &u) != POLYC__NONE)
             return;
     }
-    double d = polyc__removal_delta_below(o, v, INFINITY);
-    if (isinf(d))
-        return; /* a single scan's return would go */
+    /* only a removal cheaper than the best fix so far matters: its change is
+     * exact below that bound (INFINITY: a single scan's return would go) */
+    double bound = best->kind != 0 ? best->delta : (double)INFINITY;
+    double d = polyc__removal_delta_below(o, v, bound);
+    if (isinf(d) || (best->kind != 0 && d >= bound))
+        return;
     fix f = {1, v, POLYC__NONE, 0.0f, 0.0f, d};
     consider(best, &f);
 }
@@ -136,14 +139,22 @@ static void try_cut(polyc__opt *o, int32_t seg, float t, int32_t keep, fix *best
     int32_t gone = keep == a ? b : a; /* the vertex on the far side */
     const float old_xy[4] = {V[a].x, V[a].y, V[b].x, V[b].y};
     float new_xy[4] = {V[keep].x, V[keep].y, x, y};
-    double derr = polyc__local_delta(o, &seg, 1, new_xy, 1, INFINITY);
     double dk = 0.0, dangle = 0.0;
     int end = keep == a ? V[b].next == POLYC__NONE : V[a].prev == POLYC__NONE;
     if (!end) {
         dk = 1.0;                  /* the cut adds the vertex at the cut */
         dangle = -o->acost[gone];  /* and the far vertex becomes an end */
     }
-    double d = (double)o->cfg->alpha * (derr + (double)o->cfg->gamma * dangle) + dk * o->log_n;
+    double alpha = (double)o->cfg->alpha, fixed = alpha * (double)o->cfg->gamma * dangle + dk * o->log_n;
+    /* a cut only takes map away, so its error change is >= 0: it matters
+     * only below the best fix so far, and is exact below that */
+    double limit = best->kind != 0 ? (best->delta - fixed) / alpha : (double)INFINITY;
+    if (limit <= 0.0)
+        return;
+    double derr = polyc__local_delta(o, &seg, 1, new_xy, 1, limit);
+    if (derr >= limit)
+        return;
+    double d = alpha * derr + fixed;
     if (o->rays.on && polyc__loses_returns(&o->rays, old_xy, 1, new_xy, 1))
         d += LOSES_RETURNS;
     fix f = {2, keep, seg, x, y, d};
@@ -200,12 +211,14 @@ int polyc__op_untangle(polyc__opt *o)
                 break;
             int32_t ends[4] = {v, w, other, s->v[other].next};
             fix best = {0, POLYC__NONE, POLYC__NONE, 0.0f, 0.0f, 0.0};
-            for (int e = 0; e < 4; e++)
-                try_remove(o, ends[e], &best);
+            /* cuts first: an overshooting end is the usual crossing, and its
+             * trim bounds the rest */
             try_cut(o, v, t, v, &best);
             try_cut(o, v, t, w, &best);
             try_cut(o, other, u, ends[2], &best);
             try_cut(o, other, u, ends[3], &best);
+            for (int e = 0; e < 4; e++)
+                try_remove(o, ends[e], &best);
             if (best.kind == 0 || !apply(o, &best))
                 break;
             fixed++;
