@@ -265,9 +265,9 @@ POLYC_API polyc_status polyc_add_grid(polyc_ctx *ctx, const polyc_occupancy_grid
  * POLYC_ERR_EXTENT. The polylines come in the map frame (the origin pose
  * applied); polyc_grid_info gives the origin corner and the resolution,
  * polyc_grid_cell hits 1 for an occupied cell, misses 1 for a free one (in
- * tiles within two cells of an occupied cell), contour 1 for an occupied
- * cell that faces free space (a free side neighbour, or an unknown one with
- * a free cell beyond). The optimiser's data are those cells' centres; it
+ * tiles within four cells of an occupied cell), contour 1 for an occupied
+ * cell that faces free space (a free cell at most four cells away along a
+ * row or a column, only unknown cells between). The optimiser's data are those cells' centres; it
  * weighs a grid's squared distances by alpha (0.05 / resolution_m)^2, splits
  * only where a gap lies in free cells, searches at least 3 cells and has no
  * angle prior (gamma unused): docs/algorithm.md, "From an occupancy grid". */

@@ -188,8 +188,9 @@ static polyc_status collect_raw(polyc__opt *o, polyc__point *tmp, int32_t cap, i
 }
 
 /* An occupancy grid's data: one point at the centre of each occupied cell
- * that faces free space (its side neighbour free, or unknown with a free
- * cell beyond it, as occupancy.c's contour), weight 1. The other occupied
+ * that faces free space (a free cell at most POLYC__FACE_CELLS away along a
+ * row or a column, only unknown cells between, as occupancy.c's contour),
+ * weight 1. The other occupied
  * cells are inside a wall or behind one, not its surface: with them the
  * lines lie in the middle of the occupied bands a mapper leaves (1-3 cells),
  * half a cell or more behind the walls. The centre, not the side facing free
@@ -222,10 +223,13 @@ static polyc_status collect_occupied(polyc__opt *o, polyc__point *tmp, int32_t c
                 continue;
             int32_t ix = tx + (k & (POLYC__TILE_SIDE - 1)), iy = ty + (k >> POLYC__TILE_SHIFT);
             int faces = 0;
-            for (int e = 0; e < 4 && !faces; e++) {
-                int a = cell_class(g, ix + side[e][0], iy + side[e][1]);
-                faces = a == 1 || (a == 0 && cell_class(g, ix + 2 * side[e][0], iy + 2 * side[e][1]) == 1);
-            }
+            for (int e = 0; e < 4 && !faces; e++)
+                for (int step = 1; step <= POLYC__FACE_CELLS; step++) {
+                    int a = cell_class(g, ix + step * side[e][0], iy + step * side[e][1]);
+                    faces = a == 1;
+                    if (a != 0)
+                        break;
+                }
             if (!faces)
                 continue; /* inside or behind a wall */
             if (n >= cap)

@@ -73,8 +73,9 @@ static int8_t cell_at(const scene *s, int64_t i, int64_t j)
     return s->cells[(size_t)j * s->grid.width + (size_t)i];
 }
 
-/* Occupied cells with a free side neighbour, or an unknown one with a free
- * cell beyond it: the data points and the contour of a grid. */
+/* Occupied cells with a free cell at most 4 cells away along a row or a
+ * column, only unknown cells between: the data points and the contour of a
+ * grid (POLYC__FACE_CELLS). */
 static uint32_t count_facing(const scene *s)
 {
     static const int side[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
@@ -84,11 +85,13 @@ static uint32_t count_facing(const scene *s)
             if (cell_at(s, i, j) != 100)
                 continue;
             int faces = 0;
-            for (int e = 0; e < 4 && !faces; e++) {
-                int8_t a = cell_at(s, (int64_t)i + side[e][0], (int64_t)j + side[e][1]);
-                int8_t b = cell_at(s, (int64_t)i + 2 * side[e][0], (int64_t)j + 2 * side[e][1]);
-                faces = a == 0 || (a == -1 && b == 0);
-            }
+            for (int e = 0; e < 4 && !faces; e++)
+                for (int k = 1; k <= 4; k++) {
+                    int8_t a = cell_at(s, (int64_t)i + k * side[e][0], (int64_t)j + k * side[e][1]);
+                    faces = a == 0;
+                    if (a != -1)
+                        break;
+                }
             n += (uint32_t)faces;
         }
     return n;

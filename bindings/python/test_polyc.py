@@ -227,13 +227,19 @@ class Grid(unittest.TestCase):
         # every vertex of the pillar's polyline within a cell and a half of its square
         for x, y in pillar[0].points:
             self.assertLess(max(abs(x - 2.15), abs(y - 1.15)), 0.15 + 0.075)
-        # the data: the occupied cells that face free space (a free side
-        # neighbour, or an unknown one with a free cell beyond it)
+        # the data: the occupied cells that face free space (a free cell at
+        # most 4 cells away along a row or a column, only unknown between)
         def at(i, j):
             return cells[j * width + i] if 0 <= i < width and 0 <= j < height else -1
+
+        def faces(i, j, di, dj):
+            for k in range(1, 5):
+                v = at(i + k * di, j + k * dj)
+                if v != -1:
+                    return v == 0
+            return False
         facing = sum(1 for j in range(height) for i in range(width) if at(i, j) == 100 and any(
-            at(i + di, j + dj) == 0 or (at(i + di, j + dj) == -1 and at(i + 2 * di, j + 2 * dj) == 0)
-            for di, dj in ((1, 0), (-1, 0), (0, 1), (0, -1))))
+            faces(i, j, di, dj) for di, dj in ((1, 0), (-1, 0), (0, 1), (0, -1))))
         self.assertEqual(result.stats["data_points"], facing)
         self.assertEqual(result.stats["scans"], 0)
         self.assertEqual(result.stats["grid_width"], width)
