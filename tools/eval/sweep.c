@@ -95,8 +95,8 @@ typedef struct options {
 /* One entry per column: to add a figure, add it here, to `figures` and to
  * score_scene. */
 enum figure { FIG_SCANS, FIG_BEAMS, FIG_MS, FIG_VERTS, FIG_IDEAL, FIG_RATIO, FIG_RMS,
-              FIG_CORE, FIG_FIT, FIG_FLOOR, FIG_COMPL, FIG_DCOV, FIG_CROSS, FIG_UNS20,
-              FIG_COUNT };
+              FIG_CORE, FIG_FIT, FIG_FLOOR, FIG_COMPL, FIG_GCOMPL, FIG_DCOV, FIG_CROSS,
+              FIG_UNS20, FIG_COUNT };
 
 typedef struct figure_info {
     const char *name;
@@ -109,7 +109,8 @@ static const figure_info figures[FIG_COUNT] = {
     {"scans", 6, 0, 1.0, 0},   {"beams", 8, 0, 1.0, 0},   {"ms", 7, 1, 1.0, 0},
     {"verts", 6, 0, 1.0, 0},   {"ideal", 6, 0, 1.0, 0},   {"ratio", 6, 2, 1.0, 0},
     {"rms", 6, 1, 1e3, 0},     {"core", 6, 1, 1e3, 0},    {"fit", 6, 1, 1e3, 0},
-    {"floor", 6, 1, 1e3, 0},   {"compl", 7, 4, 1.0, 1},   {"dcov", 6, 2, 1.0, 0},
+    {"floor", 6, 1, 1e3, 0},   {"compl", 7, 4, 1.0, 1},   {"gcompl", 7, 4, 1.0, 1},
+    {"dcov", 6, 2, 1.0, 0},
     {"cross", 5, 0, 1.0, 0},   {"uns20", 5, 0, 1.0, 0},
 };
 
@@ -157,6 +158,33 @@ static int truth_of(const scansim_scene *sc, gtscore_truth *truth, char *err, si
     return rc;
 }
 
+/* --occupancy: the completeness of the grid itself, the share of the seen
+ * samples within GTSCORE_COMPLETE_M of an occupied cell's centre: a wall
+ * the grid does not hold, no map of the grid can hold (a bound on the map's
+ * completeness). */
+static double grid_completeness(const gtscore_truth *truth, const polyc_occupancy_grid *g)
+{
+    double c = cos(g->origin_yaw_rad), sn = sin(g->origin_yaw_rad), r = (double)g->resolution_m;
+    double lim2 = GTSCORE_COMPLETE_M * GTSCORE_COMPLETE_M;
+    uint32_t k, covered = 0;
+    for (k = 0; k < truth->seen_count; k++) {
+        double dx = truth->seen_xy_m[2 * k] - g->origin_x_m, dy = truth->seen_xy_m[2 * k + 1] - g->origin_y_m;
+        double gx = (c * dx + sn * dy) / r, gy = (-sn * dx + c * dy) / r; /* in cells */
+        long i0 = (long)floor(gx), j0 = (long)floor(gy), i, j;
+        int hit = 0;
+        for (j = j0 - 2; j <= j0 + 2 && !hit; j++)
+            for (i = i0 - 2; i <= i0 + 2 && !hit; i++) {
+                if (i < 0 || j < 0 || i >= (long)g->width || j >= (long)g->height ||
+                    g->cells[(size_t)j * g->width + (size_t)i] < OCC_MIN)
+                    continue;
+                double ex = ((double)i + 0.5 - gx) * r, ey = ((double)j + 0.5 - gy) * r;
+                hit = ex * ex + ey * ey <= lim2;
+            }
+        covered += (uint32_t)hit;
+    }
+    return truth->seen_count ? (double)covered / (double)truth->seen_count : 1.0;
+}
+
 /* Every figure of one map and the targets it misses: the one place that
  * scores a scene. The topology's data: the occupied cells' centres of
  * `grid` when it is given (--occupancy, whose targets then apply), else the
@@ -200,6 +228,7 @@ static int score_scene(const scansim_scene *sc, const gtscore_truth *truth,
     r->fig[FIG_COMPL] = score.completeness;
     r->missed = 0;
     if (grid) {
+        r->fig[FIG_GCOMPL] = grid_completeness(truth, grid);
         if (core_m > OCC_TARGET_CORE_M)
             r->missed |= MISS_PRECISION;
         if (topo.crossings > 0)
