@@ -79,8 +79,8 @@ static const char usage_text[] =
     "data within 5 cm), then the targets missed: P core precision > max(1.25 x\n"
     "fit, fit + 1.5 mm), C completeness < 0.98, V vertices > 1.5 x ideal, T\n"
     "double cover > 0.25 m, a crossing or a run over 20 cm ('ok': none).\n"
-    "Summary rows give per kind and over "
-    "all the median and the worst (highest; completeness: lowest) of each figure.\n"
+    "Summary rows give per kind and over all the median and the worst (highest;\n"
+    "completeness: lowest) of each figure.\n"
     "Exit: 0 every scene ran; 1 a scene failed (its row says why); 2 usage error.\n";
 
 static const char *const default_kinds[] = {"hall",   "shelves", "flat",   "curved",
