@@ -319,14 +319,12 @@ void polyc__traverse(const polyc__beam *b, polyc__cell_fn visit, void *u);
 
 /* occupancy.c: the grid and contour stages of an occupancy grid, at once */
 polyc_status polyc__occ_add(polyc_ctx *ctx, const polyc_occupancy_grid *grid);
-/* whether the cell at (x, y), in the optimiser's frame, is free (stored
- * tiles only: others read as unknown) */
+/* 1 if the cell at (x, y), in the optimiser's frame, is a free cell of the
+ * grid; a cell outside the stored tiles reads as unknown */
 int polyc__occ_free_at(const polyc_ctx *ctx, float x, float y);
 /* An occupied cell faces free space if a free cell lies this many cells or
  * fewer along a row or a column, with only unknown cells between */
-#ifndef POLYC__FACE_CELLS
 #define POLYC__FACE_CELLS 4
-#endif
 
 /* contour.c */
 /* entries the grid's tile directory may have under the limits */

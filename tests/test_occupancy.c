@@ -202,14 +202,35 @@ static double nearest_segment(const polyc_ctx *ctx, double x, double y)
     return best;
 }
 
-/* The map of the room: every wall found (each point of it, every 5 cm,
- * within `tol` of the map), a vertex within `tol` of every corner, every
- * vertex within `tol` of a wall, 8 to 12 vertices in all. */
-static void check_room_map_tol(const polyc_ctx *ctx, double tol, const char *what)
+/* The room's corners and walls moved `face` towards the room's free space:
+ * into the room, out of the box. */
+static void faces_of(double face, wall *walls, double corners[8][2])
 {
-    double res = tol;
+    for (int k = 0; k < 8; k++) {
+        double side = k < 4 ? 1.0 : -1.0; /* into the room, or out of the box */
+        double cx = k < 4 ? 3.0 : 4.0, cy = 2.0;
+        corners[k][0] = CORNERS[k][0] + side * face * (CORNERS[k][0] < cx ? 1.0 : -1.0);
+        corners[k][1] = CORNERS[k][1] + side * face * (CORNERS[k][1] < cy ? 1.0 : -1.0);
+    }
+    /* wall i runs from corner i to the next corner of its square */
     for (int i = 0; i < 8; i++) {
-        const wall *w = &WALLS[i];
+        int a = i, b = (i & ~3) + ((i + 1) & 3);
+        walls[i] = (wall){corners[a][0], corners[a][1], corners[b][0], corners[b][1]};
+    }
+}
+
+/* The map of the room: every wall face found (each point of it, every 5 cm,
+ * within `res` of the map), a vertex within `res` of every corner, every
+ * vertex within `res` of a wall face, 8 to 12 vertices in all. The faces lie
+ * `face` from the walls' centre lines towards free space: the map follows
+ * the occupied cells that face free space. */
+static void check_room_faces(const polyc_ctx *ctx, double res, double face, const char *what)
+{
+    wall walls[8];
+    double corners[8][2];
+    faces_of(face, walls, corners);
+    for (int i = 0; i < 8; i++) {
+        const wall *w = &walls[i];
         double len = hypot(w->x1 - w->x0, w->y1 - w->y0);
         for (double t = 0.0; t <= len + 1e-9; t += 0.05) {
             double x = w->x0 + (w->x1 - w->x0) * t / len, y = w->y0 + (w->y1 - w->y0) * t / len;
@@ -219,7 +240,7 @@ static void check_room_map_tol(const polyc_ctx *ctx, double tol, const char *wha
         }
     }
     for (int k = 0; k < 8; k++) {
-        double d = nearest_vertex(ctx, CORNERS[k][0], CORNERS[k][1]);
+        double d = nearest_vertex(ctx, corners[k][0], corners[k][1]);
         if (d > res)
             fail_msg("%s: corner (%.1f, %.1f): nearest vertex %.1f mm away", what, CORNERS[k][0],
                      CORNERS[k][1], d * 1e3);
@@ -229,10 +250,12 @@ static void check_room_map_tol(const polyc_ctx *ctx, double tol, const char *wha
         polyc_polyline pl;
         assert_int_equal(polyc_get_polyline(ctx, i, &pl), POLYC_OK);
         for (uint32_t k = 0; k < pl.point_count; k++) {
-            double d = scene_dist(pl.xy_m[2 * k], pl.xy_m[2 * k + 1]);
+            double d = 1e9, x = pl.xy_m[2 * k], y = pl.xy_m[2 * k + 1];
+            for (int w = 0; w < 8; w++)
+                d = fmin(d, wall_dist(&walls[w], x, y));
             if (d > res)
-                fail_msg("%s: vertex (%.3f, %.3f) is %.1f mm off every wall", what,
-                         (double)pl.xy_m[2 * k], (double)pl.xy_m[2 * k + 1], d * 1e3);
+                fail_msg("%s: vertex (%.3f, %.3f) is %.1f mm off every wall face", what, x, y,
+                         d * 1e3);
         }
         vertices += pl.point_count;
     }
@@ -240,10 +263,10 @@ static void check_room_map_tol(const polyc_ctx *ctx, double tol, const char *wha
         fail_msg("%s: %u vertices for 8 corners", what, vertices);
 }
 
-/* Walls 1-2 cells thick: within a cell. */
+/* Walls 1-2 cells thick, their faces within a cell of the centre lines. */
 static void check_room_map(const polyc_ctx *ctx, double res, const char *what)
 {
-    check_room_map_tol(ctx, res, what);
+    check_room_faces(ctx, res, 0.0, what);
 }
 
 /* ---- the room ------------------------------------------------------------ */
@@ -308,10 +331,10 @@ static void test_room_resolutions(void **state)
             polyc_status st = polyc_build(o.ctx, NULL, NULL);
             if (st != POLYC_OK)
                 fail_msg("%s: %s (%s)", what, polyc_status_str(st), polyc_last_error(o.ctx));
-            /* the map follows the face of a wall that borders free space:
-             * on walls 2-3 cells thick up to a cell and a half from the
-             * centre line the room is drawn on */
-            check_room_map_tol(o.ctx, thick ? 1.5 * res[k] : res[k], what);
+            /* walls 2-3 cells thick (cells within 1.1 cells of the centre
+             * line occupied): the cells facing free space lie about 0.6 of a
+             * cell from the centre line, and the map on them within a cell */
+            check_room_faces(o.ctx, res[k], thick ? 0.6 * res[k] : 0.0, what);
             close_opened(&o);
             scene_free(&s);
         }

@@ -855,6 +855,24 @@ static int map_fail(const options *o, const map_input *m, polyc_status st, const
 
 /* ---- the map out ---- */
 
+/* The log's scans into the context; 0, or the exit code of the complaint
+ * (a scan the library rejects names its line). */
+static int add_scans(const options *o, const run *r, polyc_ctx *ctx, size_t size)
+{
+    progress_stage("adding scans");
+    for (uint32_t i = 0; i < r->log.count; i++) {
+        polyc_status st = polyc_add_scan(ctx, &r->log.scans[i]);
+        if (st == POLYC_OK)
+            continue;
+        if (st == POLYC_ERR_SCAN)
+            return complain(EXIT_INPUT, "%s:%llu: scan rejected by the library: %s",
+                            input_name(o), (unsigned long long)r->log.line_of_scan[i],
+                            polyc_last_error(ctx));
+        return library_fail("add scan", st, ctx, size);
+    }
+    return 0;
+}
+
 static int make_map(const options *o, run *r, double t_start, mapout_times *t)
 {
     polyc_config cfg = o->config;
@@ -896,15 +914,9 @@ static int make_map(const options *o, run *r, double t_start, mapout_times *t)
             if ((st = polyc_add_grid(ctx, grid)) != POLYC_OK)
                 return map_fail(o, r->map, st, ctx, size);
         } else {
-            progress_stage("adding scans");
-            for (uint32_t i = 0; i < r->log.count; i++)
-                if ((st = polyc_add_scan(ctx, &r->log.scans[i])) != POLYC_OK) {
-                    if (st == POLYC_ERR_SCAN)
-                        return complain(EXIT_INPUT, "%s:%llu: scan rejected by the library: %s",
-                                        input_name(o), (unsigned long long)r->log.line_of_scan[i],
-                                        polyc_last_error(ctx));
-                    return library_fail("add scan", st, ctx, size);
-                }
+            int rc = add_scans(o, r, ctx, size);
+            if (rc != 0)
+                return rc;
         }
         double t1 = now_ms();
         t->add_ms = t1 - t0;
@@ -1036,15 +1048,9 @@ static int grid_files(const options *o, run *r, double t_start)
                         size);
     if ((st = polyc_init(r->block, size, &cfg, &lim, &ctx)) != POLYC_OK)
         return library_fail("init", st, ctx, size);
-    progress_stage("adding scans");
-    for (uint32_t i = 0; i < r->log.count; i++)
-        if ((st = polyc_add_scan(ctx, &r->log.scans[i])) != POLYC_OK) {
-            if (st == POLYC_ERR_SCAN)
-                return complain(EXIT_INPUT, "%s:%llu: scan rejected by the library: %s",
-                                input_name(o), (unsigned long long)r->log.line_of_scan[i],
-                                polyc_last_error(ctx));
-            return library_fail("add scan", st, ctx, size);
-        }
+    int added = add_scans(o, r, ctx, size);
+    if (added != 0)
+        return added;
     progress_stage("grid");
     if ((st = polyc_build_grid(ctx)) != POLYC_OK)
         return library_fail("grid", st, ctx, size);

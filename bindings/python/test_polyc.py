@@ -209,13 +209,11 @@ class Grid(unittest.TestCase):
     def test_room_from_grid(self):
         cells, width, height, origin = self.room
         result = polyc.build_map_from_grid(cells, width, height, 0.05, origin=origin)
-        # the room, the cabinet and the pillar: the first two closed polygons;
-        # every corner of the room and the cabinet within a cell of a vertex
-        # (map frame). The 30 cm pillar, 6 cells wide, is a short polyline
-        # round it: the BIC prefers 3 vertices to 4 there, and a triangle's
-        # corner stands off the cells, which the map may not span
-        # (docs/algorithm.md)
+        # the room, the cabinet and the 30 cm pillar (6 cells wide): three
+        # closed polygons, every corner of each within a cell of a vertex
+        # (map frame)
         self.assertEqual(len(result.polylines), 3)
+        self.assertTrue(all(line.closed for line in result.polylines))
         vertices = [p for line in result.polylines for p in line.points]
         self.assertLessEqual(len(vertices), 12)
         for w in WALLS[:8]:
@@ -223,10 +221,8 @@ class Grid(unittest.TestCase):
         pillar = [line for line in result.polylines
                   if all(math.hypot(x - 2.15, y - 1.15) < 0.4 for x, y in line.points)]
         self.assertEqual(len(pillar), 1)
-        self.assertTrue(all(line.closed for line in result.polylines if line not in pillar))
-        # every vertex of the pillar's polyline within a cell and a half of its square
-        for x, y in pillar[0].points:
-            self.assertLess(max(abs(x - 2.15), abs(y - 1.15)), 0.15 + 0.075)
+        for cx, cy in ((2.0, 1.0), (2.3, 1.0), (2.3, 1.3), (2.0, 1.3)):
+            self.assertLess(min(math.hypot(x - cx, y - cy) for x, y in pillar[0].points), 0.05)
         # the data: the occupied cells that face free space (a free cell at
         # most 4 cells away along a row or a column, only unknown between)
         def at(i, j):
