@@ -100,6 +100,7 @@ size_t polyc__prior_bytes(const polyc_limits *lim)
     size_t n = polyc__add(polyc__bytes(cells, sizeof(uint32_t)),           /* row_of */
                           polyc__bytes(cells, BINS * sizeof(uint16_t)));   /* rows */
     n = polyc__add(n, polyc__bytes(cells, sizeof(uint32_t)));              /* totals */
+    n = polyc__add(n, polyc__accuracy_bytes(lim, cells));
     return polyc__add(n, polyc__bytes(cache_beams(lim), 3 * sizeof(float)));
 }
 
@@ -110,6 +111,7 @@ typedef struct fit_line {
     float mx, my;                  /* centroid (frame metres) */
     float dx, dy;                  /* unit direction, in beam order */
     float t0, t1;                  /* extent along d from the centroid */
+    float res2;                    /* residual variance across the line, m^2 */
     int ok;
 } fit_line;
 
@@ -123,6 +125,8 @@ typedef struct prior_pass {
     int cached;                    /* the cache holds this scan */
     fit_line last, pend;           /* last emitted line, line pending a merge */
     int have_last, have_pend;
+    polyc__acc_learn *acc;         /* the accuracy's samples (accuracy.c) */
+    uint32_t scan;                 /* index of s */
 } prior_pass;
 
 static int is_hit(const polyc__scan *s, float r)
@@ -229,7 +233,9 @@ static void fit(const prior_pass *q, uint32_t a, uint32_t b, fit_line *l)
     }
     /* major eigenvector of [[cxx, cxy], [cxy, cyy]] */
     float half = 0.5f * (cxx - cyy);
-    float lam = 0.5f * (cxx + cyy) + sqrtf(half * half + cxy * cxy);
+    float root = sqrtf(half * half + cxy * cxy);
+    float lam = 0.5f * (cxx + cyy) + root;
+    float lam2 = 0.5f * (cxx + cyy) - root;
     float v1x = lam - cyy, v1y = cxy, v2x = cxy, v2y = lam - cxx;
     float n1 = v1x * v1x + v1y * v1y, n2 = v2x * v2x + v2y * v2y;
     float dx = n1 >= n2 ? v1x : v2x, dy = n1 >= n2 ? v1y : v2y;
@@ -259,6 +265,7 @@ static void fit(const prior_pass *q, uint32_t a, uint32_t b, fit_line *l)
     l->dy = dy;
     l->t0 = -(mx * dx + my * dy);
     l->t1 = (cx - mx) * dx + (cy - my) * dy;
+    l->res2 = lam2 > 0.0f ? lam2 / n : 0.0f;
     l->ok = b - a + 1 >= MIN_POINTS && sqrtf(cx * cx + cy * cy) >= MIN_LEN_M;
 }
 
@@ -281,10 +288,20 @@ static void emit(prior_pass *q, const fit_line *l)
     float len = l->t1 - l->t0;
     uint32_t n = len > STRAIGHT_M ? (uint32_t)(len / STRAIGHT_M) : 1u;
     float step = len / (float)n;
+    /* the normal towards the sensor, and points per metre: the accuracy's */
+    float nx = -l->dy, ny = l->dx;
+    if (nx * (q->s->x_m - l->mx) + ny * (q->s->y_m - l->my) < 0.0f) {
+        nx = -nx;
+        ny = -ny;
+    }
+    float density = len > 0.0f ? (float)(l->b - l->a + 1) / len : 0.0f;
     for (uint32_t j = 0; j < n; j++) {
         float t = l->t0 + ((float)j + 0.5f) * step;
-        if (record(q, l->mx + t * l->dx, l->my + t * l->dy, 0, 1u) && p->straights < UINT32_MAX)
+        float x = l->mx + t * l->dx, y = l->my + t * l->dy;
+        if (record(q, x, y, 0, 1u) && p->straights < UINT32_MAX)
             p->straights++;
+        if (q->acc)
+            polyc__accuracy_sample(q->acc, x, y, nx, ny, q->scan, l->res2, density);
     }
     q->last = *l;
     q->have_last = 1;
@@ -484,6 +501,11 @@ polyc_status polyc__prior_build(polyc_ctx *ctx, polyc__prior *p, size_t spare)
     p->origin_y = g->origin_y_m - ctx->frame_y;
     size_t cells = (size_t)p->w * (size_t)p->h;
     p->row_of = polyc__alloc_zero(&ctx->arena, cells, sizeof(uint32_t));
+    polyc__acc_learn acc;
+    if (!p->row_of || !polyc__accuracy_begin(&acc, p, &ctx->arena, &ctx->lim)) {
+        memset(p, 0, sizeof *p);
+        return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the angle prior");
+    }
     size_t rows_at = ctx->arena.used;
     p->hist = p->row_of ? polyc__alloc(&ctx->arena, cells, BINS * sizeof(uint16_t)) : NULL;
     if (!p->hist) {
@@ -499,10 +521,14 @@ polyc_status polyc__prior_build(polyc_ctx *ctx, polyc__prior *p, size_t spare)
     q.oy = (float)p->origin_y;
     q.cache_cap = cache_beams(&ctx->lim);
     q.cache = polyc__alloc(&ctx->arena, q.cache_cap, 3 * sizeof(float));
+    q.acc = polyc__accuracy_scratch(&acc, &ctx->arena, &ctx->lim) && acc.p ? &acc : NULL;
     for (uint32_t si = 0; si < ctx->scan_count; si++) {
         q.s = &ctx->scans[si];
+        q.scan = si;
         learn_scan(&q);
     }
+    if (q.acc)
+        polyc__accuracy_finish(&acc, &ctx->arena, ctx->cfg.alpha);
     /* the rows not handed out go back to the block (the cache is gone too) */
     ctx->arena.used = rows_at + polyc__bytes(p->rows, BINS * sizeof(uint16_t));
     p->total = polyc__alloc(&ctx->arena, p->rows, sizeof(uint32_t));

@@ -161,7 +161,32 @@ typedef struct polyc__prior {
     uint32_t *smooth_of;
     uint32_t *smooth;
     uint32_t corners, straights;   /* observations recorded */
+    /* per cell: the weight of the error term there (accuracy.c); NULL: 1 */
+    float *weight;
 } polyc__prior;
+
+/* ---- the data's accuracy (accuracy.c), learned in the prior's pass ---- */
+typedef struct polyc__acc_learn {
+    polyc__prior *p;               /* NULL: nothing to learn (one scan) */
+    void *samples, *cells;         /* scratch */
+    uint32_t n, cap;
+} polyc__acc_learn;
+/* bytes for a prior of `cells` cells: the weights and the scratch */
+size_t polyc__accuracy_bytes(const polyc_limits *lim, size_t cells);
+/* the weights (all 1), after the prior's cells are laid out; 0: no room */
+int polyc__accuracy_begin(polyc__acc_learn *L, polyc__prior *p, polyc__arena *a,
+                          const polyc_limits *lim);
+/* the scratch, released with the prior's; 0: no room */
+int polyc__accuracy_scratch(polyc__acc_learn *L, polyc__arena *a, const polyc_limits *lim);
+/* one sample of a line fitted in scan `scan`: a point on it, its unit
+ * normal towards the sensor, the line's residual variance (m^2) and its
+ * points per metre */
+void polyc__accuracy_sample(polyc__acc_learn *L, float x, float y, float nx, float ny,
+                            uint32_t scan, float res2, float density);
+/* pairs the samples up and sets the weights (alpha: the error term's) */
+void polyc__accuracy_finish(polyc__acc_learn *L, polyc__arena *a, float alpha);
+/* the weight at (x, y), frame metres; 1 outside the prior or without one */
+float polyc__accuracy_weight(const polyc__prior *p, float x, float y);
 
 size_t polyc__prior_bytes(const polyc_limits *lim);
 /* Learns the prior from the stored scans (needs the grid for its extent);

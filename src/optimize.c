@@ -29,6 +29,10 @@ size_t polyc__optimizer_bytes(const polyc_config *cfg, const polyc_limits *lim)
     size_t NE = (size_t)polyc__hash_entry_cap(lim);
     size_t n = 0;
     n = polyc__add(n, polyc__bytes(P * 2, sizeof(polyc__point))); /* sorted + unsorted */
+    if (lim->max_scans > 1) {
+        n = polyc__add(n, polyc__bytes(P * 2, 2 * sizeof(float))); /* pt_view, sorted + unsorted */
+        n = polyc__add(n, polyc__bytes(V, sizeof(float)));         /* seg_side */
+    }
     n = polyc__add(n, polyc__bytes(P, sizeof(int32_t)));          /* pt_seg */
     n = polyc__add(n, polyc__bytes(P, sizeof(double)));           /* pt_cost */
     n = polyc__add(n, polyc__bytes(P, sizeof(int32_t)));          /* loc_pt */
@@ -48,7 +52,7 @@ size_t polyc__optimizer_bytes(const polyc_config *cfg, const polyc_limits *lim)
     n = polyc__add(n, polyc__bytes(NB, 4 * sizeof(int32_t)));     /* heads, starts, marks, list */
     n = polyc__add(n, polyc__bytes(NE, sizeof(polyc__hash_entry)));
     n = polyc__add(n, polyc__flat_bytes(lim));                    /* best model */
-    return polyc__add(n, 40 * 16);                                /* alignment slack */
+    return polyc__add(n, 44 * 16);                                /* alignment slack */
 }
 
 #define ALLOC(ptr, count) \
@@ -148,6 +152,9 @@ polyc_status polyc__opt_setup(polyc_ctx *ctx, polyc__opt *o)
     ALLOC(o->cut_t1, V / 4 + 64);
     o->cut_cap = V / 4 + 64;
     ALLOC(o->acost, V);
+    o->seg_side = NULL;
+    if (o->pt_view)
+        ALLOC(o->seg_side, V);
     ALLOC(o->seg_sum, V);
     ALLOC(o->seg_w, V);
     ALLOC(o->seg_far_d, V);

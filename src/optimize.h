@@ -29,7 +29,11 @@ typedef struct polyc__opt {
 
     /* data: weighted points sorted by hash bucket, and their assignment */
     polyc__point *pts;
+    float *pt_view;                /* per point: the sum of unit vectors from its endpoints
+                                    * towards their sensors (NULL: not known, grids and
+                                    * single scans) */
     int32_t np;
+    float *seg_side;               /* per vertex: its segment's side (topology.c, band zip) */
     int32_t *pt_seg;               /* nearest segment (its start vertex) or NONE */
     double *pt_cost;               /* capped cost of the point's endpoints */
     double n, log_n;               /* BIC's n: every endpoint */
@@ -134,6 +138,8 @@ polyc_status polyc__opt_setup(polyc_ctx *ctx, polyc__opt *o);
 
 /* points.c */
 int32_t polyc__points_bound(const polyc_config *cfg, const polyc_limits *lim);
+/* whether the points carry the direction they were seen from (pt_view) */
+int polyc__points_viewed(const polyc_ctx *ctx);
 polyc_status polyc__points_collect(polyc__opt *o);
 
 /* spatial_hash.c */

@@ -12,6 +12,7 @@
 typedef struct endpoint {
     int32_t ix, iy;
     float fx, fy;                  /* offset from the cell centre, metres */
+    float vx, vy;                  /* unit vector from the endpoint towards its sensor */
 } endpoint;
 
 /* The data rule: a cell with hits that the grid does not judge free. */
@@ -31,6 +32,9 @@ static int endpoint_of(const polyc_ctx *ctx, const polyc__scan *s, uint32_t i, e
     e->iy = (int32_t)fy;
     e->fx = (b.ex - fx - 0.5f) * ctx->grid.cell_m;
     e->fy = (b.ey - fy - 0.5f) * ctx->grid.cell_m;
+    float vx = b.sx - b.ex, vy = b.sy - b.ey, vl = sqrtf(vx * vx + vy * vy);
+    e->vx = vl > 0.0f ? vx / vl : 0.0f;
+    e->vy = vl > 0.0f ? vy / vl : 0.0f;
     /* Data if the endpoint's own cell is not judged free. (A looser rule,
      * accepting points next to solid cells, lets people walking along walls
      * in: measured on the corridor scene, it tripled the vertex count.) */
@@ -67,7 +71,8 @@ static float block_centre(double origin, int32_t i, float cell)
 }
 
 /* One weighted point per marked cell: mark cells, number them, accumulate. */
-static polyc_status collect_cells(polyc__opt *o, polyc__point *tmp, int32_t cap, int32_t *n_out)
+static polyc_status collect_cells(polyc__opt *o, polyc__point *tmp, float *view, int32_t cap,
+                                  int32_t *n_out)
 {
     polyc_ctx *ctx = o->ctx;
     polyc__grid *g = &ctx->grid;
@@ -111,6 +116,8 @@ static polyc_status collect_cells(polyc__opt *o, polyc__point *tmp, int32_t cap,
     if (n > (uint32_t)cap)
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "more weighted data points than limits.max_points");
     memset(tmp, 0, (size_t)n * sizeof *tmp);
+    if (view)
+        memset(view, 0, (size_t)n * 2 * sizeof *view);
     for (uint32_t si = 0; si < ctx->scan_count; si++)
         for (uint32_t i = 0; i < ctx->scans[si].count; i++) {
             if (!endpoint_of(ctx, &ctx->scans[si], i, &e))
@@ -126,7 +133,12 @@ static polyc_status collect_cells(polyc__opt *o, polyc__point *tmp, int32_t cap,
                 below &= below - 1;
                 c++;
             }
-            polyc__point *p = &tmp[t->mark_base + t->mark_row[by & 31] + c];
+            uint32_t at = t->mark_base + t->mark_row[by & 31] + c;
+            polyc__point *p = &tmp[at];
+            if (view) {
+                view[2 * at] += e.vx;
+                view[2 * at + 1] += e.vy;
+            }
             /* sums of offsets from the block centre: small numbers, float is exact enough */
             p->w += 1.0f;
             p->x += fx;
@@ -164,7 +176,8 @@ static polyc_status collect_cells(polyc__opt *o, polyc__point *tmp, int32_t cap,
     return POLYC_OK;
 }
 
-static polyc_status collect_raw(polyc__opt *o, polyc__point *tmp, int32_t cap, int32_t *n_out)
+static polyc_status collect_raw(polyc__opt *o, polyc__point *tmp, float *view, int32_t cap,
+                                int32_t *n_out)
 {
     polyc_ctx *ctx = o->ctx;
     polyc__grid *g = &ctx->grid;
@@ -182,6 +195,10 @@ static polyc_status collect_raw(polyc__opt *o, polyc__point *tmp, int32_t cap, i
             p->x = cell_centre(ox, e.ix, g->cell_m) + e.fx;
             p->y = cell_centre(oy, e.iy, g->cell_m) + e.fy;
             p->w = 1.0f;
+            if (view) {
+                view[2 * (n - 1)] = e.vx;
+                view[2 * (n - 1) + 1] = e.vy;
+            }
         }
     *n_out = n;
     return POLYC_OK;
@@ -245,6 +262,11 @@ static polyc_status collect_occupied(polyc__opt *o, polyc__point *tmp, int32_t c
     return POLYC_OK;
 }
 
+int polyc__points_viewed(const polyc_ctx *ctx)
+{
+    return !ctx->from_grid && ctx->lim.max_scans > 1;
+}
+
 int32_t polyc__points_bound(const polyc_config *cfg, const polyc_limits *lim)
 {
     uint32_t b = lim->max_points ? lim->max_points : lim->max_beams;
@@ -259,17 +281,21 @@ polyc_status polyc__points_collect(polyc__opt *o)
     int32_t cap = polyc__points_bound(o->cfg, &ctx->lim);
     /* final array first, the unsorted one after it (released at the end) */
     o->pts = polyc__alloc(&ctx->arena, (size_t)cap, sizeof(polyc__point));
+    /* where the endpoints were seen from: scans (more than one) only */
+    int viewed = polyc__points_viewed(ctx);
+    o->pt_view = viewed ? polyc__alloc(&ctx->arena, (size_t)cap, 2 * sizeof(float)) : NULL;
     size_t mark = ctx->arena.used;
     polyc__point *tmp = polyc__alloc(&ctx->arena, (size_t)cap, sizeof(polyc__point));
-    if (!o->pts || !tmp)
+    float *tmp_view = viewed ? polyc__alloc(&ctx->arena, (size_t)cap, 2 * sizeof(float)) : NULL;
+    if (!o->pts || !tmp || (viewed && (!o->pt_view || !tmp_view)))
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the data points");
     int32_t n = 0;
     /* one scan: a point per return, whose beam the ends are set by (a
      * weighted point of several near returns would set them by their mean) */
     int exact = (o->cfg->flags & POLYC_FLAG_EXACT_POINTS) || o->rays.on;
     polyc_status st = ctx->from_grid ? collect_occupied(o, tmp, cap, &n)
-                      : exact        ? collect_raw(o, tmp, cap, &n)
-                                     : collect_cells(o, tmp, cap, &n);
+                      : exact        ? collect_raw(o, tmp, tmp_view, cap, &n)
+                                     : collect_cells(o, tmp, tmp_view, cap, &n);
     if (st != POLYC_OK)
         return st;
     /* counting sort by bucket: points of one bucket are contiguous */
@@ -280,6 +306,15 @@ polyc_status polyc__points_collect(polyc__opt *o)
     for (int32_t i = 0; i < n; i++) {
         h->pt_start[polyc__bucket_of(h, tmp[i].x, tmp[i].y) + 1]++;
         total += (double)tmp[i].w;
+        /* where the scans disagree beyond the sensor's accuracy, their
+         * points weigh less (accuracy.c); n stays the count of endpoints */
+        float f = polyc__accuracy_weight(&o->prior, tmp[i].x, tmp[i].y);
+        if (f < 1.0f) {
+            tmp[i].w *= f;
+            tmp[i].cxx *= f;
+            tmp[i].cxy *= f;
+            tmp[i].cyy *= f;
+        }
     }
     for (int32_t b = 0; b < nb; b++)
         h->pt_start[b + 1] += h->pt_start[b];
@@ -287,6 +322,10 @@ polyc_status polyc__points_collect(polyc__opt *o)
         int32_t b = polyc__bucket_of(h, tmp[i].x, tmp[i].y);
         uint32_t at = h->pt_start[b]++;
         o->pts[at] = tmp[i];
+        if (tmp_view) {
+            o->pt_view[2 * at] = tmp_view[2 * i];
+            o->pt_view[2 * at + 1] = tmp_view[2 * i + 1];
+        }
     }
     for (int32_t b = nb; b > 0; b--)
         h->pt_start[b] = h->pt_start[b - 1];

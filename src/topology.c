@@ -23,6 +23,15 @@
 #define ZIP_STEP_M 0.02f    /* samples along a segment for the double-cover test */
 #define ZIP_RUN_M 0.15f     /* a doubly covered stretch longer than this goes */
 #define ZIP_SNAP_M 0.03f    /* a stretch this near a segment end reaches it */
+/* One line through a band (not in the paper): two pieces of map seen from
+ * the same side, parallel within BAND_COS and within BAND_M of each other
+ * along more than ZIP_RUN_M, are one wall whose points form a band (pose
+ * error, far range): a laser cannot see a wall through another from the
+ * same side. BAND_M: bands on the real logs are 10-30 cm wide, and two lines
+ * through a 30 cm band settle 15 cm apart. */
+#define BAND_M 0.20f
+#define BAND_COS 0.9397f    /* cos 20 degrees */
+#define SIDE_REACH_M 0.10f  /* endpoints this near a segment tell its side */
 
 /* Whether segments p0-p1 and q0-q1 cross with the crossing at least
  * CROSS_END_M from all four ends; *t and *u: its position along each. */
@@ -266,9 +275,97 @@ static int covered(const polyc__opt *o, float x, float y, int32_t a, int32_t b, 
     return nearest_other(o, x, y, a, b, &d2) != POLYC__NONE && d2 <= lim2;
 }
 
-/* The longest doubly covered stretch of segment v, as fractions [*t0, *t1]
- * along it; 0 if none is longer than ZIP_RUN_M. */
-static int covered_run(const polyc__opt *o, int32_t v, float *t0, float *t1)
+/* The side each segment is seen from, into seg_side: the sum over the
+ * endpoints within SIDE_REACH_M whose nearest segment it is of their
+ * directions towards their sensors, along its left normal (> 0: seen from
+ * the left). Valid for the segments not edited since zip_mark. */
+static void find_sides(polyc__opt *o)
+{
+    const polyc__store *s = o->s;
+    float *side = o->seg_side;
+    for (int32_t v = 0; v < s->v_high; v++)
+        side[v] = 0.0f;
+    for (int32_t i = 0; i < o->np; i++) {
+        int32_t sg = o->pt_seg[i];
+        if (sg == POLYC__NONE || s->v[sg].next == POLYC__NONE)
+            continue;
+        const polyc__vertex *a = &s->v[sg], *b = &s->v[a->next];
+        const polyc__point *p = &o->pts[i];
+        if (polyc__seg_dist2(p->x, p->y, a->x, a->y, b->x, b->y) > SIDE_REACH_M * SIDE_REACH_M)
+            continue;
+        side[sg] += o->pt_view[2 * i] * (a->y - b->y) + o->pt_view[2 * i + 1] * (b->x - a->x);
+    }
+}
+
+/* The unit normal of segment sg towards those who saw it; 0 if unknown
+ * (no endpoint, or edited since the sides were found). */
+static int seen_normal(const polyc__opt *o, int32_t sg, float *nx, float *ny)
+{
+    const polyc__vertex *a = &o->s->v[sg], *b = &o->s->v[a->next];
+    float dx = b->x - a->x, dy = b->y - a->y, len = sqrtf(dx * dx + dy * dy);
+    float side = o->seg_side[sg];
+    if (!(len > 0.0f) || side == 0.0f || edited(o, sg, o->zip_mark))
+        return 0;
+    float sign = side > 0.0f ? 1.0f : -1.0f;
+    *nx = -sign * dy / len;
+    *ny = sign * dx / len;
+    return 1;
+}
+
+/* A segment that does not touch a or b (the ends of the segment that
+ * (x, y) lies on, seen along the unit normal nx, ny), lies within BAND_M of
+ * (x, y), holds its foot, runs parallel and is seen from the same side; or
+ * NONE. */
+static int32_t band_other(const polyc__opt *o, float x, float y, int32_t a, int32_t b, float nx,
+                          float ny)
+{
+    const polyc__hash *h = &o->h;
+    const polyc__store *s = o->s;
+    int32_t ix0, iy0, ix1, iy1;
+    polyc__bucket_xy(h, x - BAND_M, y - BAND_M, &ix0, &iy0);
+    polyc__bucket_xy(h, x + BAND_M, y + BAND_M, &ix1, &iy1);
+    for (int32_t iy = iy0; iy <= iy1; iy++)
+        for (int32_t ix = ix0; ix <= ix1; ix++)
+            for (int32_t e = h->seg_head[iy * h->bx + ix]; e != POLYC__NONE; e = h->entries[e].next) {
+                int32_t sg = h->entries[e].seg;
+                if (touches(s, sg, a, b))
+                    continue;
+                const polyc__vertex *c = &s->v[sg], *d = &s->v[c->next];
+                float dx = d->x - c->x, dy = d->y - c->y, l2 = dx * dx + dy * dy;
+                if (!(l2 > 0.0f))
+                    continue;
+                float u = ((x - c->x) * dx + (y - c->y) * dy) / l2;
+                float off = ((x - c->x) * dy - (y - c->y) * dx);
+                if (u < 0.0f || u > 1.0f || off * off > BAND_M * BAND_M * l2)
+                    continue;
+                float mx, my;
+                if (!seen_normal(o, sg, &mx, &my) || mx * nx + my * ny < BAND_COS)
+                    continue;
+                return sg;
+            }
+    return POLYC__NONE;
+}
+
+/* What a sample of a segment is tested for: double cover (within sqrt
+ * lim2 of another piece of map) or a band (band_other, the segment's seen
+ * normal nx, ny). */
+typedef struct run_test {
+    int band;
+    float lim2, nx, ny;
+} run_test;
+
+static int sample_in_run(const polyc__opt *o, const run_test *rt, float x, float y, int32_t a,
+                         int32_t b)
+{
+    if (rt->band)
+        return band_other(o, x, y, a, b, rt->nx, rt->ny) != POLYC__NONE;
+    return covered(o, x, y, a, b, rt->lim2);
+}
+
+/* The longest stretch of segment v whose samples pass the test (band 0:
+ * double cover; 1: a band with another piece of map seen from v's side),
+ * as fractions [*t0, *t1] along it; 0 if none is longer than ZIP_RUN_M. */
+static int longest_run(const polyc__opt *o, int32_t v, int band, float *t0, float *t1)
 {
     const polyc__vertex *V = o->s->v;
     int32_t w = V[v].next;
@@ -276,14 +373,16 @@ static int covered_run(const polyc__opt *o, int32_t v, float *t0, float *t1)
     float len = sqrtf(dx * dx + dy * dy);
     if (!(len > ZIP_RUN_M))
         return 0;
-    float lim = o->cfg->overlap_m, lim2 = lim * lim;
+    run_test rt = {band, o->cfg->overlap_m * o->cfg->overlap_m, 0.0f, 0.0f};
+    if (band && (!o->seg_side || !seen_normal(o, v, &rt.nx, &rt.ny)))
+        return 0;
     int32_t n = (int32_t)ceilf(len / ZIP_STEP_M);
     int32_t run0 = -1, best0 = 0, best1 = -1;
     for (int32_t k = 0; k <= n + 1; k++) {
         int c = 0;
         if (k <= n) {
             float t = (float)k / (float)n;
-            c = covered(o, ax + t * dx, ay + t * dy, v, w, lim2);
+            c = sample_in_run(o, &rt, ax + t * dx, ay + t * dy, v, w);
         }
         if (c && run0 < 0)
             run0 = k;
@@ -383,25 +482,38 @@ int polyc__op_zip(polyc__opt *o)
         return 0;
     uint32_t since = o->zip_mark;
     o->zip_mark = ++o->touch_stamp;
+    if (o->seg_side)
+        find_sides(o);
     for (int32_t v = 0; v < s->v_high; v++) {
         for (int k = 0; k < FIXES_PER_SEGMENT; k++) {
             if (s->v[v].line == POLYC__NONE || s->v[v].next == POLYC__NONE ||
                 (k == 0 && !edited(o, v, since)))
                 break;
             float t0, t1;
-            if (!covered_run(o, v, &t0, &t1))
-                break;
+            int band = 0;
+            if (!longest_run(o, v, 0, &t0, &t1)) {
+                if (!longest_run(o, v, 1, &t0, &t1))
+                    break;
+                band = 1;
+            }
             /* the stretch goes from this segment or from the piece of map
              * along it (its own run there), whichever costs less */
             const polyc__vertex *V = s->v;
             int32_t w = V[v].next;
             float mx = V[v].x + 0.5f * (t0 + t1) * (V[w].x - V[v].x);
             float my = V[v].y + 0.5f * (t0 + t1) * (V[w].y - V[v].y);
-            float qd2;
-            int32_t q = nearest_other(o, mx, my, v, w, &qd2);
+            int32_t q;
+            if (band) {
+                float nx = 0.0f, ny = 0.0f;
+                seen_normal(o, v, &nx, &ny);
+                q = band_other(o, mx, my, v, w, nx, ny);
+            } else {
+                float qd2;
+                q = nearest_other(o, mx, my, v, w, &qd2);
+            }
             float u0, u1;
             double d_here = drop_delta(o, v, t0, t1);
-            if (q != POLYC__NONE && covered_run(o, q, &u0, &u1) &&
+            if (q != POLYC__NONE && longest_run(o, q, band, &u0, &u1) &&
                 drop_delta(o, q, u0, u1) < d_here) {
                 if (!drop_stretch(o, q, u0, u1))
                     break;
@@ -413,4 +525,3 @@ int polyc__op_zip(polyc__opt *o)
     }
     return zipped;
 }
-

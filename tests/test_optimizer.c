@@ -147,8 +147,10 @@ static void fx_close(fixture *f)
 
 /* Replaces the data points by unit points at xy (n of them), sorted by
  * bucket as points.c sorts them; the per-point arrays were sized for the
- * room's points, so the new set must not be larger (checked). */
-static void set_points(fixture *f, const float *xy, int n)
+ * room's points, so the new set must not be larger (checked). Each point is
+ * seen from seen_xy (its sensor's position, 2 per point), or from nowhere
+ * known when seen_xy is NULL. */
+static void set_points_seen(fixture *f, const float *xy, const float *seen_xy, int n)
 {
     polyc__opt *o = &f->o;
     polyc__hash *h = &o->h;
@@ -161,11 +163,19 @@ static void set_points(fixture *f, const float *xy, int n)
         h->pt_start[b + 1] += h->pt_start[b];
     for (int i = 0; i < n; i++) {
         int32_t b = polyc__bucket_of(h, xy[2 * i], xy[2 * i + 1]);
-        polyc__point *p = &o->pts[h->pt_start[b]++];
+        uint32_t at = h->pt_start[b]++;
+        polyc__point *p = &o->pts[at];
         memset(p, 0, sizeof *p);
         p->x = xy[2 * i];
         p->y = xy[2 * i + 1];
         p->w = 1.0f;
+        if (o->pt_view) {
+            float vx = seen_xy ? seen_xy[2 * i] - p->x : 0.0f;
+            float vy = seen_xy ? seen_xy[2 * i + 1] - p->y : 0.0f;
+            float vl = sqrtf(vx * vx + vy * vy);
+            o->pt_view[2 * at] = vl > 0.0f ? vx / vl : 0.0f;
+            o->pt_view[2 * at + 1] = vl > 0.0f ? vy / vl : 0.0f;
+        }
     }
     for (int32_t b = nb; b > 0; b--)
         h->pt_start[b] = h->pt_start[b - 1];
@@ -173,6 +183,11 @@ static void set_points(fixture *f, const float *xy, int n)
     o->np = n;
     o->n = (double)n;
     o->log_n = log(o->n > 1.0 ? o->n : 1.0);
+}
+
+static void set_points(fixture *f, const float *xy, int n)
+{
+    set_points_seen(f, xy, NULL, n);
 }
 
 /* a growing list of synthetic points */
@@ -1193,13 +1208,22 @@ static double longest_unsupported(const polyc__opt *o)
 }
 
 /* Data along two parallel 2 m walls `gap` apart, with a polyline on each. */
-static void parallel_case(fixture *f, float gap)
+/* Two polylines along y = 0 and y = gap with their data; the points of the
+ * second are seen from above (y = 2) and those of the first from below
+ * (y = -2), or from above too when same_side. */
+static void parallel_case(fixture *f, float gap, int same_side)
 {
     static ptlist p;
+    static float seen[2 * MAX_PTS];
     p.n = 0;
     pts_line(&p, -1.0f, 0.0f, 1.0f, 0.0f, 0.02f);
+    int first = p.n;
     pts_line(&p, -1.0f, gap, 1.0f, gap, 0.02f);
-    set_points(f, p.xy, p.n);
+    for (int i = 0; i < p.n; i++) {
+        seen[2 * i] = p.xy[2 * i];
+        seen[2 * i + 1] = i < first && !same_side ? -2.0f : 2.0f;
+    }
+    set_points_seen(f, p.xy, seen, p.n);
     clear_lines(&f->o);
     const float a[4] = {-1.0f, 0.0f, 1.0f, 0.0f}, b[4] = {-1.0f, gap, 1.0f, gap};
     add_line(&f->o, a, 2, 0);
@@ -1214,7 +1238,7 @@ static void test_zip_parallel_lines_become_one(void **state)
     (void)state;
     static fixture f;
     fx_open_hand(&f, 0.0f);
-    parallel_case(&f, 0.03f);
+    parallel_case(&f, 0.03f, 0);
     assert_true(polyc__op_zip(&f.o) >= 1);
     check_books(&f.o, "zip");
     assert_int_equal(live_lines(&f.o), 1);
@@ -1223,13 +1247,39 @@ static void test_zip_parallel_lines_become_one(void **state)
     fx_close(&f);
 }
 
-/* Two walls 10 cm apart are two walls: nothing is zipped. */
+/* The two faces of a wall 10 cm thick, each seen from its own side, are two
+ * lines: nothing is zipped. */
 static void test_zip_leaves_walls_10cm_apart(void **state)
 {
     (void)state;
     static fixture f;
     fx_open_hand(&f, 0.0f);
-    parallel_case(&f, 0.10f);
+    parallel_case(&f, 0.10f, 0);
+    assert_int_equal(polyc__op_zip(&f.o), 0);
+    assert_int_equal(live_lines(&f.o), 2);
+    fx_close(&f);
+}
+
+/* Two lines 10 and 18 cm apart, both seen from the same side, are one wall
+ * seen as a band (a laser does not see a wall through another): one goes,
+ * the other is left whole. 25 cm apart they are two. */
+static void test_zip_same_side_band(void **state)
+{
+    (void)state;
+    static fixture f;
+    const float gaps[2] = {0.10f, 0.18f};
+    for (int k = 0; k < 2; k++) {
+        fx_open_hand(&f, 0.0f);
+        parallel_case(&f, gaps[k], 1);
+        assert_true(polyc__op_zip(&f.o) >= 1);
+        check_books(&f.o, "band zip");
+        assert_int_equal(live_lines(&f.o), 1);
+        assert_int_equal(f.o.s->v_live, 2);
+        assert_int_equal(polyc__op_zip(&f.o), 0);
+        fx_close(&f);
+    }
+    fx_open_hand(&f, 0.0f);
+    parallel_case(&f, 0.25f, 1);
     assert_int_equal(polyc__op_zip(&f.o), 0);
     assert_int_equal(live_lines(&f.o), 2);
     fx_close(&f);
@@ -2114,6 +2164,7 @@ int main(void)
         cmocka_unit_test(test_split_gap_with_clutter_beside),
         cmocka_unit_test(test_zip_parallel_lines_become_one),
         cmocka_unit_test(test_zip_leaves_walls_10cm_apart),
+        cmocka_unit_test(test_zip_same_side_band),
         cmocka_unit_test(test_untangle_resolves_x),
         cmocka_unit_test(test_untangle_hairpin_through_wall),
         cmocka_unit_test(test_spike_past_corner_removed),
