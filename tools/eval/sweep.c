@@ -59,7 +59,8 @@ static const char usage_text[] =
     "options:\n"
     "  --seeds A-B      seeds A to B (or one seed A); default 1-6\n"
     "  --kinds a,b,...  scene kinds; default hall,shelves,flat,curved,thinwalls,\n"
-    "                   office,angled,square (any of scansim's built-in names)\n"
+    "                   office,angled,square,drift,farhall (any of scansim's\n"
+    "                   built-in names; drift and farhall: poses that drift)\n"
     "  --save DIR       write DIR/KIND-sSEED.log and .gt.txt (for build/polyc)\n"
     "  --svg DIR        write DIR/KIND-sSEED.svg: true walls (grey), the robot's\n"
     "                   path (blue), people (pink), the map (black, dots on vertices;\n"
@@ -92,7 +93,8 @@ static const char usage_text[] =
     "Exit: 0 every scene ran; 1 a scene failed (its row says why); 2 usage error.\n";
 
 static const char *const default_kinds[] = {"hall",   "shelves", "flat",   "curved",
-                                            "thinwalls", "office", "angled", "square"};
+                                            "thinwalls", "office", "angled", "square",
+                                            "drift",  "farhall"};
 
 typedef struct options {
     uint64_t seed_first, seed_last;
