@@ -18,7 +18,7 @@ LIB_OBJ  = $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
 # the benchmark use and the tool does not.
 TOOL_MOD = $(filter-out tools/polyc.c,$(wildcard tools/*.c))
 TOOL_OBJ = $(TOOL_MOD:tools/%.c=$(BUILD)/tobj/%.o)
-EVAL_MOD = $(filter-out tools/eval/bench.c tools/eval/sweep.c,$(wildcard tools/eval/*.c))
+EVAL_MOD = $(filter-out tools/eval/bench.c tools/eval/sweep.c tools/eval/mapscore.c,$(wildcard tools/eval/*.c))
 EVAL_OBJ = $(EVAL_MOD:tools/eval/%.c=$(BUILD)/eobj/%.o)
 TOOL_CFLAGS = $(WARN) $(OPT) $(CFLAGS) -Iinclude -Itools -D_POSIX_C_SOURCE=200809L
 EVAL_CFLAGS = $(TOOL_CFLAGS) -Itools/eval
@@ -226,12 +226,15 @@ $(XBUILD)/embedded_scan.elf: $(XBUILD)/embedded_scan.o $(XBUILD)/libpolyc.a
 
 # Benchmark on the shared data (not in the repo): an optimised build in
 # build-bench/, then one table. `make bench DATA=dir BENCH_ARGS='--only intel'`
+# (also builds build-bench/mapscore: one map's topology and bands against one log)
 DATA ?= ../shared/data
 BENCH_ARGS ?=
 bench:
-	$(MAKE) BUILD=build-bench OPT='-O3 -march=native -DNDEBUG' build-bench/bench
+	$(MAKE) BUILD=build-bench OPT='-O3 -march=native -DNDEBUG' build-bench/bench build-bench/mapscore
 	build-bench/bench $(BENCH_ARGS) $(DATA)
 $(BUILD)/bench: tools/eval/bench.c $(EVAL_OBJ) $(TOOL_OBJ) $(BUILD)/libpolyc.a
+	$(CC) $(EVAL_CFLAGS) $^ -o $@ $(LDLIBS)
+$(BUILD)/mapscore: tools/eval/mapscore.c $(EVAL_OBJ) $(TOOL_OBJ) $(BUILD)/libpolyc.a
 	$(CC) $(EVAL_CFLAGS) $^ -o $@ $(LDLIBS)
 
 # Simulated scenes of every kind over several seeds, each scored against its

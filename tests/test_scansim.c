@@ -10,6 +10,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "gtscore.h"
@@ -298,7 +299,8 @@ static void test_path_spacing(void **state)
 }
 
 
-static const char *const kinds[] = {"hall", "shelves", "flat", "curved", "thinwalls"};
+static const char *const kinds[] = {"hall",      "shelves", "flat",   "curved",
+                                    "thinwalls", "drift",   "farhall"};
 #define KIND_COUNT (sizeof kinds / sizeof kinds[0])
 
 /* Is (x, y) inside the closed wall w? (even-odd rule) */
@@ -472,6 +474,204 @@ static void test_hall_scanner(void **state)
     scansim_scene_free(&s);
 }
 
+/* Segment k of the scene (scansim_segment_count order): x0 y0 x1 y1. */
+static void segment_xy(const scansim_scene *s, uint32_t k, double *g)
+{
+    uint32_t w;
+    for (w = 0; w < s->wall_count; w++) {
+        const scansim_wall *wall = &s->walls[w];
+        uint32_t n = wall->closed ? wall->point_count : wall->point_count - 1u;
+        if (k < n) {
+            const double *a = &s->wall_xy_m[2u * (wall->first_point + k)];
+            const double *b = &s->wall_xy_m[2u * (wall->first_point + (k + 1u) % wall->point_count)];
+            g[0] = a[0];
+            g[1] = a[1];
+            g[2] = b[0];
+            g[3] = b[1];
+            return;
+        }
+        k -= n;
+    }
+    fail_msg("no segment %u", (unsigned)k);
+}
+
+static int compare_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+#define SPREAD_MIN_HITS 200u
+
+/* The band of the endpoints around the true walls: every reflected beam
+ * that the true pose sends to a wall segment puts its endpoint, as the
+ * logged pose places it, at some signed distance from that segment's
+ * line; per segment hit by SPREAD_MIN_HITS beams or more, the spread of
+ * those distances (95th minus 5th percentile). Gives the largest spread
+ * and the median over those segments. */
+static void endpoint_spread(const scansim_scene *s, double *largest, double *median)
+{
+    uint32_t segs = scansim_segment_count(s), k, scan, i, used = 0;
+    uint32_t *count = calloc(segs, sizeof *count), *fill = calloc(segs, sizeof *fill);
+    double *spread = calloc(segs, sizeof *spread), **offset = calloc(segs, sizeof *offset);
+    int32_t *hit = malloc((size_t)s->scan_count * s->laser.beam_count * sizeof *hit);
+    assert_non_null(count);
+    assert_non_null(fill);
+    assert_non_null(spread);
+    assert_non_null(offset);
+    assert_non_null(hit);
+    for (scan = 0; scan < s->scan_count; scan++) {
+        const polyc_scan *sc = &s->scans[scan];
+        const scansim_pose *p = &s->poses[scan];
+        for (i = 0; i < sc->beam_count; i++) {
+            int32_t *obj = &hit[(size_t)scan * sc->beam_count + i];
+            double a = p->theta_rad + (double)sc->start_angle_rad +
+                       (double)i * (double)sc->angle_step_rad;
+            *obj = -1;
+            if (sc->range_m[i] < sc->max_range_m)
+                (void)scansim_cast(s, p->x_m, p->y_m, a, scan, obj);
+            if (*obj >= 0)
+                count[*obj]++;
+        }
+    }
+    for (k = 0; k < segs; k++)
+        if (count[k] >= SPREAD_MIN_HITS)
+            assert_non_null(offset[k] = malloc(count[k] * sizeof(double)));
+    for (scan = 0; scan < s->scan_count; scan++) {
+        const polyc_scan *sc = &s->scans[scan];
+        for (i = 0; i < sc->beam_count; i++) {
+            int32_t obj = hit[(size_t)scan * sc->beam_count + i];
+            double a = sc->pose_theta_rad + (double)sc->start_angle_rad +
+                       (double)i * (double)sc->angle_step_rad, g[4] = {0.0, 0.0, 0.0, 0.0};
+            double ex, ey, x, y;
+            if (obj < 0 || !offset[obj])
+                continue;
+            segment_xy(s, (uint32_t)obj, g);
+            ex = g[2] - g[0];
+            ey = g[3] - g[1];
+            x = sc->pose_x_m + (double)sc->range_m[i] * cos(a);
+            y = sc->pose_y_m + (double)sc->range_m[i] * sin(a);
+            offset[obj][fill[obj]++] = ((x - g[0]) * -ey + (y - g[1]) * ex) / hypot(ex, ey);
+        }
+    }
+    for (k = 0; k < segs; k++) {
+        if (!offset[k])
+            continue;
+        qsort(offset[k], count[k], sizeof(double), compare_double);
+        spread[used++] = offset[k][count[k] * 95u / 100u] - offset[k][count[k] * 5u / 100u];
+        free(offset[k]);
+    }
+    assert_true(used > 0u);
+    qsort(spread, used, sizeof(double), compare_double);
+    *largest = spread[used - 1u];
+    *median = spread[used / 2u];
+    free(count);
+    free(fill);
+    free(spread);
+    free(offset);
+    free(hit);
+}
+
+/* The drift kind (every 4th pose, seeds 1-2): the same seed gives the same
+ * logged poses; the drift moves the logged poses only (the ranges and the
+ * seen samples are those of the scene with the drift off); the endpoints of
+ * the corridor walls, seen on three passes with different drift, spread
+ * over a band: some wall over 8 cm wide and the median wall wider than
+ * without the drift, which stays under 6 cm. */
+static void test_drift_band(void **state)
+{
+    uint64_t seed;
+    (void)state;
+    for (seed = 1; seed <= 2u; seed++) {
+        scansim_scene a, b, off;
+        double largest, median, off_largest, off_median;
+        size_t n;
+        uint32_t i;
+        assert_int_equal(scansim_scene_builtin(&a, "drift", seed), 0);
+        assert_int_equal(scansim_scene_builtin(&b, "drift", seed), 0);
+        assert_int_equal(scansim_scene_builtin(&off, "drift", seed), 0);
+        assert_true(a.drift_m_per_m > 0.0 && a.drift_rad_per_m > 0.0 && a.drift_reset_m > 0.0);
+        off.drift_m_per_m = off.drift_rad_per_m = 0.0;
+        assert_int_equal(scansim_keep_every(&a, 4u), 0);
+        assert_int_equal(scansim_keep_every(&b, 4u), 0);
+        assert_int_equal(scansim_keep_every(&off, 4u), 0);
+        assert_int_equal(scansim_run(&a), 0);
+        assert_int_equal(scansim_run(&b), 0);
+        assert_int_equal(scansim_run(&off), 0);
+        n = (size_t)a.scan_count * a.laser.beam_count;
+        assert_memory_equal(a.range_m, b.range_m, n * sizeof(float));
+        assert_memory_equal(a.range_m, off.range_m, n * sizeof(float));
+        assert_int_equal(scansim_seen_count(&a), scansim_seen_count(&off));
+        assert_int_equal(scansim_ideal_vertices(&a), scansim_ideal_vertices(&off));
+        for (i = 0; i < a.scan_count; i++) {
+            assert_true(a.scans[i].pose_x_m == b.scans[i].pose_x_m);
+            assert_true(a.scans[i].pose_y_m == b.scans[i].pose_y_m);
+            assert_true(a.scans[i].pose_theta_rad == b.scans[i].pose_theta_rad);
+        }
+        assert_true(a.scans[a.scan_count - 1u].pose_x_m != off.scans[off.scan_count - 1u].pose_x_m);
+        endpoint_spread(&a, &largest, &median);
+        endpoint_spread(&off, &off_largest, &off_median);
+        if (!(largest > 0.08 && median > off_median + 0.02 && off_largest < 0.06))
+            fail_msg("drift seed %u: spread largest %.3f median %.3f, without drift %.3f %.3f",
+                     (unsigned)seed, largest, median, off_largest, off_median);
+        scansim_scene_free(&a);
+        scansim_scene_free(&b);
+        scansim_scene_free(&off);
+    }
+}
+
+/* The drift model on a straight 20 m path (scansim.h): without a reset the
+ * logged heading's error is a random walk and the position's error across
+ * the path follows it (a turned step), so that it grows far beyond the
+ * position's own walk; a reset every 2 m with keep 0 pulls every error
+ * back to under one 2 m stretch's walk. The farhall kind is the hall of the
+ * same seed with drift. */
+static void test_drift_model(void **state)
+{
+    scansim_scene s, hall, far;
+    static const double wall[] = {-1.0, 5.0, 21.0, 5.0};
+    static const double path[] = {0.0, 0.0, 20.0, 0.0};
+    double worst_heading = 0.0, worst_across = 0.0, along_sum = 0.0, across_sum = 0.0;
+    uint32_t i;
+    (void)state;
+    scansim_scene_init(&s, "straight", 3);
+    s.pose_sigma_m = s.pose_sigma_rad = 0.0;
+    s.drift_rad_per_m = 0.5 * 3.14159265358979323846 / 180.0;
+    assert_int_equal(scansim_add_wall(&s, wall, 2u, 0), 0);
+    assert_int_equal(scansim_add_path(&s, path, 2u, 0.1), 0);
+    assert_int_equal(scansim_run(&s), 0);
+    for (i = 0; i < s.scan_count; i++) {
+        double et = s.scans[i].pose_theta_rad - s.poses[i].theta_rad;
+        /* position error across the path: the sum of the turned steps */
+        assert_near(s.scans[i].pose_y_m, across_sum, 1e-5);
+        assert_near(s.scans[i].pose_x_m, s.poses[i].x_m + along_sum, 1e-5);
+        along_sum += 0.1 * (cos(et) - 1.0);
+        across_sum += 0.1 * sin(et);
+        worst_heading = fmax(worst_heading, fabs(et));
+        worst_across = fmax(worst_across, fabs(s.scans[i].pose_y_m));
+    }
+    assert_true(worst_heading > 0.5 * 3.14159265358979323846 / 180.0);
+    assert_true(worst_across > 0.03);
+    s.drift_m_per_m = 0.01;
+    s.drift_reset_m = 2.0;
+    s.drift_keep = 0.0;
+    assert_int_equal(scansim_run(&s), 0);
+    for (i = 0; i < s.scan_count; i++)
+        assert_true(fabs(s.scans[i].pose_theta_rad - s.poses[i].theta_rad) <
+                    5.0 * 0.5 * 3.14159265358979323846 / 180.0 * sqrt(2.0));
+    scansim_scene_free(&s);
+
+    assert_int_equal(scansim_scene_builtin(&hall, "hall", 5), 0);
+    assert_int_equal(scansim_scene_builtin(&far, "farhall", 5), 0);
+    assert_int_equal(far.wall_point_count, hall.wall_point_count);
+    assert_memory_equal(far.wall_xy_m, hall.wall_xy_m, 2u * hall.wall_point_count * sizeof(double));
+    assert_int_equal(far.pose_count, hall.pose_count);
+    assert_true(hall.drift_rad_per_m == 0.0 && far.drift_rad_per_m > 0.0);
+    assert_near(far.laser.max_range_m, 30.0, 1e-6);
+    scansim_scene_free(&hall);
+    scansim_scene_free(&far);
+}
+
 /* Keeping every third pose keeps poses 0, 3, 6 and moves the people with
  * them. */
 static void test_keep_every(void **state)
@@ -530,6 +730,8 @@ int main(void)
         cmocka_unit_test(test_kinds_layouts),
         cmocka_unit_test(test_kinds_run),
         cmocka_unit_test(test_hall_scanner),
+        cmocka_unit_test(test_drift_band),
+        cmocka_unit_test(test_drift_model),
         cmocka_unit_test(test_keep_every),
         cmocka_unit_test(test_path_clearance),
     };

@@ -24,6 +24,7 @@
 
 #include "gridimage.h"
 #include "gridtrace.h"
+#include "gtband.h"
 #include "gtscore.h"
 #include "gttopo.h"
 #include "mapfile.h"
@@ -76,7 +77,10 @@ static const char usage_text[] =
     "len = map length (m); dcov = doubly covered length in runs over 20 cm (m,\n"
     "and % of len); cross = pairs of segments crossing; uns20, uns10 = runs of\n"
     "map over 20 / 10 cm with no endpoint within 5 cm; loose = open ends 3-15 cm\n"
-    "from another part of the map; sim scenes: rms = precision RMS, core = the\n"
+    "from another part of the map; band15 = map length drawn as a band of parallel\n"
+    "lines seen from the same side, in runs over 20 cm (m, and % of len;\n"
+    "tools/eval/gtband.h); end20, end10, end5 = share of scan endpoints within\n"
+    "20 / 10 / 5 cm of the map; sim scenes: rms = precision RMS, core = the\n"
     "precision RMS of the samples within 0.5 m of a true wall (mm); ms = the\n"
     "topology scorers' time.\n"
     "Occupancy maps (last section, docs/evaluation.md): sim scenes but the circles\n"
@@ -294,6 +298,7 @@ typedef struct topo_row {
     char label[160];
     int ok;                    /* 0: the scene failed or the scorer ran out of memory */
     gttopo_score score;
+    gtband_score band;         /* band15, end5 / end10 / end20 */
     double rms_m, core_m;      /* sim scenes; < 0: none */
     double ms;                 /* the scorers' time, points included */
 } topo_row;
@@ -312,12 +317,14 @@ typedef struct row_accuracy {
 static void topology(const scanlog *log, const polyc_polyline *lines, uint32_t count,
                      const gtscore_truth *truth, const row_accuracy *acc, topo_row *row)
 {
-    double t0 = pipeline_now_ms(), *xy = NULL;
+    double t0 = pipeline_now_ms(), *xy = NULL, *from = NULL;
     uint64_t n = 0;
     row->rms_m = row->core_m = -1.0;
-    row->ok = gttopo_scan_points(log->scans, log->count, &xy, &n) == 0 &&
-              gttopo_score_map(lines, count, xy, n, &row->score) == 0;
+    row->ok = gtband_scan_points(log->scans, log->count, &xy, &from, &n) == 0 &&
+              gttopo_score_map(lines, count, xy, n, &row->score) == 0 &&
+              gtband_score_map(lines, count, xy, from, n, &row->band) == 0;
     free(xy);
+    free(from);
     row->ms = pipeline_now_ms() - t0;
     if (row->ok && truth) {
         row->rms_m = acc->score.precision_rms_m;
@@ -454,16 +461,18 @@ static int bench_scene(const options *o, const scene *s, topo_row *row)
 static void print_topology(const topo_row *rows, size_t count)
 {
     size_t i;
-    printf("\ntopology (tools/eval/gttopo.h): the map against its log's scan endpoints; "
-           "rms and core (the\nsamples within 0.5 m of a true wall) are precision RMS, "
-           "sim scenes only\n");
-    printf("%-24s %9s %8s %6s %6s %6s %6s %6s | %6s %6s | %7s\n", "scene", "len", "dcov",
-           "dcov%", "cross", "uns20", "uns10", "loose", "rms", "core", "topo");
-    printf("%-24s %9s %8s %6s %6s %6s %6s %6s | %6s %6s | %7s\n", "", "m", "m", "", "", "",
-           "", "", "mm", "mm", "ms");
+    printf("\ntopology (tools/eval/gttopo.h) and bands (tools/eval/gtband.h): the map "
+           "against its log's scan\nendpoints; rms and core (the samples within 0.5 m of a "
+           "true wall) are precision RMS, sim\nscenes only\n");
+    printf("%-24s %9s %8s %6s %6s %6s %6s %6s | %8s %6s %6s %6s %6s | %6s %6s | %7s\n",
+           "scene", "len", "dcov", "dcov%", "cross", "uns20", "uns10", "loose", "band15",
+           "band%", "end20", "end10", "end5", "rms", "core", "topo");
+    printf("%-24s %9s %8s %6s %6s %6s %6s %6s | %8s %6s %6s %6s %6s | %6s %6s | %7s\n", "",
+           "m", "m", "", "", "", "", "", "m", "", "", "", "", "mm", "mm", "ms");
     for (i = 0; i < count; i++) {
         const topo_row *r = &rows[i];
         const gttopo_score *t = &r->score;
+        const gtband_score *b = &r->band;
         char rms[16] = "-", core[16] = "-";
         if (!r->ok) {
             if (r->label[0])
@@ -474,11 +483,14 @@ static void print_topology(const topo_row *rows, size_t count)
             snprintf(rms, sizeof rms, "%.1f", 1e3 * r->rms_m);
         if (r->core_m >= 0.0)
             snprintf(core, sizeof core, "%.1f", 1e3 * r->core_m);
-        printf("%-24s %9.1f %8.2f %6.2f %6u %6u %6u %6u | %6s %6s | %7.1f\n", r->label,
-               t->map_length_m, t->double_cover_m,
+        printf("%-24s %9.1f %8.2f %6.2f %6u %6u %6u %6u | %8.2f %6.2f %6.4f %6.4f %6.4f | "
+               "%6s %6s | %7.1f\n",
+               r->label, t->map_length_m, t->double_cover_m,
                t->map_length_m > 0.0 ? 100.0 * t->double_cover_m / t->map_length_m : 0.0,
-               t->crossings, t->unsupported_20, t->unsupported_10, t->loose_ends, rms, core,
-               r->ms);
+               t->crossings, t->unsupported_20, t->unsupported_10, t->loose_ends, b->band_m,
+               b->map_length_m > 0.0 ? 100.0 * b->band_m / b->map_length_m : 0.0,
+               gtband_share(b->within_20, b->points), gtband_share(b->within_10, b->points),
+               gtband_share(b->within_5, b->points), rms, core, r->ms);
     }
     fflush(stdout);
 }

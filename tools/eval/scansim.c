@@ -558,11 +558,43 @@ static double round_to(double v, double per_unit)
     return floor(v * per_unit + 0.5) / per_unit;
 }
 
+/* The drift of each pose (scansim.h): err gets x, y, heading per pose. */
+static void make_drift(const scansim_scene *scene, double *err)
+{
+    scansim_rng rng;
+    double ex = 0.0, ey = 0.0, et = 0.0, since = 0.0;
+    uint32_t s;
+    scansim_rng_seed(&rng, scene->seed ^ UINT64_C(0x6472696674)); /* "drift" */
+    for (s = 0; s < scene->pose_count; s++) {
+        if (s > 0) {
+            const scansim_pose *a = &scene->poses[s - 1u], *b = &scene->poses[s];
+            double dx = b->x_m - a->x_m, dy = b->y_m - a->y_m, d = hypot(dx, dy);
+            double c = cos(et), sn = sin(et), root = sqrt(d);
+            double gx = scansim_rng_gauss(&rng), gy = scansim_rng_gauss(&rng);
+            double gt = scansim_rng_gauss(&rng);
+            ex += c * dx - sn * dy - dx + scene->drift_m_per_m * root * gx;
+            ey += sn * dx + c * dy - dy + scene->drift_m_per_m * root * gy;
+            et += scene->drift_rad_per_m * root * gt;
+            since += d;
+            if (scene->drift_reset_m > 0.0 && since >= scene->drift_reset_m) {
+                ex *= scene->drift_keep;
+                ey *= scene->drift_keep;
+                et *= scene->drift_keep;
+                since = 0.0;
+            }
+        }
+        err[3u * s] = ex;
+        err[3u * s + 1u] = ey;
+        err[3u * s + 2u] = et;
+    }
+}
+
 int scansim_run(scansim_scene *scene)
 {
     const scansim_laser *laser = &scene->laser;
     uint32_t nseg, n = laser->beam_count, s, i;
     seg_info *seg = NULL;
+    double *drift = NULL;
     scansim_rng rng;
     int rc = -1, full_circle;
 
@@ -578,6 +610,12 @@ int scansim_run(scansim_scene *scene)
     if (!seg || !scene->wall_first_sample || !scene->wall_sample_count || !scene->scans ||
         !scene->range_m || make_samples(scene, seg) != 0)
         goto done;
+    if (scene->drift_m_per_m > 0.0 || scene->drift_rad_per_m > 0.0) {
+        drift = malloc(((size_t)scene->pose_count * 3u + 1u) * sizeof *drift);
+        if (!drift)
+            goto done;
+        make_drift(scene, drift);
+    }
 
     scansim_rng_seed(&rng, scene->seed);
     full_circle = (double)n * fabs((double)laser->angle_step_rad) >= 2.0 * SCANSIM_PI - 1e-4;
@@ -587,11 +625,19 @@ int scansim_run(scansim_scene *scene)
         float *range = &scene->range_m[(size_t)s * n];
         wall_hit first, prev, cur;
 
-        /* logged pose: truth plus alignment noise, in the log's precision */
-        scan->pose_x_m = round_to(truth->x_m + scene->pose_sigma_m * scansim_rng_gauss(&rng), 1e6);
-        scan->pose_y_m = round_to(truth->y_m + scene->pose_sigma_m * scansim_rng_gauss(&rng), 1e6);
-        scan->pose_theta_rad =
-            round_to(truth->theta_rad + scene->pose_sigma_rad * scansim_rng_gauss(&rng), 1e6);
+        /* logged pose: truth plus alignment noise (and drift), in the log's
+         * precision */
+        scan->pose_x_m = truth->x_m + scene->pose_sigma_m * scansim_rng_gauss(&rng);
+        scan->pose_y_m = truth->y_m + scene->pose_sigma_m * scansim_rng_gauss(&rng);
+        scan->pose_theta_rad = truth->theta_rad + scene->pose_sigma_rad * scansim_rng_gauss(&rng);
+        if (drift) {
+            scan->pose_x_m += drift[3u * s];
+            scan->pose_y_m += drift[3u * s + 1u];
+            scan->pose_theta_rad += drift[3u * s + 2u];
+        }
+        scan->pose_x_m = round_to(scan->pose_x_m, 1e6);
+        scan->pose_y_m = round_to(scan->pose_y_m, 1e6);
+        scan->pose_theta_rad = round_to(scan->pose_theta_rad, 1e6);
         scan->start_angle_rad = laser->start_angle_rad;
         scan->angle_step_rad = laser->angle_step_rad;
         scan->min_range_m = laser->min_range_m;
@@ -638,6 +684,7 @@ int scansim_run(scansim_scene *scene)
     rc = 0;
 done:
     free(seg);
+    free(drift);
     if (rc != 0)
         free_results(scene);
     return rc;

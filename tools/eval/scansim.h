@@ -84,6 +84,21 @@ typedef struct scansim_scene {
     scansim_laser laser;
     double pose_sigma_m;       /* alignment noise of the logged pose */
     double pose_sigma_rad;
+    /* Drift of the logged pose (off while both rates are 0), on top of the
+     * alignment noise: an error (x, y, heading) that starts at 0 and, over
+     * each step between two poses of d metres, grows as dead reckoning's
+     * does: the step is turned by the heading error, the position error
+     * takes a Gaussian of std-dev drift_m_per_m x sqrt(d) per axis, the
+     * heading error one of drift_rad_per_m x sqrt(d). Every drift_reset_m
+     * metres travelled (0: never) the error is scaled by drift_keep, as a
+     * scan matcher pulls it back towards zero. A stream of its own (from
+     * the seed), so that the other draws are those of a scene without
+     * drift. The ground truth (seen samples, ideal) follows the true
+     * poses. */
+    double drift_m_per_m;
+    double drift_rad_per_m;
+    double drift_reset_m;
+    double drift_keep;
 
     double *wall_xy_m;         /* interleaved x, y */
     uint32_t wall_point_count, wall_point_cap;
@@ -133,8 +148,9 @@ void scansim_transform(scansim_scene *scene, double angle_rad, double dx_m, doub
 
 /* Built-in scenes: "square", "office", "angled", "circle" (fixed layouts;
  * the seed drives the noise only) and the randomised kinds "hall",
- * "shelves", "flat", "curved", "thinwalls" (the seed also draws the layout,
- * furniture, people, rotation and shift). -1 if unknown. */
+ * "shelves", "flat", "curved", "thinwalls", and with drifting poses
+ * "drift", "farhall" (the seed also draws the layout, furniture, people,
+ * rotation and shift). -1 if unknown. */
 int scansim_scene_builtin(scansim_scene *scene, const char *name, uint64_t seed);
 /* NULL-terminated list of the built-in names. */
 const char *const *scansim_builtin_names(void);
@@ -147,6 +163,8 @@ int scansim_kind_shelves(scansim_scene *scene);
 int scansim_kind_flat(scansim_scene *scene);
 int scansim_kind_curved(scansim_scene *scene);
 int scansim_kind_thinwalls(scansim_scene *scene);
+int scansim_kind_drift(scansim_scene *scene);
+int scansim_kind_farhall(scansim_scene *scene);
 
 /* Keeps every step-th pose (0, step, 2 step, ...) and moves the people's
  * scan intervals with them: a smaller scene of the same layout, for tests.

@@ -778,3 +778,130 @@ int scansim_kind_thinwalls(scansim_scene *s)
     place_anywhere(&L);
     return 0;
 }
+
+/* ---- drift and farhall: poses that drift --------------------------------------- */
+
+#define DRIFT_T 0.12         /* the drift building's wall thickness */
+#define DRIFT_DOOR_M 0.9
+
+/* The drift of the logged poses (scansim.h): m_per_m and deg_per_m per
+ * sqrt(metre) travelled, pulled back to keep x the error every reset_m
+ * metres. */
+static void set_drift(scansim_scene *s, double m_per_m, double deg_per_m, double reset_m,
+                      double keep)
+{
+    s->drift_m_per_m = m_per_m;
+    s->drift_rad_per_m = deg_per_m * PI / 180.0;
+    s->drift_reset_m = reset_m;
+    s->drift_keep = keep;
+}
+
+/* A wall DRIFT_T thick along one axis from a to b (x if horizontal, else
+ * y), across it from c to c + DRIFT_T, with a DRIFT_DOOR_M gap at each
+ * door start (ascending, within (a, b)). */
+static int wall_with_doors(scansim_scene *s, int horizontal, double a, double b, double c,
+                           const double *door, uint32_t doors)
+{
+    double from = a;
+    uint32_t k;
+    int rc = 0;
+    for (k = 0; k <= doors; k++) {
+        double to = k < doors ? door[k] : b;
+        if (to > from)
+            rc |= horizontal ? scansim_add_box(s, from, c, to, c + DRIFT_T)
+                             : scansim_add_box(s, c, from, c + DRIFT_T, to);
+        if (k < doors)
+            from = door[k] + DRIFT_DOOR_M;
+    }
+    return rc;
+}
+
+/* One row of offices between the outline and the corridor ring: the row
+ * runs along one axis over [a, b], its corridor wall at c (across), the
+ * outline at `back`; partitions every 3-4.5 m within the corridor's span
+ * [lo, hi], one door per office where it faces the corridor. */
+static int office_row(layout *L, int horizontal, double a, double b, double lo, double hi,
+                      double c, double back)
+{
+    scansim_scene *s = L->s;
+    /* the partitions, across: from the corridor wall's office face to the
+     * outline */
+    double cut[16], door[17], x, q0 = back < c ? back : c + DRIFT_T, q1 = back < c ? c : back;
+    uint32_t n = 0, k, doors = 0;
+    int rc = 0;
+    for (x = lo + urange(&L->rng, 3.0, 4.5); x < hi - 2.5 && n < 16u;
+         x += urange(&L->rng, 3.0, 4.5))
+        cut[n++] = x;
+    for (k = 0; k <= n; k++) {
+        double o0 = fmax(k ? cut[k - 1u] + DRIFT_T / 2.0 : a, lo) + 0.3;
+        double o1 = fmin(k < n ? cut[k] - DRIFT_T / 2.0 : b, hi) - 0.3 - DRIFT_DOOR_M;
+        if (o1 > o0)
+            door[doors++] = urange(&L->rng, o0, o1);
+    }
+    rc |= wall_with_doors(s, horizontal, a, b, c, door, doors);
+    for (k = 0; k < n; k++)
+        rc |= horizontal ? scansim_add_box(s, cut[k] - DRIFT_T / 2.0, q0, cut[k] + DRIFT_T / 2.0, q1)
+                         : scansim_add_box(s, q0, cut[k] - DRIFT_T / 2.0, q1, cut[k] + DRIFT_T / 2.0);
+    return rc;
+}
+
+/* An office floor of 24-32 m x 16-22 m: offices 3-4 m deep along the
+ * outside, each behind a door on a corridor 1.8-2.4 m wide that runs round
+ * a central block. The robot drives round the corridor three times, so
+ * that every wall is seen on three passes, each with the drift of its own
+ * stretch: 1 cm and 0.15 degrees per sqrt(m), halved every 5-10 m, on top
+ * of 5 mm / 0.1 degree of alignment noise per scan. The endpoints of one
+ * corridor wall then spread over a band of about 10 cm (5th to 95th
+ * percentile across it), up to 30 cm, as on the real logs. */
+int scansim_kind_drift(scansim_scene *s)
+{
+    layout L;
+    double w, h, o, c, m, outline[8];
+    uint32_t loop;
+    int rc = 0;
+    layout_init(&L, s, UINT64_C(0x6472696674));
+    set_drift(s, 0.01, 0.15, urange(&L.rng, 5.0, 10.0), 0.5);
+    s->pose_sigma_m = 0.005;
+    s->pose_sigma_rad = 0.1 * PI / 180.0;
+    w = urange(&L.rng, 24.0, 32.0);
+    h = urange(&L.rng, 16.0, 22.0);
+    o = urange(&L.rng, 3.0, 4.0);
+    c = urange(&L.rng, 1.8, 2.4);
+    outline[0] = 0.0; outline[1] = 0.0; outline[2] = w; outline[3] = 0.0;
+    outline[4] = w; outline[5] = h; outline[6] = 0.0; outline[7] = h;
+    L.outline = s->wall_count;
+    rc |= scansim_add_wall(s, outline, 4u, 1);
+    /* south and north rows span the width (their corridor walls close the
+     * corner offices), west and east rows lie between them */
+    rc |= office_row(&L, 1, 0.0, w, o, w - o, o - DRIFT_T, 0.0);
+    rc |= office_row(&L, 1, 0.0, w, o, w - o, h - o, h);
+    rc |= office_row(&L, 0, o, h - o, o, h - o, o - DRIFT_T, 0.0);
+    rc |= office_row(&L, 0, o, h - o, o, h - o, w - o, w);
+    rc |= scansim_add_box(s, o + c, o + c, w - o - c, h - o - c);
+    m = o + c / 2.0;
+    for (loop = 0; loop < 3u; loop++) {
+        way(&L, m, m);
+        way(&L, w - m, m);
+        way(&L, w - m, h - m);
+        way(&L, m, h - m);
+    }
+    way(&L, m, m + 0.2);
+    rc |= lay_path(&L, 1000.0);
+    rc |= add_people(&L, 2u, 1u);
+    if (rc != 0)
+        return -1;
+    place_anywhere(&L);
+    return 0;
+}
+
+/* The hall (the same layout, path and people for a seed) with drift: its
+ * 30 m scanner sees the far walls at 20-30 m, where 0.1 degree of heading
+ * is 4-5 cm. 3 mm and 0.05 degrees per sqrt(m), reset to a third every
+ * 8 m. */
+int scansim_kind_farhall(scansim_scene *s)
+{
+    if (scansim_kind_hall(s) != 0)
+        return -1;
+    set_drift(s, 0.003, 0.05, 8.0, 1.0 / 3.0);
+    return 0;
+}

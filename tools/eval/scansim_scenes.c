@@ -154,10 +154,13 @@ static const builtin builtins[] = {
     {"flat", scansim_kind_flat},
     {"curved", scansim_kind_curved},
     {"thinwalls", scansim_kind_thinwalls},
+    {"drift", scansim_kind_drift},
+    {"farhall", scansim_kind_farhall},
 };
 
-static const char *const builtin_names[] = {"square", "office",  "angled", "circle",    "hall",
-                                            "shelves", "flat", "curved", "thinwalls", NULL};
+static const char *const builtin_names[] = {"square", "office",  "angled", "circle",
+                                            "hall",   "shelves", "flat",   "curved",
+                                            "thinwalls", "drift", "farhall", NULL};
 
 const char *const *scansim_builtin_names(void)
 {

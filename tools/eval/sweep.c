@@ -20,6 +20,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "gtband.h"
 #include "gtscore.h"
 #include "gttopo.h"
 #include "occmap.h"
@@ -39,6 +40,8 @@
 /* and the topology's: double cover at most 25 cm, no crossing, no run of
  * map over 20 cm without a scan endpoint within 5 cm */
 #define TARGET_DCOV_M 0.25
+/* and the bands': band15 at most 1 % of the map's length */
+#define TARGET_BAND 0.01
 #define CORE_M 0.5                 /* core precision: map samples this near a true wall */
 /* --occupancy: the scenes through the mapper at 5 cm (tools/eval/occmap.h)
  * and the library's polyc_add_grid; its targets: core precision at most
@@ -56,7 +59,8 @@ static const char usage_text[] =
     "options:\n"
     "  --seeds A-B      seeds A to B (or one seed A); default 1-6\n"
     "  --kinds a,b,...  scene kinds; default hall,shelves,flat,curved,thinwalls,\n"
-    "                   office,angled,square (any of scansim's built-in names)\n"
+    "                   office,angled,square,drift,farhall (any of scansim's\n"
+    "                   built-in names; drift and farhall: poses that drift)\n"
     "  --save DIR       write DIR/KIND-sSEED.log and .gt.txt (for build/polyc)\n"
     "  --svg DIR        write DIR/KIND-sSEED.svg: true walls (grey), the robot's\n"
     "                   path (blue), people (pink), the map (black, dots on vertices;\n"
@@ -76,15 +80,21 @@ static const char usage_text[] =
     "line-fit floor, mm), compl (completeness), gcompl (--occupancy: the grid's\n"
     "own completeness, seen samples within 5 cm of an occupied cell's centre),\n"
     "dcov (double cover, m), cross (crossings), uns20 (runs over 20 cm without\n"
-    "data within 5 cm), then the targets missed: P core precision > max(1.25 x\n"
+    "data within 5 cm), band% (band15: map length drawn as a band of parallel\n"
+    "lines seen from the same side, in runs over 20 cm, % of the map's length;\n"
+    "tools/eval/gtband.h), end20, end10 (share of scan endpoints within 20 / 10 cm\n"
+    "of the map; band%, end20 and end10 need the scans: '-' with --occupancy),\n"
+    "then the targets missed: P core precision > max(1.25 x\n"
     "fit, fit + 1.5 mm), C completeness < 0.98, V vertices > 1.5 x ideal, T\n"
-    "double cover > 0.25 m, a crossing or a run over 20 cm ('ok': none).\n"
+    "double cover > 0.25 m, a crossing or a run over 20 cm, B band15 > 1 % of\n"
+    "the map's length ('ok': none).\n"
     "Summary rows give per kind and over all the median and the worst (highest;\n"
     "completeness: lowest) of each figure.\n"
     "Exit: 0 every scene ran; 1 a scene failed (its row says why); 2 usage error.\n";
 
 static const char *const default_kinds[] = {"hall",   "shelves", "flat",   "curved",
-                                            "thinwalls", "office", "angled", "square"};
+                                            "thinwalls", "office", "angled", "square",
+                                            "drift",  "farhall"};
 
 typedef struct options {
     uint64_t seed_first, seed_last;
@@ -101,7 +111,7 @@ typedef struct options {
  * score_scene. */
 enum figure { FIG_SCANS, FIG_BEAMS, FIG_MS, FIG_VERTS, FIG_IDEAL, FIG_RATIO, FIG_RMS,
               FIG_CORE, FIG_FIT, FIG_FLOOR, FIG_COMPL, FIG_GCOMPL, FIG_DCOV, FIG_CROSS,
-              FIG_UNS20, FIG_COUNT };
+              FIG_UNS20, FIG_BAND, FIG_END20, FIG_END10, FIG_COUNT };
 
 typedef struct figure_info {
     const char *name;
@@ -116,11 +126,13 @@ static const figure_info figures[FIG_COUNT] = {
     {"rms", 6, 1, 1e3, 0},     {"core", 6, 1, 1e3, 0},    {"fit", 6, 1, 1e3, 0},
     {"floor", 6, 1, 1e3, 0},   {"compl", 7, 4, 1.0, 1},   {"gcompl", 7, 4, 1.0, 1},
     {"dcov", 6, 2, 1.0, 0},
-    {"cross", 5, 0, 1.0, 0},   {"uns20", 5, 0, 1.0, 0},
+    {"cross", 5, 0, 1.0, 0},   {"uns20", 5, 0, 1.0, 0},   {"band%", 6, 2, 100.0, 0},
+    {"end20", 6, 4, 1.0, 1},   {"end10", 6, 4, 1.0, 1},
 };
 
 /* Bits of the targets a scene misses. */
-enum { MISS_PRECISION = 1, MISS_COMPLETENESS = 2, MISS_VERTICES = 4, MISS_TOPOLOGY = 8 };
+enum { MISS_PRECISION = 1, MISS_COMPLETENESS = 2, MISS_VERTICES = 4, MISS_TOPOLOGY = 8,
+       MISS_BAND = 16 };
 
 typedef struct row {
     char kind[32];
@@ -200,7 +212,8 @@ static int score_scene(const scansim_scene *sc, const gtscore_truth *truth,
 {
     gtscore_map_score score;
     gttopo_score topo;
-    double fit_m, floor_m, core_m, *hits = NULL;
+    gtband_score band = {0};
+    double fit_m, floor_m, core_m, *hits = NULL, *from = NULL;
     uint64_t hit_count = 0;
     uint32_t i;
     for (i = 0; i < FIG_COUNT; i++)
@@ -211,10 +224,13 @@ static int score_scene(const scansim_scene *sc, const gtscore_truth *truth,
         gtscore_line_floor(truth, sc->scans, sc->scan_count, &floor_m) != 0)
         return -1;
     if (grid ? occmap_cell_points(grid, OCC_MIN, &hits, &hit_count) != 0
-             : gttopo_scan_points(sc->scans, sc->scan_count, &hits, &hit_count) != 0)
+             : gtband_scan_points(sc->scans, sc->scan_count, &hits, &from, &hit_count) != 0)
         return -1;
-    int topo_rc = gttopo_score_map(lines, count, hits, hit_count, &topo);
+    /* the bands need the sensor of each point: scans only */
+    int topo_rc = gttopo_score_map(lines, count, hits, hit_count, &topo) != 0 ||
+                  (!grid && gtband_score_map(lines, count, hits, from, hit_count, &band) != 0);
     free(hits);
+    free(from);
     if (topo_rc != 0)
         return -1;
     r->fig[FIG_CORE] = core_m;
@@ -231,6 +247,11 @@ static int score_scene(const scansim_scene *sc, const gtscore_truth *truth,
     r->fig[FIG_FIT] = fit_m >= 0.0 ? fit_m : (double)NAN;
     r->fig[FIG_FLOOR] = floor_m >= 0.0 ? floor_m : (double)NAN;
     r->fig[FIG_COMPL] = score.completeness;
+    if (!grid) {
+        r->fig[FIG_BAND] = band.map_length_m > 0.0 ? band.band_m / band.map_length_m : 0.0;
+        r->fig[FIG_END20] = gtband_share(band.within_20, band.points);
+        r->fig[FIG_END10] = gtband_share(band.within_10, band.points);
+    }
     r->missed = 0;
     if (grid) {
         r->fig[FIG_GCOMPL] = grid_completeness(truth, grid);
@@ -252,6 +273,8 @@ static int score_scene(const scansim_scene *sc, const gtscore_truth *truth,
         r->missed |= MISS_COMPLETENESS;
     if (score.ideal && (double)score.vertices > TARGET_RATIO * (double)score.ideal)
         r->missed |= MISS_VERTICES;
+    if (r->fig[FIG_BAND] > TARGET_BAND)
+        r->missed |= MISS_BAND;
     return 0;
 }
 
@@ -361,9 +384,9 @@ static void print_missed(unsigned missed)
         printf("  ok\n");
         return;
     }
-    printf("  %s%s%s%s\n", missed & MISS_PRECISION ? "P" : "",
+    printf("  %s%s%s%s%s\n", missed & MISS_PRECISION ? "P" : "",
            missed & MISS_COMPLETENESS ? "C" : "", missed & MISS_VERTICES ? "V" : "",
-           missed & MISS_TOPOLOGY ? "T" : "");
+           missed & MISS_TOPOLOGY ? "T" : "", missed & MISS_BAND ? "B" : "");
 }
 
 /* Simulates, maps and scores one scene; prints its row. */
@@ -606,11 +629,11 @@ int main(int argc, char **argv)
     else
         printf("libpolyc %u.%u.%u sweep: seeds %llu-%llu, targets: P core <= max(%.2f x fit, fit + "
                "%.1f mm), C compl >= %.2f, V verts <= %.1f x ideal, T dcov <= %.2f m, 0 cross, "
-               "0 uns20\n",
+               "0 uns20, B band15 <= %.0f %% of the map\n",
                polyc_version() / 10000u, polyc_version() / 100u % 100u, polyc_version() % 100u,
                (unsigned long long)o.seed_first, (unsigned long long)o.seed_last,
                TARGET_FIT_FACTOR, 1e3 * TARGET_FIT_MARGIN_M, TARGET_COMPLETENESS, TARGET_RATIO,
-               TARGET_DCOV_M);
+               TARGET_DCOV_M, 100.0 * TARGET_BAND);
     printf("%-10s %4s", "kind", "seed");
     for (f = 0; f < FIG_COUNT; f++)
         printf(" %*s", figures[f].width, figures[f].name);

@@ -1,0 +1,180 @@
+/* mapscore.c - the topology and band figures of one map against one log.
+ *
+ *   mapscore LOG [MAP.txt]
+ *
+ * Takes a scan log (read by tools/scanlog, as the CLI reads it) and a map
+ * in the TXT format `polyc --format txt` writes (docs/formats.md); without
+ * a map, maps the log with the library's defaults (tools/eval/pipeline.h,
+ * as the bench does). Gives one row: the map's size, its topology figures
+ * (tools/eval/gttopo.h) and its bands (tools/eval/gtband.h) against the
+ * log's scan endpoints. No ground truth needed. Exit codes: 0 ok, 1 the
+ * log, the map or the library failed, 2 usage.
+ */
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gtband.h"
+#include "gttopo.h"
+#include "pipeline.h"
+#include "polyc.h"
+#include "scanlog.h"
+
+#define EXIT_FAILED 1
+#define EXIT_USAGE 2
+
+static const char usage_text[] =
+    "usage: mapscore LOG [MAP.txt]\n"
+    "Scores MAP (as `polyc --format txt` writes it; without MAP: the log mapped\n"
+    "with the library's defaults) against LOG's scan endpoints, one row:\n"
+    "lines, verts; len = map length (m); dcov (m, and % of len), cross, uns20,\n"
+    "uns10, loose (tools/eval/gttopo.h); band15 = map length drawn as a band of\n"
+    "parallel lines seen from the same side (m, and % of len); end20, end10,\n"
+    "end5 = share of endpoints within 20 / 10 / 5 cm of the map\n"
+    "(tools/eval/gtband.h, docs/evaluation.md); libms = the library's time\n"
+    "(without MAP; 0 with it), scorems = the scorers' time.\n"
+    "Exit: 0 ok; 1 the log, the map or the library failed; 2 usage.\n";
+
+/* The polylines of a TXT map: "open|closed N x1 y1 ... xN yN" per line.
+ * *lines and each xy_m are malloc'ed (free_lines). -1 with a message on
+ * stderr when the file is not such a map. */
+static int read_txt_map(const char *path, polyc_polyline **lines, uint32_t *count)
+{
+    FILE *f = fopen(path, "r");
+    char word[16];
+    uint32_t cap = 0;
+    int c;
+    *lines = NULL;
+    *count = 0;
+    if (!f) {
+        fprintf(stderr, "mapscore: %s: %s\n", path, strerror(errno));
+        return -1;
+    }
+    while (fscanf(f, "%15s", word) == 1) {
+        polyc_polyline *pl;
+        unsigned long n, k;
+        float *xy;
+        if ((strcmp(word, "open") != 0 && strcmp(word, "closed") != 0) ||
+            fscanf(f, "%lu", &n) != 1 || n == 0 || n > 100000000ul)
+            goto bad;
+        if (*count == cap) {
+            polyc_polyline *p = realloc(*lines, (cap ? 2u * cap : 64u) * sizeof *p);
+            if (!p)
+                goto bad;
+            *lines = p;
+            cap = cap ? 2u * cap : 64u;
+        }
+        xy = malloc(2u * n * sizeof *xy);
+        if (!xy)
+            goto bad;
+        pl = &(*lines)[(*count)++];
+        memset(pl, 0, sizeof *pl);
+        pl->xy_m = xy;
+        pl->point_count = (uint32_t)n;
+        pl->closed = strcmp(word, "closed") == 0;
+        for (k = 0; k < 2u * n; k++)
+            if (fscanf(f, "%f", &xy[k]) != 1)
+                goto bad;
+    }
+    c = fgetc(f);
+    if (c != EOF || ferror(f))
+        goto bad;
+    fclose(f);
+    return 0;
+bad:
+    fprintf(stderr, "mapscore: %s: not a TXT map (polyline %u)\n", path, *count);
+    fclose(f);
+    return -1;
+}
+
+static void free_lines(polyc_polyline *lines, uint32_t count, int owned_points)
+{
+    uint32_t i;
+    for (i = 0; owned_points && i < count; i++)
+        free((void *)lines[i].xy_m);
+    free(lines);
+}
+
+int main(int argc, char **argv)
+{
+    scanlog log;
+    pipeline p;
+    polyc_polyline *lines = NULL;
+    uint32_t count = 0, verts = 0, i;
+    gttopo_score topo;
+    gtband_score band;
+    double *xy = NULL, *from = NULL, lib_ms = 0.0, t0;
+    uint64_t n = 0;
+    FILE *f;
+    int rc = EXIT_FAILED, from_file = argc == 3;
+
+    if (argc == 2 && (strcmp(argv[1], "-h") == 0 || strcmp(argv[1], "--help") == 0)) {
+        fputs(usage_text, stdout);
+        return 0;
+    }
+    if (argc < 2 || argc > 3 || argv[1][0] == '-' || (from_file && argv[2][0] == '-')) {
+        fputs(usage_text, stderr);
+        return EXIT_USAGE;
+    }
+    memset(&log, 0, sizeof log);
+    memset(&p, 0, sizeof p);
+    f = fopen(argv[1], "r");
+    if (!f) {
+        fprintf(stderr, "mapscore: %s: %s\n", argv[1], strerror(errno));
+        return EXIT_FAILED;
+    }
+    if (scanlog_read(&log, f, argv[1], NULL) != 0) {
+        fprintf(stderr, "mapscore: %s\n", log.error);
+        fclose(f);
+        goto done;
+    }
+    fclose(f);
+    if (from_file) {
+        if (read_txt_map(argv[2], &lines, &count) != 0)
+            goto done;
+    } else {
+        polyc_config config;
+        double times[PIPELINE_STAGES];
+        polyc_config_default(&config);
+        if (pipeline_open(&p, &config, log.scans, log.count) != 0 ||
+            pipeline_run(&p, log.scans, log.count, times) != 0 ||
+            (lines = pipeline_lines(&p, &count)) == NULL) {
+            fprintf(stderr, "mapscore: error in %s: %s (%s)\n",
+                    p.failed_at ? p.failed_at : "pipeline_lines", polyc_status_str(p.status),
+                    p.ctx ? polyc_last_error(p.ctx) : "");
+            goto done;
+        }
+        for (i = 0; i < PIPELINE_STAGES; i++)
+            lib_ms += times[i];
+    }
+    for (i = 0; i < count; i++)
+        verts += lines[i].point_count;
+    t0 = pipeline_now_ms();
+    if (gtband_scan_points(log.scans, log.count, &xy, &from, &n) != 0 ||
+        gttopo_score_map(lines, count, xy, n, &topo) != 0 ||
+        gtband_score_map(lines, count, xy, from, n, &band) != 0) {
+        fprintf(stderr, "mapscore: the scorers ran out of memory\n");
+        goto done;
+    }
+    printf("%-28s %6s %7s %9s %8s %6s %5s %5s %5s %5s %8s %6s %6s %6s %6s %8s %7s\n", "map",
+           "lines", "verts", "len", "dcov", "dcov%", "cross", "uns20", "uns10", "loose",
+           "band15", "band%", "end20", "end10", "end5", "libms", "scorems");
+    printf("%-28s %6u %7u %9.1f %8.2f %6.2f %5u %5u %5u %5u %8.2f %6.2f %6.4f %6.4f %6.4f %8.1f "
+           "%7.1f\n",
+           from_file ? argv[2] : "(library defaults)", count, verts, topo.map_length_m,
+           topo.double_cover_m,
+           topo.map_length_m > 0.0 ? 100.0 * topo.double_cover_m / topo.map_length_m : 0.0,
+           topo.crossings, topo.unsupported_20, topo.unsupported_10, topo.loose_ends,
+           band.band_m, band.map_length_m > 0.0 ? 100.0 * band.band_m / band.map_length_m : 0.0,
+           gtband_share(band.within_20, band.points), gtband_share(band.within_10, band.points),
+           gtband_share(band.within_5, band.points), lib_ms, pipeline_now_ms() - t0);
+    rc = 0;
+done:
+    free(xy);
+    free(from);
+    free_lines(lines, count, from_file);
+    pipeline_close(&p);
+    scanlog_free(&log);
+    return rc;
+}
