@@ -300,7 +300,7 @@ static void emit(prior_pass *q, const fit_line *l)
         float x = l->mx + t * l->dx, y = l->my + t * l->dy;
         if (record(q, x, y, 0, 1u) && p->straights < UINT32_MAX)
             p->straights++;
-        if (q->acc)
+        if (q->acc && len >= 0.5f)
             polyc__accuracy_sample(q->acc, x, y, nx, ny, q->scan, l->res2, density);
     }
     q->last = *l;

@@ -30,6 +30,8 @@
  * same side. BAND_M: bands on the real logs are 10-30 cm wide, and two lines
  * through a 30 cm band settle 15 cm apart. */
 #define BAND_M 0.20f
+#define BAND_END_M 0.15f   /* past the other's end: a 10 cm recess's back is within this of
+                             * the wall's ends over 11 cm only (less than ZIP_RUN_M) */
 #define BAND_COS 0.9397f    /* cos 20 degrees */
 #define SIDE_REACH_M 0.10f  /* endpoints this near a segment tell its side */
 
@@ -336,7 +338,8 @@ static int32_t band_other(const polyc__opt *o, float x, float y, int32_t a, int3
                     continue;
                 float u = ((x - c->x) * dx + (y - c->y) * dy) / l2;
                 float off = ((x - c->x) * dy - (y - c->y) * dx);
-                if (u < 0.0f || u > 1.0f || off * off > BAND_M * BAND_M * l2)
+                int beside = u >= 0.0f && u <= 1.0f && off * off <= BAND_M * BAND_M * l2;
+                if (!beside && polyc__seg_dist2(x, y, c->x, c->y, d->x, d->y) > BAND_END_M * BAND_END_M)
                     continue;
                 float mx, my;
                 if (!seen_normal(o, sg, &mx, &my) || mx * nx + my * ny < BAND_COS)
