@@ -314,38 +314,66 @@ static int seen_normal(const polyc__opt *o, int32_t sg, float *nx, float *ny)
     return 1;
 }
 
-/* A segment that does not touch a or b (the ends of the segment that
- * (x, y) lies on, seen along the unit normal nx, ny), lies within BAND_M of
- * (x, y), holds its foot, runs parallel and is seen from the same side; or
- * NONE. */
-static int32_t band_other(const polyc__opt *o, float x, float y, int32_t a, int32_t b, float nx,
-                          float ny)
+/* The segments that may lie in a band with segment v (seen along the unit
+ * normal nx, ny): not touching it, parallel within BAND_COS, seen from the
+ * same side and within BAND_M of it (the nearest of the four ends to the
+ * other segment: parallel segments do not cross). At most BAND_CANDIDATES
+ * (the first found), into cand; returns how many. */
+#define BAND_CANDIDATES 16
+static int band_candidates(const polyc__opt *o, int32_t v, float nx, float ny, int32_t *cand)
 {
     const polyc__hash *h = &o->h;
     const polyc__store *s = o->s;
+    int32_t w = s->v[v].next, n = 0;
+    float ax = s->v[v].x, ay = s->v[v].y, bx = s->v[w].x, by = s->v[w].y;
     int32_t ix0, iy0, ix1, iy1;
-    polyc__bucket_xy(h, x - BAND_M, y - BAND_M, &ix0, &iy0);
-    polyc__bucket_xy(h, x + BAND_M, y + BAND_M, &ix1, &iy1);
+    polyc__bucket_xy(h, polyc__minf(ax, bx) - BAND_M, polyc__minf(ay, by) - BAND_M, &ix0, &iy0);
+    polyc__bucket_xy(h, polyc__maxf(ax, bx) + BAND_M, polyc__maxf(ay, by) + BAND_M, &ix1, &iy1);
     for (int32_t iy = iy0; iy <= iy1; iy++)
         for (int32_t ix = ix0; ix <= ix1; ix++)
             for (int32_t e = h->seg_head[iy * h->bx + ix]; e != POLYC__NONE; e = h->entries[e].next) {
-                int32_t sg = h->entries[e].seg;
-                if (touches(s, sg, a, b))
+                int32_t sg = h->entries[e].seg, k;
+                if (touches(s, sg, v, w))
                     continue;
-                const polyc__vertex *c = &s->v[sg], *d = &s->v[c->next];
-                float dx = d->x - c->x, dy = d->y - c->y, l2 = dx * dx + dy * dy;
-                if (!(l2 > 0.0f))
-                    continue;
-                float u = ((x - c->x) * dx + (y - c->y) * dy) / l2;
-                float off = ((x - c->x) * dy - (y - c->y) * dx);
-                int beside = u >= 0.0f && u <= 1.0f && off * off <= BAND_M * BAND_M * l2;
-                if (!beside && polyc__seg_dist2(x, y, c->x, c->y, d->x, d->y) > BAND_END_M * BAND_END_M)
-                    continue;
+                for (k = 0; k < n && cand[k] != sg; k++)
+                    ;
+                if (k < n)
+                    continue; /* listed from another bucket */
                 float mx, my;
                 if (!seen_normal(o, sg, &mx, &my) || mx * nx + my * ny < BAND_COS)
                     continue;
-                return sg;
+                const polyc__vertex *c = &s->v[sg], *d = &s->v[c->next];
+                float d2 = polyc__minf(
+                    polyc__minf(polyc__seg_dist2(ax, ay, c->x, c->y, d->x, d->y),
+                                polyc__seg_dist2(bx, by, c->x, c->y, d->x, d->y)),
+                    polyc__minf(polyc__seg_dist2(c->x, c->y, ax, ay, bx, by),
+                                polyc__seg_dist2(d->x, d->y, ax, ay, bx, by)));
+                if (d2 > BAND_M * BAND_M)
+                    continue;
+                cand[n++] = sg;
+                if (n == BAND_CANDIDATES)
+                    return n;
             }
+    return n;
+}
+
+/* The first of the n candidates (band_candidates) in a band with the
+ * point (x, y): within BAND_M of it with its foot on the candidate, or
+ * within BAND_END_M of the candidate past its end; or NONE. */
+static int32_t band_other(const polyc__opt *o, float x, float y, const int32_t *cand, int n)
+{
+    const polyc__store *s = o->s;
+    for (int k = 0; k < n; k++) {
+        const polyc__vertex *c = &s->v[cand[k]], *d = &s->v[c->next];
+        float dx = d->x - c->x, dy = d->y - c->y, l2 = dx * dx + dy * dy;
+        if (!(l2 > 0.0f))
+            continue;
+        float u = ((x - c->x) * dx + (y - c->y) * dy) / l2;
+        float off = ((x - c->x) * dy - (y - c->y) * dx);
+        if ((u >= 0.0f && u <= 1.0f && off * off <= BAND_M * BAND_M * l2) ||
+            polyc__seg_dist2(x, y, c->x, c->y, d->x, d->y) <= BAND_END_M * BAND_END_M)
+            return cand[k];
+    }
     return POLYC__NONE;
 }
 
@@ -354,14 +382,16 @@ static int32_t band_other(const polyc__opt *o, float x, float y, int32_t a, int3
  * normal nx, ny). */
 typedef struct run_test {
     int band;
-    float lim2, nx, ny;
+    float lim2;
+    int32_t cand[BAND_CANDIDATES];  /* band: the segments that may hold it */
+    int n_cand;
 } run_test;
 
 static int sample_in_run(const polyc__opt *o, const run_test *rt, float x, float y, int32_t a,
                          int32_t b)
 {
     if (rt->band)
-        return band_other(o, x, y, a, b, rt->nx, rt->ny) != POLYC__NONE;
+        return band_other(o, x, y, rt->cand, rt->n_cand) != POLYC__NONE;
     return covered(o, x, y, a, b, rt->lim2);
 }
 
@@ -376,9 +406,16 @@ static int longest_run(const polyc__opt *o, int32_t v, int band, float *t0, floa
     float len = sqrtf(dx * dx + dy * dy);
     if (!(len > ZIP_RUN_M))
         return 0;
-    run_test rt = {band, o->cfg->overlap_m * o->cfg->overlap_m, 0.0f, 0.0f};
-    if (band && (!o->seg_side || !seen_normal(o, v, &rt.nx, &rt.ny)))
-        return 0;
+    run_test rt;
+    rt.band = band;
+    rt.lim2 = o->cfg->overlap_m * o->cfg->overlap_m;
+    rt.n_cand = 0;
+    if (band) {
+        float nx, ny;
+        if (!o->seg_side || !seen_normal(o, v, &nx, &ny) ||
+            (rt.n_cand = band_candidates(o, v, nx, ny, rt.cand)) == 0)
+            return 0;
+    }
     int32_t n = (int32_t)ceilf(len / ZIP_STEP_M);
     int32_t run0 = -1, best0 = 0, best1 = -1;
     for (int32_t k = 0; k <= n + 1; k++) {
@@ -508,8 +545,9 @@ int polyc__op_zip(polyc__opt *o)
             int32_t q;
             if (band) {
                 float nx = 0.0f, ny = 0.0f;
+                int32_t cand[BAND_CANDIDATES];
                 seen_normal(o, v, &nx, &ny);
-                q = band_other(o, mx, my, v, w, nx, ny);
+                q = band_other(o, mx, my, cand, band_candidates(o, v, nx, ny, cand));
             } else {
                 float qd2;
                 q = nearest_other(o, mx, my, v, w, &qd2);
