@@ -12,7 +12,7 @@
 typedef struct endpoint {
     int32_t ix, iy;
     float fx, fy;                  /* offset from the cell centre, metres */
-    float vx, vy;                  /* unit vector from the endpoint towards its sensor */
+    float vx, vy;                  /* from the endpoint to its sensor, metres */
 } endpoint;
 
 /* The data rule: a cell with hits that the grid does not judge free. */
@@ -32,9 +32,8 @@ static int endpoint_of(const polyc_ctx *ctx, const polyc__scan *s, uint32_t i, e
     e->iy = (int32_t)fy;
     e->fx = (b.ex - fx - 0.5f) * ctx->grid.cell_m;
     e->fy = (b.ey - fy - 0.5f) * ctx->grid.cell_m;
-    float vx = b.sx - b.ex, vy = b.sy - b.ey, vl = sqrtf(vx * vx + vy * vy);
-    e->vx = vl > 0.0f ? vx / vl : 0.0f;
-    e->vy = vl > 0.0f ? vy / vl : 0.0f;
+    e->vx = (b.sx - b.ex) * ctx->grid.cell_m;
+    e->vy = (b.sy - b.ey) * ctx->grid.cell_m;
     /* Data if the endpoint's own cell is not judged free. (A looser rule,
      * accepting points next to solid cells, lets people walking along walls
      * in: measured on the corridor scene, it tripled the vertex count.) */

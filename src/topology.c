@@ -23,6 +23,7 @@
 #define ZIP_STEP_M 0.02f    /* samples along a segment for the double-cover test */
 #define ZIP_RUN_M 0.15f     /* a doubly covered stretch longer than this goes */
 #define ZIP_SNAP_M 0.03f    /* a stretch this near a segment end reaches it */
+#define ZIP_PASSES 3        /* passes of one zip over what the last one edited */
 /* One line through a band (not in the paper): two pieces of map seen from
  * the same side, parallel within BAND_COS and within BAND_M of each other
  * along more than ZIP_RUN_M, are one wall whose points form a band (pose
@@ -278,9 +279,10 @@ static int covered(const polyc__opt *o, float x, float y, int32_t a, int32_t b, 
 }
 
 /* The side each segment is seen from, into seg_side: the sum over the
- * endpoints within SIDE_REACH_M whose nearest segment it is of their
- * directions towards their sensors, along its left normal (> 0: seen from
- * the left). Valid for the segments not edited since zip_mark. */
+ * endpoints within SIDE_REACH_M whose nearest segment it is of the vectors
+ * to their sensors along its left normal (> 0: seen from the left; as
+ * docs/evaluation.md's band15 gives a segment its side). Valid for the
+ * segments not edited since zip_mark. */
 static void find_sides(polyc__opt *o)
 {
     const polyc__store *s = o->s;
@@ -358,11 +360,15 @@ static int band_candidates(const polyc__opt *o, int32_t v, float nx, float ny, i
 }
 
 /* The first of the n candidates (band_candidates) in a band with the
- * point (x, y): within BAND_M of it with its foot on the candidate, or
- * within BAND_END_M of the candidate past its end; or NONE. */
+ * point (x, y): more than a grid cell from its line (nearer, it is the
+ * same line continued: on the sim office, 12 cm walls seen from both sides
+ * lost pieces to their own continuations at 1.5 cm, none at 2.5), and
+ * within BAND_M of it with its foot on the candidate, or within BAND_END_M
+ * of the candidate past its end; or NONE. */
 static int32_t band_other(const polyc__opt *o, float x, float y, const int32_t *cand, int n)
 {
     const polyc__store *s = o->s;
+    float lim2 = o->ctx->cfg.cell_m * o->ctx->cfg.cell_m;
     for (int k = 0; k < n; k++) {
         const polyc__vertex *c = &s->v[cand[k]], *d = &s->v[c->next];
         float dx = d->x - c->x, dy = d->y - c->y, l2 = dx * dx + dy * dy;
@@ -370,6 +376,8 @@ static int32_t band_other(const polyc__opt *o, float x, float y, const int32_t *
             continue;
         float u = ((x - c->x) * dx + (y - c->y) * dy) / l2;
         float off = ((x - c->x) * dy - (y - c->y) * dx);
+        if (off * off <= lim2 * l2)
+            continue; /* on its line */
         if ((u >= 0.0f && u <= 1.0f && off * off <= BAND_M * BAND_M * l2) ||
             polyc__seg_dist2(x, y, c->x, c->y, d->x, d->y) <= BAND_END_M * BAND_END_M)
             return cand[k];
@@ -514,14 +522,11 @@ static int drop_stretch(polyc__opt *o, int32_t v, float t0, float t1)
     return ok;
 }
 
-int polyc__op_zip(polyc__opt *o)
+/* One pass over the segments edited since `since`. */
+static int zip_pass(polyc__opt *o, uint32_t since)
 {
     polyc__store *s = o->s;
     int zipped = 0;
-    if (!(o->cfg->overlap_m > 0.0f))
-        return 0;
-    uint32_t since = o->zip_mark;
-    o->zip_mark = ++o->touch_stamp;
     if (o->seg_side)
         find_sides(o);
     for (int32_t v = 0; v < s->v_high; v++) {
@@ -563,6 +568,22 @@ int polyc__op_zip(polyc__opt *o)
             }
             zipped++;
         }
+    }
+    return zipped;
+}
+
+int polyc__op_zip(polyc__opt *o)
+{
+    if (!(o->cfg->overlap_m > 0.0f))
+        return 0;
+    /* a cut leaves the pieces it edited without a side until the sides are
+     * found again: passes over what the last one edited, a few at most */
+    int zipped = 0, n = 0;
+    for (int pass = 0; pass < ZIP_PASSES && (pass == 0 || n > 0); pass++) {
+        uint32_t since = o->zip_mark;
+        o->zip_mark = ++o->touch_stamp;
+        n = zip_pass(o, since);
+        zipped += n;
     }
     return zipped;
 }

@@ -170,11 +170,8 @@ static void set_points_seen(fixture *f, const float *xy, const float *seen_xy, i
         p->y = xy[2 * i + 1];
         p->w = 1.0f;
         if (o->pt_view) {
-            float vx = seen_xy ? seen_xy[2 * i] - p->x : 0.0f;
-            float vy = seen_xy ? seen_xy[2 * i + 1] - p->y : 0.0f;
-            float vl = sqrtf(vx * vx + vy * vy);
-            o->pt_view[2 * at] = vl > 0.0f ? vx / vl : 0.0f;
-            o->pt_view[2 * at + 1] = vl > 0.0f ? vy / vl : 0.0f;
+            o->pt_view[2 * at] = seen_xy ? seen_xy[2 * i] - p->x : 0.0f;
+            o->pt_view[2 * at + 1] = seen_xy ? seen_xy[2 * i + 1] - p->y : 0.0f;
         }
     }
     for (int32_t b = nb; b > 0; b--)
