@@ -33,7 +33,6 @@ POLYC_IO_API int polyc_io_read_log(const char *path, double max_range_m, scanlog
                                    char *error, size_t error_size);
 POLYC_IO_API uint32_t polyc_io_log_count(const scanlog *log);
 POLYC_IO_API const polyc_scan *polyc_io_log_scans(const scanlog *log);
-POLYC_IO_API uint64_t polyc_io_log_line(const scanlog *log, uint32_t index);
 POLYC_IO_API void polyc_io_log_free(scanlog *log);
 
 typedef struct polyc_io_map {
@@ -99,11 +98,6 @@ uint32_t polyc_io_log_count(const scanlog *log)
 const polyc_scan *polyc_io_log_scans(const scanlog *log)
 {
     return log ? log->scans : NULL;
-}
-
-uint64_t polyc_io_log_line(const scanlog *log, uint32_t index)
-{
-    return log && index < log->count ? log->line_of_scan[index] : 0;
 }
 
 void polyc_io_log_free(scanlog *log)

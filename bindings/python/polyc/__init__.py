@@ -33,7 +33,9 @@ import ctypes
 import math
 import numbers
 import os
+import signal
 import struct
+import threading
 from array import array
 from typing import NamedTuple, Sequence, Tuple
 
@@ -469,20 +471,58 @@ def _grid(cells, width, height, resolution, origin):
     return g, buf
 
 
+class _Interrupts:
+    """While the library runs on the main thread, SIGINT (Ctrl-C) only sets
+    a flag: Python would raise KeyboardInterrupt on entry to the next ctypes
+    callback, where nothing can catch it and ctypes prints and drops it.
+    The callback turns the flag into a stop; when the call returns, the
+    signal goes to the handler that was there before (KeyboardInterrupt for
+    Python's own)."""
+
+    def __init__(self):
+        self.pending, self.previous = False, None
+
+    def __enter__(self):
+        if threading.current_thread() is threading.main_thread():
+            try:
+                previous = signal.getsignal(signal.SIGINT)
+                if callable(previous):
+                    signal.signal(signal.SIGINT, self._handler)
+                    self.previous = previous
+            except (ValueError, OSError):
+                pass
+        return self
+
+    def _handler(self, signum, frame):
+        self.pending = True
+
+    def __exit__(self, *exc):
+        if self.previous is not None:
+            signal.signal(signal.SIGINT, self.previous)
+        return False
+
+    def deliver(self):
+        if self.pending:
+            self.pending = False
+            self.previous(signal.SIGINT, None)
+
+
 class _Progress:
     """The C callback around fn(dict of polyc_iteration): a true result
-    stops. An exception in fn (KeyboardInterrupt too: a Ctrl-C during the
-    optimiser lands in this callback, which runs even without fn) is kept,
-    stops the optimiser and is raised again by Context._run."""
+    stops. An exception in fn is kept, stops the optimiser and is raised
+    again by Context._run; so is a Ctrl-C (_Interrupts), for which the
+    callback runs even without fn."""
 
-    def __init__(self, fn, ctx):
+    def __init__(self, fn, ctx, interrupts):
         if fn is not None and not callable(fn):
             raise TypeError("progress must be callable or None, not %s" % type(fn).__name__)
-        self.fn, self.ctx, self.error, self.stopped = fn, ctx, None, False
+        self.fn, self.ctx, self.interrupts, self.error = fn, ctx, interrupts, None
         self.c = _PROGRESS(self._call)
 
     def _call(self, _user, it):
         try:
+            if self.interrupts.pending:
+                return 1
             if self.fn is None:
                 return 0
             i = it.contents
@@ -492,9 +532,8 @@ class _Progress:
                 stop = self.fn(report)
             finally:
                 self.ctx._busy = False
-            self.stopped = bool(stop)
-            return 1 if stop else 0
-        except BaseException as e:          # noqa: B036 - Ctrl-C too, raised again later
+            return 1 if stop or self.interrupts.pending else 0
+        except BaseException as e:          # KeyboardInterrupt too: raised again later
             self.error = e
             return 1
 
@@ -539,8 +578,11 @@ class Context:
         """fn(ctx, callback, None) with progress; the callback's exception
         first, then the status."""
         self._enter(what)
-        cb = _Progress(progress, self)
-        status = fn(self._ctx, cb.c, None)
+        interrupts = _Interrupts()
+        cb = _Progress(progress, self, interrupts)
+        with interrupts:
+            status = fn(self._ctx, cb.c, None)
+        interrupts.deliver()
         if cb.error is not None:
             error, cb.error = cb.error, None
             raise error
