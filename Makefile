@@ -275,4 +275,4 @@ $(BUILD)/gen_example: tests/gen_example.c $(EVAL_OBJ) $(TOOL_OBJ) $(BUILD)/libpo
 	$(CC) $(EVAL_CFLAGS) $^ -o $@ $(LDLIBS)
 
 clean:
-	rm -rf $(BUILD) build-*
+	rm -rf $(BUILD) build-* *.egg-info bindings/python/build bindings/python/*.egg-info

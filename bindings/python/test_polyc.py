@@ -393,8 +393,13 @@ class Package(unittest.TestCase):
         want = subprocess.run([sys.executable, "-c", example], capture_output=True, text=True,
                               check=True, cwd=HERE).stdout
         self.assertIn("vertices", want)
-        for source in (HERE, REPO):          # pip install ./bindings/python, and . at the root
+        for where in ("bindings/python", "."):  # pip install ./bindings/python, and . at the root
             with tempfile.TemporaryDirectory() as tmp:
+                # a clean copy of the checkout (pip builds in place)
+                clone = os.path.join(tmp, "libpolyc")
+                shutil.copytree(REPO, clone, ignore=shutil.ignore_patterns(
+                    "build", "build-*", "*.egg-info", "__pycache__", ".git", "*.o"))
+                source = os.path.join(clone, where)
                 subprocess.run([sys.executable, "-m", "venv", os.path.join(tmp, "venv")],
                                check=True, env=env)
                 python = os.path.join(tmp, "venv", "bin", "python")
