@@ -1,8 +1,9 @@
 /* polyc_io.c - the polyc tool's readers for the Python binding: a laser log
  * (tools/scanlog.c) into polyc_scan records, a map_server map YAML and its
  * PGM (tools/mapfile.c) into a polyc_occupancy_grid, read as `polyc` reads
- * them. Built into the binding's libpolyc.so with the library; the library
- * itself (src/) stays without allocation and I/O.
+ * them; and a context's hit/miss grid as the image `polyc grid` writes
+ * (tools/gridimage.c). Built into the binding's libpolyc.so with the
+ * library; the library itself (src/) stays without allocation and I/O.
  *
  * Memory: each reader mallocs a handle that owns everything it points to;
  * the matching *_free releases it. Errors: -1 with the reader's message
@@ -15,6 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "gridimage.h"
 #include "mapfile.h"
 #include "polyc.h"
 #include "scanlog.h"
@@ -29,6 +31,7 @@
 #define POLYC_IO_VERSION 1
 
 POLYC_IO_API int polyc_io_version(void);
+POLYC_IO_API size_t polyc_io_struct_size(const char *name);
 POLYC_IO_API int polyc_io_read_log(const char *path, double max_range_m, scanlog **out,
                                    char *error, size_t error_size);
 POLYC_IO_API uint32_t polyc_io_log_count(const scanlog *log);
@@ -47,10 +50,24 @@ typedef struct polyc_io_map {
 POLYC_IO_API int polyc_io_read_map(const char *path, polyc_io_map **out, char *error,
                                    size_t error_size);
 POLYC_IO_API void polyc_io_map_free(polyc_io_map *map);
+POLYC_IO_API int polyc_io_grid_image(const polyc_ctx *ctx, gridimage **out,
+                                     polyc_status *status);
+POLYC_IO_API void polyc_io_grid_image_free(gridimage *img);
 
 int polyc_io_version(void)
 {
     return POLYC_IO_VERSION;
+}
+
+/* sizeof of the structs the binding reads ("polyc_io_map", "gridimage"), 0
+ * if unknown. */
+size_t polyc_io_struct_size(const char *name)
+{
+    if (name && strcmp(name, "polyc_io_map") == 0)
+        return sizeof(polyc_io_map);
+    if (name && strcmp(name, "gridimage") == 0)
+        return sizeof(gridimage);
+    return 0;
 }
 
 static int fail(char *error, size_t error_size, const char *fmt, const char *a, const char *b)
@@ -235,4 +252,28 @@ void polyc_io_map_free(polyc_io_map *m)
     free((void *)m->grid.cells);
     free(m->image_path);
     free(m);
+}
+
+/* ---- the grid as an image ---- */
+
+/* The context's hit/miss grid (after polyc_build_grid) as map_saver's
+ * trinary image, as `polyc grid` writes it: GRIDIMAGE_OK and *out, or a
+ * GRIDIMAGE_* code (GRIDIMAGE_LIBRARY with *status, GRIDIMAGE_TOO_LARGE
+ * with the size in *out, which is then freed by polyc_io_grid_image_free
+ * too). */
+int polyc_io_grid_image(const polyc_ctx *ctx, gridimage **out, polyc_status *status)
+{
+    *out = calloc(1, sizeof **out);
+    if (!*out)
+        return GRIDIMAGE_NOMEM;
+    *status = POLYC_OK;
+    return gridimage_make(ctx, *out, status);
+}
+
+void polyc_io_grid_image_free(gridimage *img)
+{
+    if (!img)
+        return;
+    gridimage_free(img);
+    free(img);
 }

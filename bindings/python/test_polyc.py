@@ -537,6 +537,33 @@ class Files(unittest.TestCase):
                 polyc.read_log(os.path.join(tmp, "missing.log"))
             self.assertIn("No such file", str(e.exception))
 
+    def test_grid_image_is_what_polyc_grid_writes(self):
+        image = polyc.grid_image(polyc.read_log(self.LOG))
+        with tempfile.TemporaryDirectory() as tmp:
+            prefix = os.path.join(tmp, "office")
+            subprocess.run([TOOL, "grid", "-o", prefix, self.LOG], check=True,
+                           capture_output=True)
+            with open(prefix + ".pgm", "rb") as f:
+                data = f.read()
+            grid = polyc.read_map(prefix + ".yaml")
+        header = [w for w in data[:200].split(b"\n")[:4] if not w.startswith(b"#")]
+        magic, width, height, maxval = b" ".join(header).split()[:4]
+        self.assertEqual((magic, int(width), int(height), int(maxval)),
+                         (b"P5", image.width, image.height, 255))
+        self.assertEqual(image.pixels, data[-image.width * image.height:])
+        self.assertEqual(set(image.pixels), {0, 205, 254})
+        self.assertEqual(image.cell_m, grid.resolution)
+        self.assertEqual(image.cell_m, 0.025)
+        for a, b in zip(image.origin, grid.origin):
+            self.assertAlmostEqual(a, b, places=6)
+        ctx = polyc.Context((1, 10, 4096, 0))
+        ctx.add_scan((0.0, 0.0, 0.0), -1.5, 0.1, 0.02, 10.0, [1.0] * 10)
+        with self.assertRaises(polyc.PolycError) as e:     # before the grid
+            ctx.grid_image()
+        self.assertEqual(e.exception.status, polyc.ERR_STATE)
+        ctx.build_grid()
+        self.assertGreater(ctx.grid_image().width, 0)
+
     def test_map_gives_the_tools_map(self):
         with tempfile.TemporaryDirectory() as tmp:
             prefix = os.path.join(tmp, "office")

@@ -39,8 +39,9 @@ import threading
 from array import array
 from typing import NamedTuple, Sequence, Tuple
 
-__all__ = ["PolycError", "Scan", "Points", "Polyline", "Result", "Context", "Map",
-           "build_map", "build_map_from_grid", "read_log", "read_map", "default_config",
+__all__ = ["PolycError", "Scan", "Points", "Polyline", "Result", "Context", "Map", "GridImage",
+           "build_map", "build_map_from_grid", "grid_image", "read_log", "read_map",
+           "default_config",
            "version", "STATUS", "FLAG_EXACT_POINTS", "FLAG_NO_GRAZING", "FLAG_GRID_TRACE"]
 
 # polyc_status, append-only like the C enum
@@ -132,6 +133,12 @@ class _Map(ctypes.Structure):      # polyc_io_map of polyc_io.c
                 ("negate", ctypes.c_int)]
 
 
+class _GridImage(ctypes.Structure):  # gridimage of tools/gridimage.h
+    _fields_ = [("pixels", ctypes.POINTER(ctypes.c_uint8)), ("width", _u32), ("height", _u32),
+                ("cell_m", _f32), ("origin_x_m", _f64), ("origin_y_m", _f64),
+                ("counts", _u64 * 256)]
+
+
 # ---- loading ----
 
 def _library_path():
@@ -180,6 +187,7 @@ def _load():
     # library, not in a plain libpolyc.so named by POLYC_LIB
     io = {
         "polyc_io_version": (ctypes.c_int, []),
+        "polyc_io_struct_size": (sz, [ctypes.c_char_p]),
         "polyc_io_read_log": (ctypes.c_int, [ctypes.c_char_p, _f64, P(ctypes.c_void_p),
                                              ctypes.c_char_p, sz]),
         "polyc_io_log_count": (_u32, [ctypes.c_void_p]),
@@ -187,6 +195,8 @@ def _load():
         "polyc_io_log_free": (None, [ctypes.c_void_p]),
         "polyc_io_read_map": (ctypes.c_int, [ctypes.c_char_p, P(P(_Map)), ctypes.c_char_p, sz]),
         "polyc_io_map_free": (None, [P(_Map)]),
+        "polyc_io_grid_image": (ctypes.c_int, [ctx, P(P(_GridImage)), P(st)]),
+        "polyc_io_grid_image_free": (None, [P(_GridImage)]),
     }
     for name, (res, args) in signatures.items():
         fn = getattr(lib, name)
@@ -206,6 +216,10 @@ for _name, _cls in _STRUCTS.items():
         raise PolycError(ERR_CONFIG, "loading " + _library_path(),
                          "struct %s is %d bytes in the library but %d in polyc: the binding "
                          "does not match this libpolyc" % (_name, _size, ctypes.sizeof(_cls)))
+for _name, _cls in (("polyc_io_map", _Map), ("gridimage", _GridImage)) if _lib.has_io else ():
+    if _lib.polyc_io_struct_size(_name.encode()) != ctypes.sizeof(_cls):
+        raise PolycError(ERR_CONFIG, "loading " + _library_path(),
+                         "struct %s differs between the library and polyc" % _name)
 if _lib.has_io and _lib.polyc_io_version() != 1:
     raise PolycError(ERR_CONFIG, "loading " + _library_path(),
                      "its readers (polyc_io) are version %d, this binding wants 1"
@@ -365,6 +379,16 @@ class Map(NamedTuple):
     image_path: str
     occupied_thresh: float                 # the YAML's (its pixels are converted with them)
     free_thresh: float
+
+
+class GridImage(NamedTuple):
+    """A hit/miss grid as map_saver's trinary image, what `polyc grid` writes
+    (grid_image, Context.grid_image)."""
+    pixels: bytes                          # width * height, row 0 the top: 0 occupied, 254 free, 205 unknown
+    width: int
+    height: int
+    cell_m: float
+    origin: Tuple[float, float, float]     # x, y of cell (0, 0)'s lower-left corner, yaw 0
 
 
 def version():
@@ -645,6 +669,29 @@ class Context:
             out.append(Polyline(Points(array("d", map(_shortest, raw))), bool(pl.closed)))
         return out
 
+    def grid_image(self):
+        """The hit/miss grid (run build_grid first) as the image `polyc grid`
+        writes: a GridImage."""
+        self._enter("grid image")
+        _need_io("grid_image")
+        img = ctypes.POINTER(_GridImage)()
+        status = ctypes.c_int(OK)
+        made = _lib.polyc_io_grid_image(self._ctx, ctypes.byref(img), ctypes.byref(status))
+        try:
+            if made == -1:
+                self._check(status.value, "grid image")
+            if made == -2:
+                g = img.contents
+                raise PolycError(ERR_EXTENT, "grid image", "the grid is %d x %d cells: empty, or "
+                                 "more than a map may have" % (g.width, g.height))
+            if made != 0:
+                raise MemoryError("grid image")
+            g = img.contents
+            return GridImage(ctypes.string_at(g.pixels, g.width * g.height), g.width, g.height,
+                             _shortest(g.cell_m), (g.origin_x_m, g.origin_y_m, 0.0))
+        finally:
+            _lib.polyc_io_grid_image_free(img)
+
     def stats(self):
         self._enter("stats")
         s = _Stats()
@@ -689,6 +736,26 @@ def build_map(scans, memory_bytes=None, max_vertices=0, progress=None, **config)
                 continue
             raise
         return Result(ctx.polylines(), ctx.stats())
+
+
+def grid_image(scans, **config):
+    """The scans' hit/miss grid as map_saver's image, as `polyc grid` makes
+    it (limits from the scans, build_grid): a GridImage."""
+    cfg = _config(config)
+    held = [_scan(s) for s in scans]
+    _int_field("number of scans", len(held), _u32)
+    arr = (_Scan * max(len(held), 1))(*[s for s, _ in held])
+    lim = _Limits()
+    status = _lib.polyc_limits_for_scans(ctypes.byref(cfg), arr, len(held), ctypes.byref(lim))
+    if status != OK:
+        raise PolycError(status, "limits for scans",
+                         "the data span more than max_extent_m" if status == ERR_EXTENT else "")
+    ctx = Context((lim.max_scans, lim.max_beams, lim.max_grid_cells, lim.max_vertices,
+                   lim.max_points), **config)
+    for i, (s, _) in enumerate(held):
+        ctx._check(_lib.polyc_add_scan(ctx._ctx, ctypes.byref(s)), "add scan %d" % i)
+    ctx.build_grid()
+    return ctx.grid_image()
 
 
 def build_map_from_grid(cells, width, height, resolution, origin=(0.0, 0.0, 0.0),
