@@ -35,6 +35,7 @@ import numbers
 import os
 import signal
 import struct
+import sys
 import threading
 from array import array
 from typing import NamedTuple, Sequence, Tuple
@@ -351,8 +352,8 @@ class Points:
     def __array_interface__(self):
         n = len(self)
         addr = self._xy.buffer_info()[0]
-        return {"version": 3, "shape": (n, 2), "typestr": "<f8" if struct.pack("=H", 1)[0]
-                else ">f8", "data": (addr, True)}
+        return {"version": 3, "shape": (n, 2), "data": (addr, True),
+                "typestr": "<f8" if sys.byteorder == "little" else ">f8"}
 
     def __buffer__(self, flags):           # memoryview(points), Python 3.12+
         return self.view
