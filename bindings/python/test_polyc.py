@@ -483,6 +483,12 @@ class Results(unittest.TestCase):
             self.assertEqual(got.polylines, want.polylines)
         with self.assertRaises(TypeError):
             polyc.build_map([scans[0]._replace(ranges_m=array("i", [1, 2, 3]))])
+        if numpy is not None:          # not native byte order, or 2-D: refused, not misread
+            swapped = ">f4" if sys.byteorder == "little" else "<f4"
+            for bad in (numpy.array(scans[0].ranges_m, dtype=swapped),
+                        numpy.zeros((2, 2), dtype=numpy.float32)):
+                with self.assertRaises(TypeError):
+                    polyc.build_map([scans[0]._replace(ranges_m=bad)])
 
     def test_clockwise_scans(self):
         # the same beams listed clockwise (negative step) give the same map

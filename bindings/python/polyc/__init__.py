@@ -431,22 +431,26 @@ def _limits(limits):
 
 
 def _floats(values, what):
-    """A ctypes float array of values: any buffer of float32 / float64 (one
-    copy, no Python float per value for float32) or a sequence of numbers."""
+    """A ctypes float array of values: any buffer of native float32 / float64
+    (one copy, no Python float per value for float32; any strides) or a
+    sequence of numbers."""
     try:
         view = memoryview(values)
     except TypeError:
         view = None
     if view is not None:
-        fmt = view.format.lstrip("@=<>!")
-        if view.ndim > 1 or not view.c_contiguous:
-            view = memoryview(view.tobytes()).cast("B").cast(view.format)
-        if fmt == "f" and view.itemsize == 4:
-            return (_f32 * len(view)).from_buffer_copy(view)
-        if fmt == "d" and view.itemsize == 8:
-            return (_f32 * len(view)).from_buffer_copy(array("f", view).tobytes())
-        raise TypeError("%s: a buffer of float32 or float64 (format 'f' or 'd'), not format %r"
-                        % (what, view.format))
+        native = "<" if sys.byteorder == "little" else ">"
+        order, fmt = (view.format[0], view.format[1:]) if view.format[:1] in "@=<>!" \
+            else ("@", view.format)
+        if fmt not in ("f", "d") or order not in ("@", "=", native) or view.ndim > 1:
+            raise TypeError("%s: a 1-D buffer of float32 or float64 (format 'f' or 'd'), not "
+                            "format %r with %d dimensions" % (what, view.format, view.ndim))
+        data = view.tobytes()              # C order whatever the strides
+        if fmt == "f":
+            return (_f32 * len(view)).from_buffer_copy(data)
+        wide = array("d")
+        wide.frombytes(data)
+        return (_f32 * len(view)).from_buffer_copy(array("f", wide).tobytes())
     try:
         return (_f32 * len(values))(*values)
     except TypeError:
