@@ -845,7 +845,3 @@ def read_map(path):
     finally:
         _lib.polyc_io_map_free(handle)
 
-
-if __name__ == "__main__":
-    print("libpolyc %d.%d.%d from %s" % (version() + (_library_path(),)))
-    print("defaults:", default_config())
