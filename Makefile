@@ -103,9 +103,32 @@ $(BUILD)/tests/cxx_header: tests/cxx_header.cpp include/polyc.h $(BUILD)/libpoly
 	$(CXX) -std=c++11 -Wall -Wextra -Werror -pedantic -Iinclude $< $(BUILD)/libpolyc.a -o $@ $(LDLIBS)
 test-install: all
 	tests/install_test.sh "$(MAKE)" "$(BUILD)"
-test-python: all
-	POLYC_LIB=$(abspath $(BUILD)/libpolyc.so) POLYC_TOOL=$(abspath $(BUILD)/polyc) \
-	    python3 -m unittest discover -v -s bindings/python -p 'test_*.py'
+# The Python package's library: libpolyc with the tool's readers
+# (scanlog, mapfile, gridimage) and the binding's glue (polyc_io.c), as
+# `pip install ./bindings/python` builds it (bindings/python/setup.py).
+PY_MOD = tools/scanlog.c tools/mapfile.c tools/gridimage.c bindings/python/polyc_io.c
+PY_OBJ = $(PY_MOD:%.c=$(BUILD)/pyobj/%.o)
+$(BUILD)/pyobj/%.o: %.c include/polyc.h $(wildcard tools/*.h)
+	@mkdir -p $(dir $@)
+	$(CC) $(TOOL_CFLAGS) -fPIC -fvisibility=hidden -c $< -o $@
+$(BUILD)/py/libpolyc.so: $(LIB_OBJ) $(PY_OBJ)
+	@mkdir -p $(dir $@)
+	$(CC) -shared $(LDFLAGS) $^ -o $@ $(LDLIBS)
+# The tests run in a venv of their own ($(BUILD)/pyvenv) with numpy if pip
+# can install it (its tests skip otherwise) and the build backend's wheels
+# (setuptools, wheel) in $(BUILD)/pywheels for the test that pip-installs
+# the package into a fresh venv without going online.
+PYVENV = $(BUILD)/pyvenv
+$(PYVENV)/ready:
+	rm -rf $(PYVENV) && python3 -m venv $(PYVENV)
+	$(PYVENV)/bin/python -m pip install -q numpy || echo "test-python: numpy could not be installed: the numpy tests skip"
+	$(PYVENV)/bin/python -m pip download -q -d $(BUILD)/pywheels setuptools wheel || \
+	    echo "test-python: no setuptools wheel: the pip install test goes online or skips"
+	touch $@
+test-python: all $(BUILD)/py/libpolyc.so $(PYVENV)/ready
+	POLYC_LIB=$(abspath $(BUILD)/py/libpolyc.so) POLYC_TOOL=$(abspath $(BUILD)/polyc) \
+	    POLYC_WHEELS=$(abspath $(BUILD)/pywheels) \
+	    $(PYVENV)/bin/python -m unittest discover -v -s bindings/python -p 'test_*.py'
 # the library as for the target (8-bit grid counters), tests/embedded_test.sh checks the map
 EMB_OBJ = $(LIB_SRC:src/%.c=$(BUILD)/emb/%.o)
 $(BUILD)/emb/%.o: src/%.c include/polyc.h $(wildcard src/*.h)
@@ -255,4 +278,4 @@ $(BUILD)/gen_example: tests/gen_example.c $(EVAL_OBJ) $(TOOL_OBJ) $(BUILD)/libpo
 	$(CC) $(EVAL_CFLAGS) $^ -o $@ $(LDLIBS)
 
 clean:
-	rm -rf $(BUILD) build-*
+	rm -rf $(BUILD) build-* *.egg-info bindings/python/build bindings/python/*.egg-info

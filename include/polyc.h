@@ -49,7 +49,8 @@ typedef enum polyc_status {
     POLYC_ERR_EXTENT = 6,    /* the data span more than config.max_extent_m */
     POLYC_ERR_LIMIT = 7,     /* more scans or beams than the limits allow */
     POLYC_ERR_RANGE = 8,     /* an index argument is out of range */
-    POLYC_ERR_STOPPED = 9    /* the progress callback asked to stop (result kept) */
+    POLYC_ERR_STOPPED = 9,   /* the progress callback asked to stop (result kept) */
+    POLYC_ERR_BUSY = 10      /* called on a context from inside its progress callback */
 } polyc_status;
 
 /* Flags of polyc_config.flags. */
@@ -193,7 +194,9 @@ typedef struct polyc_iteration {
 
 /* Called after each optimiser iteration; return non-zero to stop (the best
  * map so far is kept and polyc_optimize returns POLYC_ERR_STOPPED). This is
- * how a caller imposes a deadline: the library has no clock. */
+ * how a caller imposes a deadline: the library has no clock. While it runs,
+ * every call on the same context returns POLYC_ERR_BUSY and changes nothing
+ * (polyc_polyline_count returns 0); other contexts may be used. */
 typedef int (*polyc_progress_fn)(void *user, const polyc_iteration *it);
 
 typedef struct polyc_ctx polyc_ctx;
@@ -244,9 +247,11 @@ POLYC_API polyc_status polyc_init(void *block, size_t size, const polyc_config *
 /* Forget scans and results; keep config, limits and block. */
 POLYC_API polyc_status polyc_reset(polyc_ctx *ctx);
 
-/* Copies one scan in. POLYC_ERR_SCAN for bad geometry (NaN pose, zero or
- * negative step with beams, beam_count 0 is allowed and adds nothing);
- * NaN/inf ranges are counted in stats.beams_skipped. */
+/* Copies one scan in. POLYC_ERR_SCAN for bad geometry (NaN pose, angles
+ * not finite, |angle_step_rad| > 6.2832 or |start_angle_rad| > 100, a zero
+ * step with more than one beam, an empty range interval). A negative step is
+ * a clockwise scan and is taken as it is. beam_count 0 is allowed and adds
+ * nothing; NaN/inf ranges are counted in stats.beams_skipped. */
 POLYC_API polyc_status polyc_add_scan(polyc_ctx *ctx, const polyc_scan *scan);
 
 /* Takes the grid's occupied and free cells as the map's evidence; then

@@ -24,6 +24,7 @@ const char *polyc_status_str(polyc_status st)
     case POLYC_ERR_LIMIT: return "more scans or beams than the limits allow";
     case POLYC_ERR_RANGE: return "index out of range";
     case POLYC_ERR_STOPPED: return "stopped by the progress callback";
+    case POLYC_ERR_BUSY: return "called from inside the progress callback";
     }
     return "unknown status";
 }
@@ -235,9 +236,18 @@ polyc_status polyc__fail(polyc_ctx *ctx, polyc_status st, const char *msg)
     return st;
 }
 
+/* While the progress callback runs, the context is lent to the optimiser:
+ * its magic reads POLYC__MAGIC_BUSY and every entry point refuses it with
+ * POLYC_ERR_BUSY (guarded_progress). */
+#define POLYC__MAGIC_BUSY 0x62757379u /* "busy" */
+
 static polyc_status check_ctx(const polyc_ctx *ctx)
 {
-    return ctx && ctx->magic == POLYC__MAGIC ? POLYC_OK : POLYC_ERR_NULL;
+    if (!ctx)
+        return POLYC_ERR_NULL;
+    if (ctx->magic == POLYC__MAGIC_BUSY)
+        return POLYC_ERR_BUSY;
+    return ctx->magic == POLYC__MAGIC ? POLYC_OK : POLYC_ERR_NULL;
 }
 
 polyc_status polyc_init(void *block, size_t size, const polyc_config *config,
@@ -279,8 +289,9 @@ polyc_status polyc_init(void *block, size_t size, const polyc_config *config,
 
 polyc_status polyc_reset(polyc_ctx *ctx)
 {
-    if (check_ctx(ctx) != POLYC_OK)
-        return POLYC_ERR_NULL;
+    polyc_status cst = check_ctx(ctx);
+    if (cst != POLYC_OK)
+        return cst;
     ctx->arena.used = ctx->scans_mark = ctx->base_mark;
     ctx->scan_count = ctx->range_count = 0;
     ctx->have_frame = ctx->have_extent = 0;
@@ -302,8 +313,9 @@ polyc_status polyc_reset(polyc_ctx *ctx)
 
 polyc_status polyc_add_scan(polyc_ctx *ctx, const polyc_scan *s)
 {
-    if (check_ctx(ctx) != POLYC_OK || !s)
-        return POLYC_ERR_NULL;
+    polyc_status cst = check_ctx(ctx);
+    if (cst != POLYC_OK || !s)
+        return cst != POLYC_OK ? cst : POLYC_ERR_NULL;
     ctx->error = NULL;
     if (ctx->from_grid)
         return polyc__fail(ctx, POLYC_ERR_STATE,
@@ -368,8 +380,9 @@ polyc_status polyc_add_scan(polyc_ctx *ctx, const polyc_scan *s)
 
 polyc_status polyc_add_grid(polyc_ctx *ctx, const polyc_occupancy_grid *grid)
 {
-    if (check_ctx(ctx) != POLYC_OK || !grid)
-        return POLYC_ERR_NULL;
+    polyc_status cst = check_ctx(ctx);
+    if (cst != POLYC_OK || !grid)
+        return cst != POLYC_OK ? cst : POLYC_ERR_NULL;
     ctx->error = NULL;
     return polyc__occ_add(ctx, grid);
 }
@@ -486,8 +499,9 @@ static polyc_status need_stage(polyc_ctx *ctx, polyc__stage want)
 
 polyc_status polyc_build_grid(polyc_ctx *ctx)
 {
-    if (check_ctx(ctx) != POLYC_OK)
-        return POLYC_ERR_NULL;
+    polyc_status cst = check_ctx(ctx);
+    if (cst != POLYC_OK)
+        return cst;
     ctx->error = NULL;
     /* explicit call: rebuild (an occupancy grid's is its input: the results
      * after it are dropped) */
@@ -497,8 +511,9 @@ polyc_status polyc_build_grid(polyc_ctx *ctx)
 
 polyc_status polyc_extract_contour(polyc_ctx *ctx)
 {
-    if (check_ctx(ctx) != POLYC_OK)
-        return POLYC_ERR_NULL;
+    polyc_status cst = check_ctx(ctx);
+    if (cst != POLYC_OK)
+        return cst;
     ctx->error = NULL;
     if (ctx->stage >= POLYC__STAGE_CONTOUR)
         ctx->stage = ctx->from_grid ? POLYC__STAGE_CONTOUR : POLYC__STAGE_GRID;
@@ -507,24 +522,45 @@ polyc_status polyc_extract_contour(polyc_ctx *ctx)
 
 polyc_status polyc_trace(polyc_ctx *ctx)
 {
-    if (check_ctx(ctx) != POLYC_OK)
-        return POLYC_ERR_NULL;
+    polyc_status cst = check_ctx(ctx);
+    if (cst != POLYC_OK)
+        return cst;
     ctx->error = NULL;
     if (ctx->stage >= POLYC__STAGE_TRACE)
         ctx->stage = POLYC__STAGE_CONTOUR;
     return need_stage(ctx, POLYC__STAGE_TRACE);
 }
 
+/* The caller's callback, with the context marked busy while it runs: a
+ * call back into the library on it is refused (POLYC_ERR_BUSY) instead of
+ * changing the model under the optimiser. */
+typedef struct guarded {
+    polyc_ctx *ctx;
+    polyc_progress_fn progress;
+    void *user;
+} guarded;
+
+static int guarded_progress(void *user, const polyc_iteration *it)
+{
+    guarded *g = (guarded *)user;
+    g->ctx->magic = POLYC__MAGIC_BUSY;
+    int stop = g->progress(g->user, it);
+    g->ctx->magic = POLYC__MAGIC;
+    return stop;
+}
+
 polyc_status polyc_optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *user)
 {
-    if (check_ctx(ctx) != POLYC_OK)
-        return POLYC_ERR_NULL;
+    polyc_status cst = check_ctx(ctx);
+    if (cst != POLYC_OK)
+        return cst;
     ctx->error = NULL;
     polyc_status st = need_stage(ctx, POLYC__STAGE_TRACE);
     if (st != POLYC_OK)
         return st;
     ctx->arena.used = ctx->trace_mark;
-    st = polyc__optimize(ctx, progress, user);
+    guarded g = {ctx, progress, user};
+    st = polyc__optimize(ctx, progress ? guarded_progress : NULL, &g);
     note_memory(ctx);
     ctx->arena.used = ctx->trace_mark;
     if (ctx->opt_result_valid) {
@@ -538,8 +574,9 @@ polyc_status polyc_optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *us
 
 polyc_status polyc_build(polyc_ctx *ctx, polyc_progress_fn progress, void *user)
 {
-    if (check_ctx(ctx) != POLYC_OK)
-        return POLYC_ERR_NULL;
+    polyc_status cst = check_ctx(ctx);
+    if (cst != POLYC_OK)
+        return cst;
     ctx->error = NULL;
     polyc_status st = need_stage(ctx, POLYC__STAGE_TRACE);
     if (st != POLYC_OK || ctx->cfg.max_iterations == 0)
@@ -549,8 +586,9 @@ polyc_status polyc_build(polyc_ctx *ctx, polyc_progress_fn progress, void *user)
 
 polyc_status polyc_score(polyc_ctx *ctx, double *bic, double *err)
 {
-    if (check_ctx(ctx) != POLYC_OK)
-        return POLYC_ERR_NULL;
+    polyc_status cst = check_ctx(ctx);
+    if (cst != POLYC_OK)
+        return cst;
     ctx->error = NULL;
     if (ctx->stage < POLYC__STAGE_TRACE)
         return polyc__fail(ctx, POLYC_ERR_STATE, "no polylines yet: run polyc_trace first");
@@ -572,8 +610,9 @@ uint32_t polyc_polyline_count(const polyc_ctx *ctx)
 
 polyc_status polyc_get_polyline(const polyc_ctx *ctx, uint32_t index, polyc_polyline *out)
 {
-    if (check_ctx(ctx) != POLYC_OK || !out)
-        return POLYC_ERR_NULL;
+    polyc_status cst = check_ctx(ctx);
+    if (cst != POLYC_OK || !out)
+        return cst != POLYC_OK ? cst : POLYC_ERR_NULL;
     if (ctx->stage < POLYC__STAGE_TRACE)
         return POLYC_ERR_STATE;
     if (index >= ctx->flat.count)
@@ -606,8 +645,9 @@ polyc_status polyc_copy_polyline(const polyc_ctx *ctx, uint32_t index, float *xy
 
 polyc_status polyc_get_stats(const polyc_ctx *ctx, polyc_stats *out)
 {
-    if (check_ctx(ctx) != POLYC_OK || !out)
-        return POLYC_ERR_NULL;
+    polyc_status cst = check_ctx(ctx);
+    if (cst != POLYC_OK || !out)
+        return cst != POLYC_OK ? cst : POLYC_ERR_NULL;
     *out = ctx->stats;
     return POLYC_OK;
 }
@@ -615,8 +655,9 @@ polyc_status polyc_get_stats(const polyc_ctx *ctx, polyc_stats *out)
 polyc_status polyc_grid_info(const polyc_ctx *ctx, double *origin_x_m, double *origin_y_m,
                              float *cell_m, uint32_t *width, uint32_t *height)
 {
-    if (check_ctx(ctx) != POLYC_OK)
-        return POLYC_ERR_NULL;
+    polyc_status cst = check_ctx(ctx);
+    if (cst != POLYC_OK)
+        return cst;
     if (ctx->stage < POLYC__STAGE_GRID)
         return POLYC_ERR_STATE;
     if (origin_x_m) *origin_x_m = ctx->grid.origin_x_m;
@@ -630,8 +671,9 @@ polyc_status polyc_grid_info(const polyc_ctx *ctx, double *origin_x_m, double *o
 polyc_status polyc_grid_cell(const polyc_ctx *ctx, uint32_t ix, uint32_t iy, uint32_t *hits,
                              uint32_t *misses, uint32_t *contour)
 {
-    if (check_ctx(ctx) != POLYC_OK)
-        return POLYC_ERR_NULL;
+    polyc_status cst = check_ctx(ctx);
+    if (cst != POLYC_OK)
+        return cst;
     if (ctx->stage < POLYC__STAGE_GRID)
         return POLYC_ERR_STATE;
     if (ix >= (uint32_t)ctx->grid.width || iy >= (uint32_t)ctx->grid.height)
@@ -647,7 +689,10 @@ polyc_status polyc_grid_cell(const polyc_ctx *ctx, uint32_t ix, uint32_t iy, uin
 
 const char *polyc_last_error(const polyc_ctx *ctx)
 {
-    if (check_ctx(ctx) != POLYC_OK)
+    polyc_status cst = check_ctx(ctx);
+    if (cst == POLYC_ERR_BUSY)
+        return "called from inside the progress callback";
+    if (cst != POLYC_OK)
         return "invalid context";
     return ctx->error ? ctx->error : "";
 }

@@ -626,6 +626,101 @@ static void test_caps_and_stop(void **state)
     fixture_close(&f);
 }
 
+/* A callback that calls back into the library on its own context: each
+ * call is refused with POLYC_ERR_BUSY and changes nothing. */
+typedef struct reentry {
+    polyc_ctx *ctx;
+    const polyc_scan *scan;
+    uint32_t calls;
+    int refused;                   /* every call refused as it should be */
+} reentry;
+
+static int reentry_cb(void *user, const polyc_iteration *it)
+{
+    reentry *r = user;
+    polyc_ctx *ctx = r->ctx;
+    polyc_stats st;
+    polyc_polyline pl;
+    double bic = 0;
+    uint32_t u = 0;
+    (void)it;
+    r->calls++;
+    r->refused = polyc_trace(ctx) == POLYC_ERR_BUSY && polyc_build_grid(ctx) == POLYC_ERR_BUSY &&
+                 polyc_extract_contour(ctx) == POLYC_ERR_BUSY &&
+                 polyc_optimize(ctx, NULL, NULL) == POLYC_ERR_BUSY &&
+                 polyc_build(ctx, NULL, NULL) == POLYC_ERR_BUSY &&
+                 polyc_add_scan(ctx, r->scan) == POLYC_ERR_BUSY &&
+                 polyc_reset(ctx) == POLYC_ERR_BUSY &&
+                 polyc_score(ctx, &bic, NULL) == POLYC_ERR_BUSY &&
+                 polyc_get_stats(ctx, &st) == POLYC_ERR_BUSY &&
+                 polyc_get_polyline(ctx, 0, &pl) == POLYC_ERR_BUSY &&
+                 polyc_copy_polyline(ctx, 0, NULL, 0, &u, NULL) == POLYC_ERR_BUSY &&
+                 polyc_grid_info(ctx, NULL, NULL, NULL, NULL, NULL) == POLYC_ERR_BUSY &&
+                 polyc_grid_cell(ctx, 0, 0, &u, &u, &u) == POLYC_ERR_BUSY &&
+                 polyc_polyline_count(ctx) == 0 &&
+                 strcmp(polyc_last_error(ctx), "called from inside the progress callback") == 0;
+    return r->calls >= 2;
+}
+
+static void test_callback_reentry(void **state)
+{
+    (void)state;
+    fixture f;
+    fixture_open(&f, NULL, 1, 512);
+    polyc_ctx *ctx = f.ctx;
+    for (uint32_t i = 0; i < f.scene.scan_count; i++)
+        assert_int_equal(polyc_add_scan(ctx, &f.scene.scans[i]), POLYC_OK);
+    reentry r = {ctx, &f.scene.scans[0], 0, 0};
+    assert_int_equal(polyc_build(ctx, reentry_cb, &r), POLYC_ERR_STOPPED);
+    assert_int_equal(r.calls, 2);
+    assert_true(r.refused);
+    assert_string_equal(polyc_status_str(POLYC_ERR_BUSY), "called from inside the progress callback");
+    /* after the callback the context is usable again, the scans unchanged */
+    polyc_stats st;
+    assert_int_equal(polyc_get_stats(ctx, &st), POLYC_OK);
+    assert_int_equal(st.scans, f.scene.scan_count);
+    assert_int_equal(st.iterations, 2);
+    assert_int_equal(map_is_valid(ctx, 11.5, -2.0, 4.0), 0);
+    assert_int_equal(polyc_optimize(ctx, NULL, NULL), POLYC_OK);
+    assert_int_equal(map_is_valid(ctx, 11.5, -2.0, 4.0), 0);
+    fixture_close(&f);
+}
+
+/* A negative angle step is a clockwise scan: the same beams listed the
+ * other way round give the same grid and the same data. */
+static void test_clockwise_scans(void **state)
+{
+    (void)state;
+    fixture a, b;
+    fixture_open(&a, NULL, 0, 0);
+    fixture_open(&b, NULL, 0, 0);
+    for (uint32_t i = 0; i < a.scene.scan_count; i++) {
+        polyc_scan s = a.scene.scans[i];
+        float *rev = malloc(s.beam_count * sizeof *rev);
+        assert_non_null(rev);
+        for (uint32_t j = 0; j < s.beam_count; j++)
+            rev[j] = s.range_m[s.beam_count - 1 - j];
+        assert_int_equal(polyc_add_scan(a.ctx, &s), POLYC_OK);
+        s.start_angle_rad = s.start_angle_rad + (float)(s.beam_count - 1) * s.angle_step_rad;
+        s.angle_step_rad = -s.angle_step_rad;
+        s.range_m = rev;
+        assert_int_equal(polyc_add_scan(b.ctx, &s), POLYC_OK);
+        free(rev);
+    }
+    assert_int_equal(polyc_build(a.ctx, NULL, NULL), POLYC_OK);
+    assert_int_equal(polyc_build(b.ctx, NULL, NULL), POLYC_OK);
+    polyc_stats sa, sb;
+    assert_int_equal(polyc_get_stats(a.ctx, &sa), POLYC_OK);
+    assert_int_equal(polyc_get_stats(b.ctx, &sb), POLYC_OK);
+    assert_int_equal(sa.hits, sb.hits);
+    assert_int_equal(sa.data_points, sb.data_points);
+    assert_int_equal(sa.contour_cells, sb.contour_cells);
+    assert_int_equal(map_is_valid(b.ctx, 11.5, -2.0, 4.0), 0);
+    assert_int_equal(sa.polylines, sb.polylines);
+    fixture_close(&a);
+    fixture_close(&b);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -636,6 +731,8 @@ int main(void)
         cmocka_unit_test(test_degenerate_geometry),
         cmocka_unit_test(test_order_and_results),
         cmocka_unit_test(test_caps_and_stop),
+        cmocka_unit_test(test_callback_reentry),
+        cmocka_unit_test(test_clockwise_scans),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -4,24 +4,46 @@ A synthetic room mapped through Python must give the polylines the `polyc`
 tool gives for the same scans written in its plain format (to the tool's 4
 decimals); too small a block, bad configuration and bad scans raise
 PolycError with the library's message; the ctypes structs match the library.
-Environment: POLYC_LIB (libpolyc.so) and POLYC_TOOL (the polyc binary),
-defaulting to the repository's build/.
+The package loads only its own library or $POLYC_LIB; `pip install` of
+bindings/python (and of the repository root) into a fresh venv gives a
+package that runs the README's example from another folder; logs and maps
+read through the tool's readers give the tool's maps; points are N x 2
+float64 buffers of shortest float32 decimals; exceptions in the progress
+callback (KeyboardInterrupt too) reach the caller; integers out of range are
+refused; a scan too large for the sized limits is retried as the tool does.
+Environment: POLYC_LIB (the package's libpolyc.so, `make build/py/libpolyc.so`),
+POLYC_TOOL (the polyc binary), defaulting to the repository's build/;
+POLYC_WHEELS, a folder with setuptools and wheel wheels for an offline pip
+install (else pip goes online). numpy is optional: its tests skip without it.
 """
 import ctypes
 import json
 import math
 import os
 import random
+import re
+import shutil
+import signal
 import struct
 import subprocess
+import sys
 import tempfile
+import threading
+import time
 import unittest
 from array import array
 
-import polyc
+HERE = os.path.dirname(os.path.abspath(__file__))
+REPO = os.path.dirname(os.path.dirname(HERE))
+os.environ.setdefault("POLYC_LIB", os.path.join(REPO, "build", "py", "libpolyc.so"))
+import polyc  # noqa: E402
 
-REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 TOOL = os.environ.get("POLYC_TOOL", os.path.join(REPO, "build", "polyc"))
+try:
+    import numpy
+except ImportError:
+    numpy = None
+NO_NUMPY = "numpy is not installed (make test-python installs it in build/pyvenv if pip can)"
 
 # A 6 m x 4 m room with a cabinet and a pillar: wall segments (x0, y0, x1, y1).
 WALLS = [(0, 0, 6, 0), (6, 0, 6, 4), (6, 4, 0, 4), (0, 4, 0, 0),
@@ -105,7 +127,8 @@ class Binding(unittest.TestCase):
         self.assertEqual(len(result.polylines), len(tool["polylines"]))
         for mine, theirs in zip(result.polylines, tool["polylines"]):
             self.assertEqual(mine.closed, theirs["closed"])
-            self.assertEqual([(float("%.4f" % x), float("%.4f" % y)) for x, y in mine.points],
+            self.assertEqual([(float("%.4f" % f32(x)), float("%.4f" % f32(y)))
+                              for x, y in mine.points],
                              [tuple(p) for p in theirs["points"]])
         for key in ("scans", "beams", "hits", "data_points", "polylines", "vertices",
                     "iterations", "memory_size_bytes"):
@@ -303,6 +326,417 @@ class Grid(unittest.TestCase):
         low = polyc.build_map_from_grid(cells, 10, 10, 0.1, occupied_thresh=0.5)
         self.assertEqual(low.stats["data_points"], 6)
         self.assertEqual(len(low.polylines), 1)
+
+
+def tool_json(*args):
+    """The polyc tool's JSON map of args."""
+    out = subprocess.run([TOOL, "--format", "json"] + list(args), capture_output=True,
+                         text=True, check=True).stdout
+    return json.loads(out)
+
+
+def same_as_tool(test, result, tool):
+    """The tool's polylines (4 decimals) and counts."""
+    test.assertGreater(len(result.polylines), 0)
+    test.assertEqual(len(result.polylines), len(tool["polylines"]))
+    for mine, theirs in zip(result.polylines, tool["polylines"]):
+        test.assertEqual(mine.closed, theirs["closed"])
+        # the tool prints the float32 to 4 decimals (a shortest decimal such as
+        # 11.32895 may round the other way)
+        test.assertEqual([(float("%.4f" % f32(x)), float("%.4f" % f32(y)))
+                          for x, y in mine.points],
+                         [tuple(p) for p in theirs["points"]])
+    for key in ("polylines", "vertices", "data_points", "iterations"):
+        test.assertEqual(result.stats[key], tool["stats"][key], key)
+
+
+def big_scan(beams, seed=1):
+    """One scan of the room all round from the first pose."""
+    rng = random.Random(seed)
+    start, step = f32(-math.pi), f32(2 * math.pi / beams)
+    x, y, th = POSES[0]
+    ranges = [f32(cast(x, y, th + start + i * step, 30.0) + rng.gauss(0, 0.01))
+              for i in range(beams)]
+    return polyc.Scan((x, y, th), start, step, f32(0.02), f32(30.0), ranges)
+
+
+class Package(unittest.TestCase):
+    """What is loaded, and pip install."""
+
+    def test_loads_only_its_own_library(self):
+        # a copy of the package two folders below a build/libpolyc.so (where
+        # the old binding looked) does not load it; next to it, it does
+        with tempfile.TemporaryDirectory() as tmp:
+            pkg = os.path.join(tmp, "bindings", "python", "polyc")
+            os.makedirs(pkg)
+            os.makedirs(os.path.join(tmp, "build"))
+            shutil.copy(polyc.__file__, pkg)
+            shutil.copy(os.environ["POLYC_LIB"], os.path.join(tmp, "build", "libpolyc.so"))
+            env = {k: v for k, v in os.environ.items() if k != "POLYC_LIB"}
+            run = [sys.executable, "-c", "import polyc; print(polyc._library_path())"]
+            got = subprocess.run(run, cwd=os.path.dirname(pkg), env=env, capture_output=True,
+                                 text=True)
+            self.assertNotEqual(got.returncode, 0)
+            self.assertIn("POLYC_LIB is not set", got.stderr)
+            shutil.copy(os.environ["POLYC_LIB"], pkg)
+            got = subprocess.run(run, cwd=os.path.dirname(pkg), env=env, capture_output=True,
+                                 text=True, check=True)
+            self.assertEqual(got.stdout.strip(), os.path.join(pkg, "libpolyc.so"))
+
+    def test_pip_install_and_the_readme_example(self):
+        text = open(os.path.join(HERE, "README.md")).read()
+        example = re.search(r"```python\n(.*?)```", text, re.S).group(1)
+        wheels = os.environ.get("POLYC_WHEELS", "")
+        offline = ["--no-index", "--find-links", wheels] if wheels and os.listdir(wheels) else []
+        env = {k: v for k, v in os.environ.items() if k not in ("POLYC_LIB", "PYTHONPATH")}
+        # the example with the library under test, for comparison
+        want = subprocess.run([sys.executable, "-c", example], capture_output=True, text=True,
+                              check=True, cwd=HERE).stdout
+        self.assertIn("vertices", want)
+        for where in ("bindings/python", "."):  # pip install ./bindings/python, and . at the root
+            with tempfile.TemporaryDirectory() as tmp:
+                # a clean copy of the checkout (pip builds in place)
+                clone = os.path.join(tmp, "libpolyc")
+                shutil.copytree(REPO, clone, ignore=shutil.ignore_patterns(
+                    "build", "build-*", "*.egg-info", "__pycache__", ".git", "*.o"))
+                source = os.path.join(clone, where)
+                subprocess.run([sys.executable, "-m", "venv", os.path.join(tmp, "venv")],
+                               check=True, env=env)
+                python = os.path.join(tmp, "venv", "bin", "python")
+                pip = subprocess.run([python, "-m", "pip", "install", "-q"] + offline + [source],
+                                     capture_output=True, text=True, env=env, cwd=tmp)
+                if pip.returncode != 0 and not offline and re.search(
+                        r"connection|resolve|No matching distribution|network", pip.stderr, re.I):
+                    self.skipTest("pip could not reach an index for setuptools: %s"
+                                  % pip.stderr.strip()[-300:])
+                self.assertEqual(pip.returncode, 0, pip.stderr)
+                folder = os.path.join(tmp, "elsewhere")
+                os.makedirs(folder)
+                with open(os.path.join(folder, "example.py"), "w") as f:
+                    f.write(example)
+                got = subprocess.run([python, "example.py"], capture_output=True, text=True,
+                                     env=env, cwd=folder)
+                self.assertEqual(got.returncode, 0, got.stderr)
+                self.assertEqual(got.stdout, want)
+                where = subprocess.run([python, "-c", "import polyc; print(polyc._library_path())"],
+                                       capture_output=True, text=True, env=env, cwd=folder,
+                                       check=True).stdout.strip()
+                self.assertTrue(where.startswith(os.path.join(tmp, "venv")), where)
+                self.assertTrue(where.endswith(os.path.join("polyc", "libpolyc.so")), where)
+
+
+class Results(unittest.TestCase):
+    def test_shortest_float32_decimals(self):
+        self.assertEqual(polyc._shortest(f32(2.0)), 2.0)
+        self.assertEqual(polyc._shortest(f32(0.1)), 0.1)
+        self.assertEqual(polyc._shortest(1.999999761581421), 1.9999998)
+        self.assertEqual(polyc._shortest(f32(-1234.5678)), -1234.5677)
+        rng = random.Random(3)
+        for _ in range(2000):
+            v = f32(rng.uniform(-100, 100) * 10 ** rng.randint(-6, 6))
+            short = polyc._shortest(v)
+            self.assertEqual(f32(short), v)
+            digits = len(("%.9e" % short).split("e")[0].replace("-", "").replace(".", "")
+                         .rstrip("0"))
+            if digits > 1:             # no shorter decimal rounds to the same float32
+                self.assertNotEqual(f32(float("%.*g" % (digits - 1, v))), v, (v, short))
+
+    def test_points_are_an_n_by_2_float64_buffer(self):
+        result = polyc.build_map(scene(), cell_m=0.05)
+        for line in result.polylines:
+            pts = line.points
+            n = len(pts)
+            self.assertEqual(pts.view.shape, (n, 2))
+            self.assertEqual(pts.view.format, "d")
+            self.assertTrue(pts.view.readonly)
+            self.assertEqual(pts.view.tolist(), [list(p) for p in pts])
+            self.assertEqual(pts.tolist(), list(pts))
+            self.assertEqual(pts[-1], pts.tolist()[-1])
+            for x, y in pts:           # float32 values, as their shortest decimals
+                for v in (x, y):
+                    self.assertEqual(polyc._shortest(f32(v)), v)
+
+    @unittest.skipIf(numpy is None, NO_NUMPY)
+    def test_numpy_takes_points_without_a_copy(self):
+        result = polyc.build_map(scene(), cell_m=0.05)
+        for line in result.polylines:
+            a = numpy.asarray(line.points)
+            self.assertEqual(a.shape, (len(line.points), 2))
+            self.assertEqual(a.dtype, numpy.float64)
+            self.assertTrue(numpy.shares_memory(a, numpy.asarray(line.points.view)))
+            self.assertEqual(a.tolist(), [list(p) for p in line.points])
+            b = numpy.asarray(line.points.view)
+            self.assertEqual(b.shape, a.shape)
+
+    def test_ranges_in_any_buffer(self):
+        scans = scene()
+        want = polyc.build_map(scans, cell_m=0.05)
+        kinds = [lambda r: array("f", r), lambda r: array("d", r), lambda r: list(r),
+                 lambda r: tuple(r), lambda r: memoryview(array("f", r))]
+        if numpy is not None:
+            kinds += [lambda r: numpy.array(r, dtype=numpy.float32),
+                      lambda r: numpy.array(r, dtype=numpy.float64),
+                      lambda r: numpy.repeat(numpy.array(r, dtype=numpy.float32), 2)[::2]]
+        for kind in kinds:
+            got = polyc.build_map([s._replace(ranges_m=kind(s.ranges_m)) for s in scans],
+                                  cell_m=0.05)
+            self.assertEqual(got.polylines, want.polylines)
+        with self.assertRaises(TypeError):
+            polyc.build_map([scans[0]._replace(ranges_m=array("i", [1, 2, 3]))])
+        if numpy is not None:          # not native byte order, or 2-D: refused, not misread
+            swapped = ">f4" if sys.byteorder == "little" else "<f4"
+            for bad in (numpy.array(scans[0].ranges_m, dtype=swapped),
+                        numpy.zeros((2, 2), dtype=numpy.float32)):
+                with self.assertRaises(TypeError):
+                    polyc.build_map([scans[0]._replace(ranges_m=bad)])
+
+    def test_clockwise_scans(self):
+        # the same beams listed clockwise (negative step) give the same map
+        scans = scene()
+        turned = [s._replace(start_angle_rad=f32(s.start_angle_rad + 180 * s.angle_step_rad),
+                             angle_step_rad=-s.angle_step_rad, ranges_m=s.ranges_m[::-1])
+                  for s in scans]
+        a = polyc.build_map(scans, cell_m=0.05)
+        b = polyc.build_map(turned, cell_m=0.05)
+        for key in ("hits", "data_points", "contour_cells", "polylines"):
+            self.assertEqual(a.stats[key], b.stats[key], key)
+        vertices_a = [p for line in a.polylines for p in line.points]
+        for line in b.polylines:
+            for xb, yb in line.points:
+                self.assertLess(min(math.hypot(xa - xb, ya - yb) for xa, ya in vertices_a), 0.05)
+
+
+class Files(unittest.TestCase):
+    """Logs and maps read through the tool's own readers."""
+    LOG = os.path.join(REPO, "examples", "office.log")
+
+    def test_log_gives_the_tools_map(self):
+        scans = polyc.read_log(self.LOG)
+        self.assertGreater(len(scans), 10)
+        self.assertIsInstance(scans[0].ranges_m, array)
+        same_as_tool(self, polyc.build_map(scans), tool_json(self.LOG))
+        short = polyc.read_log(self.LOG, max_range_m=4.0)
+        self.assertTrue(all(s.max_range_m <= 4.0 for s in short))
+        same_as_tool(self, polyc.build_map(short), tool_json("--max-range", "4", self.LOG))
+
+    def test_plain_log_round_trip(self):
+        scans = scene()
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "room.scans")
+            write_plain(path, scans)
+            back = polyc.read_log(path)
+        self.assertEqual([tuple(s.ranges_m) for s in back], [tuple(s.ranges_m) for s in scans])
+        self.assertEqual(polyc.build_map(back, cell_m=0.05), polyc.build_map(scans, cell_m=0.05))
+
+    def test_bad_log_says_what_the_tool_says(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "bad.log")
+            with open(path, "w") as f:
+                f.write("SCAN 0 0 0 0 0.1 0.05 4 3 1 1 1\nSCAN 0 0 0 0 0.1 0.05 4 3 1 x 1\n")
+            with self.assertRaises(ValueError) as e:
+                polyc.read_log(path)
+            tool = subprocess.run([TOOL, path], capture_output=True, text=True)
+            self.assertEqual(tool.returncode, 1)
+            self.assertEqual("polyc: " + str(e.exception), tool.stderr.strip())
+            self.assertIn(path + ":2:", str(e.exception))
+            with self.assertRaises(ValueError) as e:
+                polyc.read_log(os.path.join(tmp, "missing.log"))
+            self.assertIn("No such file", str(e.exception))
+
+    def test_grid_image_is_what_polyc_grid_writes(self):
+        image = polyc.grid_image(polyc.read_log(self.LOG))
+        with tempfile.TemporaryDirectory() as tmp:
+            prefix = os.path.join(tmp, "office")
+            subprocess.run([TOOL, "grid", "-o", prefix, self.LOG], check=True,
+                           capture_output=True)
+            with open(prefix + ".pgm", "rb") as f:
+                data = f.read()
+            grid = polyc.read_map(prefix + ".yaml")
+        header = [w for w in data[:200].split(b"\n")[:4] if not w.startswith(b"#")]
+        magic, width, height, maxval = b" ".join(header).split()[:4]
+        self.assertEqual((magic, int(width), int(height), int(maxval)),
+                         (b"P5", image.width, image.height, 255))
+        self.assertEqual(image.pixels, data[-image.width * image.height:])
+        self.assertEqual(set(image.pixels), {0, 205, 254})
+        self.assertEqual(image.cell_m, grid.resolution)
+        self.assertEqual(image.cell_m, 0.025)
+        for a, b in zip(image.origin, grid.origin):
+            self.assertAlmostEqual(a, b, places=6)
+        ctx = polyc.Context((1, 10, 4096, 0))
+        ctx.add_scan((0.0, 0.0, 0.0), -1.5, 0.1, 0.02, 10.0, [1.0] * 10)
+        with self.assertRaises(polyc.PolycError) as e:     # before the grid
+            ctx.grid_image()
+        self.assertEqual(e.exception.status, polyc.ERR_STATE)
+        ctx.build_grid()
+        self.assertGreater(ctx.grid_image().width, 0)
+
+    def test_map_gives_the_tools_map(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            prefix = os.path.join(tmp, "office")
+            subprocess.run([TOOL, "grid", "-o", prefix, self.LOG], check=True,
+                           capture_output=True)
+            grid = polyc.read_map(prefix + ".yaml")
+            self.assertEqual(grid.image_path, prefix + ".pgm")
+            self.assertEqual(len(grid.cells), grid.width * grid.height)
+            self.assertEqual(set(grid.cells) - {0, 100, 255}, set())   # 255: -1 unknown
+            result = polyc.build_map_from_grid(grid.cells, grid.width, grid.height,
+                                               grid.resolution, origin=grid.origin)
+            same_as_tool(self, result, tool_json(prefix + ".yaml"))
+            # a bad map: the YAML's line, as the tool says it
+            with open(prefix + ".yaml") as f:
+                text = f.read()
+            with open(prefix + ".yaml", "w") as f:
+                f.write(re.sub(r"resolution: .*", "resolution: -1", text))
+            with self.assertRaises(ValueError) as e:
+                polyc.read_map(prefix + ".yaml")
+            tool = subprocess.run([TOOL, prefix + ".yaml"], capture_output=True, text=True)
+            self.assertEqual("polyc: " + str(e.exception), tool.stderr.strip())
+            os.remove(prefix + ".pgm")
+            with open(prefix + ".yaml", "w") as f:
+                f.write(text)
+            with self.assertRaises(ValueError) as e:
+                polyc.read_map(prefix + ".yaml")
+            self.assertIn("image", str(e.exception))
+
+
+class Calls(unittest.TestCase):
+    """Arguments, the callback, the retry."""
+
+    def test_integers_out_of_range(self):
+        scans = scene()
+        for bad in ({"max_iterations": -1}, {"flags": 2 ** 32 + 1}, {"seed": -1},
+                    {"seed": 2 ** 64}, {"patience": 2 ** 32}):
+            with self.assertRaises(ValueError) as e:
+                polyc.build_map(scans, **bad)
+            self.assertIn(list(bad)[0], str(e.exception))
+        for bad in ({"max_iterations": 2.5}, {"seed": "1"}, {"cell_m": "0.05"},
+                    {"flags": True}):
+            with self.assertRaises(TypeError):
+                polyc.build_map(scans, **bad)
+        with self.assertRaises(TypeError) as e:
+            polyc.build_map(scans, cell=0.05)
+        for name in ("cell_m", "max_iterations", "seed", "free_thresh"):
+            self.assertIn(name, str(e.exception))
+        with self.assertRaises(ValueError):
+            polyc.Context((1, -1, 4096, 0))
+        with self.assertRaises(ValueError):
+            polyc.Context({"max_scans": 2 ** 32, "max_beams": 1, "max_grid_cells": 1,
+                           "max_vertices": 0})
+        with self.assertRaises(TypeError):
+            polyc.Context({"max_scan": 1})
+        with self.assertRaises(ValueError):
+            polyc.build_map_from_grid([0] * 4, -2, -2, 0.05)
+        with self.assertRaises(ValueError):
+            polyc.build_map(scans, max_vertices=-1)
+        # the limits still work at the top of their range
+        self.assertEqual(polyc.build_map(scans, cell_m=0.05, seed=2 ** 64 - 1).stats["scans"], 4)
+
+    def test_exception_in_the_callback_reaches_the_caller(self):
+        class Mine(Exception):
+            pass
+
+        calls = []
+
+        def bad(it):
+            calls.append(it["iteration"])
+            raise Mine("from the callback")
+
+        with self.assertRaises(Mine) as e:
+            polyc.build_map(scene(), cell_m=0.05, progress=bad)
+        self.assertEqual(str(e.exception), "from the callback")
+        self.assertEqual(len(calls), 1)              # stopped at once
+        ctx = polyc.Context((4, 4 * 181, polyc_grid_cells(scene(), 0.05), 0), cell_m=0.05)
+        for s in scene():
+            ctx.add_scan(*s)
+        with self.assertRaises(Mine):
+            ctx.build(progress=bad)
+        self.assertGreater(len(ctx.polylines()), 0)  # the best map so far is kept
+        ctx.optimize()                               # and the context still works
+
+    def test_keyboard_interrupt_in_the_callback(self):
+        def ctrl_c(it):
+            signal.raise_signal(signal.SIGINT)
+
+        def raises(it):
+            raise KeyboardInterrupt
+
+        for fn in (ctrl_c, raises):
+            with self.assertRaises(KeyboardInterrupt):
+                polyc.build_map(scene(), cell_m=0.05, progress=fn)
+        self.assertIs(signal.getsignal(signal.SIGINT), signal.default_int_handler)
+
+    def test_ctrl_c_during_the_optimiser(self):
+        # a Ctrl-C while the library runs, without a callback of the caller's:
+        # a long optimisation stops at the next iteration with KeyboardInterrupt
+        scans = scene(beams=721)
+        timer = threading.Timer(0.3, os.kill, (os.getpid(), signal.SIGINT))
+        t0 = time.monotonic()
+        timer.start()
+        try:
+            with self.assertRaises(KeyboardInterrupt):
+                polyc.build_map(scans, cell_m=0.02, max_iterations=10 ** 6, patience=10 ** 6,
+                                noise_decay=1.0)
+        finally:
+            timer.cancel()
+        self.assertLess(time.monotonic() - t0, 20.0)
+
+    def test_progress_must_be_callable(self):
+        for call in (lambda: polyc.build_map(scene(), progress=5),
+                     lambda: polyc.build_map_from_grid([0, 100, 0, 0], 2, 2, 0.05, progress="x")):
+            with self.assertRaises(TypeError) as e:
+                call()
+            self.assertIn("progress must be callable", str(e.exception))
+        ctx = polyc.Context((4, 4 * 181, polyc_grid_cells(scene(), 0.05), 0), cell_m=0.05)
+        with self.assertRaises(TypeError):
+            ctx.build(progress=5)
+
+    def test_the_callback_may_not_call_its_context(self):
+        ctx = polyc.Context((4, 4 * 181, polyc_grid_cells(scene(), 0.05), 0), cell_m=0.05)
+        for s in scene():
+            ctx.add_scan(*s)
+        seen = {}
+
+        def reenter(it):
+            # the library refuses it too, whatever the binding lets through
+            seen["trace"] = polyc._lib.polyc_trace(ctx._ctx)
+            seen["count"] = polyc._lib.polyc_polyline_count(ctx._ctx)
+            seen["error"] = polyc._lib.polyc_last_error(ctx._ctx).decode()
+            other = polyc.build_map(scene()[:1], cell_m=0.05, max_iterations=1)
+            seen["other"] = len(other.polylines)    # another context works
+            ctx.polylines()
+
+        with self.assertRaises(polyc.PolycError) as e:
+            ctx.build(progress=reenter)
+        self.assertEqual(e.exception.status, polyc.ERR_BUSY)
+        self.assertIn("progress callback", str(e.exception))
+        self.assertEqual(seen["trace"], polyc.ERR_BUSY)
+        self.assertEqual(seen["count"], 0)
+        self.assertEqual(seen["error"], "called from inside the progress callback")
+        self.assertGreater(seen["other"], 0)
+        self.assertGreater(len(ctx.polylines()), 0)    # usable again afterwards
+        self.assertEqual(polyc.STATUS[polyc.ERR_BUSY], "POLYC_ERR_BUSY")
+
+    def test_one_large_scan_is_retried_as_the_tool_does(self):
+        scan = big_scan(8000)
+        # the limits sized for it are too small for its data points...
+        cfg = polyc._config({})
+        held = polyc._scan(scan)
+        lim = polyc._Limits()
+        self.assertEqual(polyc._lib.polyc_limits_for_scans(
+            ctypes.byref(cfg), ctypes.byref(held[0]), 1, ctypes.byref(lim)), polyc.OK)
+        ctx = polyc.Context((lim.max_scans, lim.max_beams, lim.max_grid_cells,
+                             lim.max_vertices, lim.max_points))
+        ctx.add_scan(*scan)
+        with self.assertRaises(polyc.PolycError) as e:
+            ctx.build()
+        self.assertEqual(e.exception.status, polyc.ERR_NOMEM)
+        self.assertIn("max_points", str(e.exception))
+        # ...build_map runs it again with the worst-case bound, as the tool does
+        result = polyc.build_map([scan])
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "big.scans")
+            write_plain(path, [scan])
+            same_as_tool(self, result, tool_json(path))
 
 
 def polyc_grid_cells(scans, cell_m):
