@@ -125,7 +125,8 @@ $(BUILD)/footprint8: examples/footprint.c $(EMB_OBJ)
 	$(CC) $(WARN) $(OPT) $(CFLAGS) -Iinclude $^ -o $@ $(LDLIBS)
 
 # Robustness (docs/security.md). test-cli: every bad input of the tool
-# (tests/cli_bad_input.sh). test-fuzz-replay: the committed fuzz corpus through
+# (tests/cli_bad_input.sh) and where it writes (tests/cli_output.sh: as root,
+# also as an ordinary user). test-fuzz-replay: the committed fuzz corpus through
 # the fuzz targets, built with $(CC). test-asan: unit tests, corpus replay and
 # the quick bad-input tests again in build-asan/ under ASan and UBSan.
 # test-valgrind: the tool over a sample log, its grid as a ROS map and a bad
@@ -140,6 +141,7 @@ test-fuzz-replay: $(FUZZ_REPLAY)
 CLI_TEST_ARGS ?=
 test-cli: $(BUILD)/polyc
 	tests/cli_bad_input.sh $(CLI_TEST_ARGS) $(BUILD)/polyc
+	tests/cli_output.sh $(BUILD)/polyc
 SAN_LIST  = address,undefined,float-cast-overflow
 SAN_FLAGS = -fsanitize=$(SAN_LIST) -fno-sanitize-recover=all
 test-asan:

@@ -47,9 +47,9 @@ run() {
         bad "exit $rc (timeout, crash or signal)"
         return 1
     fi
-    if ls map.svg.tmp* g.pgm.tmp* g.yaml.tmp* > /dev/null 2>&1; then
+    if ls -A | grep -q '^\.polyc-'; then
         bad "a temporary output file is left behind"
-        rm -f map.svg.tmp* g.pgm.tmp* g.yaml.tmp*
+        rm -f .polyc-*
     fi
     # stderr is a file here: no progress line (it would carry a carriage return)
     if grep -q "$(printf '\r')" err.txt; then bad "a progress line on stderr, which is not a terminal"; fi

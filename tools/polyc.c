@@ -7,6 +7,7 @@
  *                                and PREFIX.yaml
  * Exit codes: 0 ok, 1 bad input or other failure, 2 usage, 3 memory budget.
  * Formats and rules: docs/formats.md. */
+#include <ctype.h>
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
@@ -20,6 +21,7 @@
 #include "gridimage.h"
 #include "mapfile.h"
 #include "mapout.h"
+#include "outfile.h"
 #include "polyc.h"
 #include "scanlog.h"
 
@@ -83,8 +85,9 @@ static const char usage_text[] =
     "--exact-points, --grid-trace and --points act on scans and are refused for a\n"
     "map; --occupied-thresh and --free-thresh apply to maps only.\n"
     "options:\n"
-    "  --format svg|json|txt   output format (default svg)\n"
-    "  -o, --output FILE       write FILE (atomically) instead of stdout\n"
+    "  --format svg|json|txt   output format (default: -o's extension, else svg)\n"
+    "  -o, --output FILE       write FILE instead of stdout (a file is replaced\n"
+    "                          atomically, a device or FIFO written in place)\n"
     "  --stats                 counts, sizes and times per stage on stderr\n"
     "  --no-optimize           stop after tracing the initial polylines\n"
     "  --cell M                grid cell size in metres (default 0.025)\n"
@@ -309,6 +312,60 @@ static int takes_value(const char *name)
     return 0;
 }
 
+/* The format -o's extension names (.svg, .json, .txt), or -1. */
+static int format_of_name(const char *path)
+{
+    static const char *const ext[] = {".svg", ".json", ".txt"};
+    const char *slash = strrchr(path, '/');
+    const char *dot = strrchr(slash ? slash + 1 : path, '.');
+    for (int f = 0; dot && f < 3; f++) {
+        size_t i = 0;
+        while (dot[i] && ext[f][i] && tolower((unsigned char)dot[i]) == ext[f][i])
+            i++;
+        if (!dot[i] && !ext[f][i])
+            return f;
+    }
+    return -1;
+}
+
+/* Refuses (usage) outputs that cannot be written as asked, before any work:
+ * an empty or directory name, -o and --trace naming the same file, a
+ * --format that -o's extension contradicts; else takes the format from it. */
+static int check_outputs(options *o)
+{
+    const char *why;
+    if (o->command == CMD_GRID) {
+        size_t n = strlen(o->output);
+        char *p = malloc(n + 6);
+        if (!p)
+            return complain(EXIT_INPUT, "out of memory");
+        why = outfile_check(o->output);
+        for (int i = 0; i < 2 && !why; i++) {
+            snprintf(p, n + 6, "%s%s", o->output, i ? ".yaml" : ".pgm");
+            why = outfile_check(p);
+        }
+        free(p);
+        return why ? complain(EXIT_USAGE, "-o PREFIX '%s' %s (polyc grid writes PREFIX.pgm and"
+                                          " PREFIX.yaml)", o->output, why)
+                   : 0;
+    }
+    if ((why = outfile_check(o->output)))
+        return complain(EXIT_USAGE, "-o '%s' %s: give a file name", o->output, why);
+    if ((why = outfile_check(o->trace)))
+        return complain(EXIT_USAGE, "--trace '%s' %s: give a file name", o->trace, why);
+    if (o->trace && outfile_same(o->output, o->trace))
+        return complain(EXIT_USAGE, "-o and --trace name the same file ('%s', '%s')",
+                        o->output ? o->output : "-", o->trace);
+    int f = o->output && o->command == CMD_MAP ? format_of_name(o->output) : -1;
+    static const char *const names[] = {"svg", "json", "txt"};
+    if (f >= 0 && (o->given & OPT_FORMAT) && (int)o->format != f)
+        return complain(EXIT_USAGE, "--format %s contradicts -o %s (a .%s name)",
+                        names[o->format], o->output, names[f]);
+    if (f >= 0)
+        o->format = (enum format)f;
+    return 0;
+}
+
 /* 0: run; -1: --help/--version done (exit 0); else an exit code. */
 static int parse_args(int argc, char **argv, options *o)
 {
@@ -366,108 +423,12 @@ static int parse_args(int argc, char **argv, options *o)
     if (o->command == CMD_GRID && (!o->output || strcmp(o->output, "-") == 0))
         return complain(EXIT_USAGE, "polyc grid needs -o PREFIX (it writes PREFIX.pgm and"
                                     " PREFIX.yaml)");
+    int rc = check_outputs(o);
+    if (rc)
+        return rc;
     const char *why = NULL;
     if (polyc_config_check(&o->config, &why) != POLYC_OK)
         return complain(EXIT_USAGE, "bad option value: %s", why ? why : "?");
-    return 0;
-}
-
-/* ---- output: all or nothing ---- */
-
-/* An output written in two steps, so that a run with two outputs (the map
- * and --trace) writes both or neither: emit_prepare writes a file's bytes to
- * a temporary file in the same directory, emit_commit renames it over the
- * file (or writes stdout), emit_abort removes what is left. */
-typedef struct pending {
-    const char *path;          /* NULL or "-": stdout, written at commit */
-    const char *data;
-    size_t len;
-    char *tmp;                 /* the prepared temporary file, or NULL */
-} pending;
-
-static int emit_file(const char *path, const char *data, size_t len, char **tmp_out);
-
-static int emit_prepare(pending *p, const char *path, const char *data, size_t len)
-{
-    p->path = path;
-    p->data = data;
-    p->len = len;
-    p->tmp = NULL;
-    if (!path || strcmp(path, "-") == 0)
-        return 0;
-    return emit_file(path, data, len, &p->tmp);
-}
-
-static int emit_commit(pending *p)
-{
-    if (!p->path || strcmp(p->path, "-") == 0) {
-        if (fwrite(p->data, 1, p->len, stdout) != p->len || fflush(stdout) != 0)
-            return complain(EXIT_INPUT, "writing stdout: %s", strerror(errno));
-        return 0;
-    }
-    int err = rename(p->tmp, p->path) != 0 ? errno : 0;
-    if (err)
-        unlink(p->tmp);
-    free(p->tmp);
-    p->tmp = NULL;
-    return err ? complain(EXIT_INPUT, "%s: %s", p->path, strerror(err)) : 0;
-}
-
-static void emit_abort(pending *p)
-{
-    if (p->tmp) {
-        unlink(p->tmp);
-        free(p->tmp);
-        p->tmp = NULL;
-    }
-}
-
-/* Writes len bytes to stdout, or to path through a temporary file in the
- * same directory renamed over it, so that a failure never leaves a partial
- * file. Returns 0 or EXIT_INPUT with a message. */
-static int emit(const char *path, const char *data, size_t len)
-{
-    pending p;
-    int rc = emit_prepare(&p, path, data, len);
-    return rc ? rc : emit_commit(&p);
-}
-
-/* The bytes in a synced temporary file next to path; *tmp_out gets its
- * name (to rename or remove). 0 or EXIT_INPUT with a message. */
-static int emit_file(const char *path, const char *data, size_t len, char **tmp_out)
-{
-    size_t n = strlen(path);
-    char *tmp = malloc(n + 16);
-    if (!tmp)
-        return complain(EXIT_INPUT, "out of memory");
-    memcpy(tmp, path, n);
-    memcpy(tmp + n, ".tmpXXXXXX", 11);
-    int fd = mkstemp(tmp);
-    if (fd < 0) {
-        int e = errno;
-        free(tmp);
-        return complain(EXIT_INPUT, "%s: cannot create a temporary file: %s", path, strerror(e));
-    }
-    mode_t mask = umask(0);            /* mkstemp makes 0600; give the usual mode */
-    umask(mask);
-    int err = fchmod(fd, 0666 & ~mask) ? errno : 0;
-    for (size_t done = 0; !err && done < len;) {
-        ssize_t w = write(fd, data + done, len - done);
-        if (w < 0 && errno != EINTR)
-            err = errno;
-        else if (w > 0)
-            done += (size_t)w;
-    }
-    if (!err && fsync(fd) != 0)
-        err = errno;
-    if (close(fd) != 0 && !err)
-        err = errno;
-    if (err) {
-        unlink(tmp);
-        free(tmp);
-        return complain(EXIT_INPUT, "%s: %s", path, strerror(err));
-    }
-    *tmp_out = tmp;
     return 0;
 }
 
@@ -493,6 +454,38 @@ static int membuf_close(membuf *m, int write_failed)
     bad = fclose(m->f) != 0 || bad;
     m->f = NULL;
     return bad ? complain(EXIT_INPUT, "out of memory rendering the output") : 0;
+}
+
+/* ---- output: all or nothing ---- */
+
+/* Writes n rendered outputs to their paths (NULL or "-": stdout), all or
+ * none where it can (outfile.h): every temporary file is written before
+ * anything is renamed or written in place. 0 or EXIT_INPUT with a message. */
+static int write_outputs(const char *const *paths, const membuf *const *bufs, size_t n)
+{
+    outfile of[2];
+    outfile *ptr[2];
+    const char *what = NULL;
+    int err = 0;
+    size_t i, made = 0;
+    for (i = 0; i < n && i < 2 && !err; i++, made++) {
+        ptr[i] = &of[i];
+        err = outfile_prepare(&of[i], paths[i], bufs[i]->data, bufs[i]->len, &what);
+    }
+    if (err) {
+        for (size_t j = 0; j < made; j++)
+            outfile_abort(&of[j]);
+        const char *p = paths[made - 1];
+        return what ? complain(EXIT_INPUT, "%s: %s: %s", p, what, strerror(err))
+                    : complain(EXIT_INPUT, "%s: %s", p, strerror(err));
+    }
+    progress_clear();                     /* before stdout, which may be the terminal */
+    const outfile *failed = NULL;
+    if ((err = outfile_commit_all(ptr, made, &failed)) != 0)
+        return failed && failed->kind != OUTFILE_STDOUT
+                   ? complain(EXIT_INPUT, "%s: %s", failed->path, strerror(err))
+                   : complain(EXIT_INPUT, "writing stdout: %s", strerror(err));
+    return 0;
 }
 
 /* ---- the optimiser's callback: --trace and the progress line ---- */
@@ -644,7 +637,9 @@ static int convert(const options *o, run *r)
         return EXIT_INPUT;
     if (o->stats)
         print_input_stats(&r->log);
-    return emit(o->output, r->out.data, r->out.len);
+    const char *paths[] = {o->output};
+    const membuf *bufs[] = {&r->out};
+    return write_outputs(paths, bufs, 1);
 }
 static const char *input_name(const options *o)
 {
@@ -1007,18 +1002,9 @@ static int make_map(const options *o, run *r, double t_start, mapout_times *t)
     if (o->trace && membuf_close(&r->trace, 0))
         return EXIT_INPUT;
     /* both outputs or neither */
-    pending map_out, trace_out;
-    memset(&trace_out, 0, sizeof trace_out);
-    int rc = emit_prepare(&map_out, o->output, r->out.data, r->out.len);
-    if (!rc && o->trace)
-        rc = emit_prepare(&trace_out, o->trace, r->trace.data, r->trace.len);
-    progress_clear();                     /* before stdout, which may be the terminal */
-    if (!rc)
-        rc = emit_commit(&map_out);
-    if (!rc && o->trace)
-        rc = emit_commit(&trace_out);
-    emit_abort(&map_out);
-    emit_abort(&trace_out);
+    const char *paths[] = {o->output, o->trace};
+    const membuf *bufs[] = {&r->out, &r->trace};
+    int rc = write_outputs(paths, bufs, o->trace ? 2 : 1);
     double t6 = now_ms();
     if (o->stats)
         print_stats(o, r, &stats, t, t6 - t5, t6 - t_start);
@@ -1097,19 +1083,10 @@ static int grid_files(const options *o, run *r, double t_start)
         }
         /* both files or neither; the image first, so that the YAML never
          * names a missing one */
-        pending pgm_out, yaml_out;
-        memset(&pgm_out, 0, sizeof pgm_out);
-        memset(&yaml_out, 0, sizeof yaml_out);
+        const char *paths[] = {pgm_path, yaml_path};
+        const membuf *bufs[] = {&r->pgm, &r->yaml};
         if (!rc)
-            rc = emit_prepare(&pgm_out, pgm_path, r->pgm.data, r->pgm.len);
-        if (!rc)
-            rc = emit_prepare(&yaml_out, yaml_path, r->yaml.data, r->yaml.len);
-        if (!rc)
-            rc = emit_commit(&pgm_out);
-        if (!rc)
-            rc = emit_commit(&yaml_out);
-        emit_abort(&pgm_out);
-        emit_abort(&yaml_out);
+            rc = write_outputs(paths, bufs, 2);
     }
     free(pgm_path);
     free(yaml_path);
@@ -1168,6 +1145,7 @@ int main(int argc, char **argv)
     options o;
     run r;
     map_input map;
+    outfile_signals();
     int rc = parse_args(argc, argv, &o);
     if (rc)
         return rc < 0 ? 0 : rc;
