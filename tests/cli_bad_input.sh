@@ -97,9 +97,9 @@ GOOD='SCAN 0 0 0 -1.5707963 0.0174532924 0.02 8 5 1.0 1.05 1.1 1.15 1.2'
 
 # ---- empty, binary, truncated, line endings ----
 : > empty.log
-refused empty empty.log - 'no scans found \(0 lines read\)$'
+refused empty empty.log - 'no scans found \(0 lines read; polyc reads CARMEN FLASER and ROBOTLASER1 lines, .*\)$'
 printf '\n\n  \n# nothing\nODOM 1 2 3\n' > blank.log
-refused blank blank.log - 'no scans found \(5 lines read\)$'
+refused blank blank.log - 'no scans found \(5 lines read; '
 printf '%s\n' "$GOOD" | gzip -c > gzip.log
 refused gzip gzip.log 1 'binary data \(byte 0x1f at column 1\)$'
 refused elf "$POLYC" 1 'binary data \(byte 0x7f at column 1\)$' 2> /dev/null
@@ -207,8 +207,36 @@ run --iterations 2 --trace trace.txt -o map.svg lf.log
 rm -f map.svg trace.txt
 name=memory-budget
 run --memory-mb 0.01 -o map.svg lf.log
-[ $rc -eq 3 ] && [ ! -e map.svg ] && grep -q '^polyc: memory budget too small: need [0-9]* bytes$' err.txt \
+[ $rc -eq 3 ] && [ ! -e map.svg ] && grep -q '^polyc: memory budget too small: need [0-9]* bytes ([0-9.]* MiB), --memory-mb 0.01 allows 0.01 MiB: give --memory-mb [0-9]* or more$' err.txt \
     || bad "exit $rc for a too small --memory-mb"
+# ---- messages name the options ----
+usage() {   # usage NAME PATTERN ARGS...: exit 2 and the message
+    name=$1 pattern=$2
+    shift 2
+    run "$@"
+    [ $rc -eq 2 ] && head -n 1 err.txt | grep -qE -- "^polyc: $pattern" || bad "exit $rc, expected 2 and '$pattern'"
+}
+usage cell-0 'bad option value: --cell must be in \[0.001, 10\]$' --cell 0 lf.log
+usage threshold-1 'bad option value: --threshold must be in \[0, 1\)$' --threshold 1 lf.log
+usage memory-huge "--memory-mb needs MiB from 0.000001 to 1000000000, not '1e10'$" --memory-mb 1e10 lf.log
+usage convert-format '--format does not apply to polyc convert$' convert --format json lf.log
+usage convert-points '--points does not apply to polyc convert$' convert --points lf.log
+usage convert-no-optimize '--no-optimize does not apply to polyc convert$' convert --no-optimize lf.log
+name=version
+run --version
+[ $rc -eq 0 ] && grep -qx "polyc $(awk '/define POLYC_VERSION_(MAJOR|MINOR|PATCH) /{v = v s $3; s = "."} END {print v}' "$ROOT/include/polyc.h")" out.txt \
+    || bad "--version is not the library's version: $(cat out.txt)"
+name=junk
+echo 'hello world' > junk.log
+run junk.log
+[ $rc -eq 1 ] && grep -q "no scans found (1 lines read; polyc reads CARMEN FLASER and ROBOTLASER1 lines, polyc's SCAN lines, or a map_server map YAML)$" err.txt \
+    || bad "exit $rc, or the message does not say which formats are read"
+name=extent-margin
+{ echo 'SCAN 0 0 0 -1.57 0.0174 0.02 8 3 1 1 1'; echo 'SCAN 1998 0 0 -1.57 0.0174 0.02 8 3 1 1 1'; } > wide.log
+run --cell 1 wide.log
+[ $rc -eq 1 ] && grep -q "plus the grid's margin of 4 m), more than the grid's limit of 2000 m$" err.txt \
+    || bad "exit $rc, or the message for a 1998 m span does not name the limit"
+if grep -q -- '--cell' err.txt; then bad "a larger --cell cannot help a span at the limit"; fi
 name=stdin
 printf '%s\n%s\n' "$GOOD" "SCAN 0 0 0 0 0.1 0.02 8 1 x" | {
     run -o map.svg -
@@ -221,7 +249,7 @@ run -o map.svg nonexistent.log
 mkdir adir
 name=directory
 run -o map.svg adir
-[ $rc -eq 1 ] && grep -q '^polyc: adir:1: read error: Is a directory$' err.txt \
+[ $rc -eq 1 ] && grep -q '^polyc: adir: Is a directory: give a log file$' err.txt \
     || bad "exit $rc for a directory as input"
 [ -e map.svg ] && bad "map.svg exists after a failure"
 
@@ -302,6 +330,20 @@ printf 'image: "\\e[2J.pgm"\nresolution: 0.05\n%s\n' "$REST" > esc.yaml
 refused map-image-name-escaped esc.yaml 1 'image .x1b\[2J.pgm: No such file or directory$'
 printf 'image: adir\nresolution: 0.05\n%s\n' "$REST" > dirimg.yaml
 refused map-image-directory dirimg.yaml 1 'image adir: Is a directory$'
+for dev in /dev/zero /dev/urandom; do
+    printf 'image: %s\nresolution: 0.05\n%s\n' $dev "$REST" > dev.yaml
+    refused "map-image-$dev" dev.yaml 1 "image $dev: not a regular file \(a device or a FIFO\): give a PGM file$"
+done
+mkfifo fifo.pgm
+printf 'image: fifo.pgm\nresolution: 0.05\n%s\n' "$REST" > fifo.yaml
+refused map-image-fifo fifo.yaml 1 'image fifo.pgm: not a regular file'
+rm -f fifo.pgm
+name=map-stats-escaped
+cp room.pgm "$(printf '\033[2J.pgm')"
+run --stats -o map.svg esc.yaml
+[ $rc -eq 0 ] && grep -qF 'cells of 0.05 m, \x1b[2J.pgm (P2' err.txt || bad "exit $rc, or --stats lacks the escaped image name"
+if LC_ALL=C grep -q '[^ -~]' err.txt; then bad "--stats prints raw bytes"; fi
+rm -f map.svg "$(printf '\033[2J.pgm')"
 printf '\211PNG\r\n\032\n\000\000\000\rIHDR' > png.pgm
 printf 'image: png.pgm\nresolution: 0.05\n%s\n' "$REST" > png.yaml
 refused_as map-png png.yaml 'polyc: png.pgm: byte 0: ' 'a PNG image: polyc reads PGM \(P5 or P2\) only; save the map as PGM'

@@ -9,6 +9,7 @@
  * Formats and rules: docs/formats.md. */
 #include <ctype.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -28,7 +29,6 @@
 #define EXIT_INPUT 1
 #define EXIT_USAGE 2
 #define EXIT_MEMORY 3
-#define TOOL_VERSION "0.1.0"
 
 enum format { FORMAT_SVG, FORMAT_JSON, FORMAT_TXT };
 enum command { CMD_MAP, CMD_CONVERT, CMD_GRID };
@@ -58,6 +58,7 @@ static const struct {
 #define OPTS_LOG_ONLY (OPT_CELL | OPT_THRESHOLD | OPT_MAX_RANGE | OPT_EXACT | OPT_GRID_TRACE | OPT_POINTS)
 #define OPTS_MAP_ONLY (OPT_OCCUPIED | OPT_FREE)
 #define OPTS_GRID_CMD (OPT_OUTPUT | OPT_CELL | OPT_MAX_RANGE | OPT_MEMORY | OPT_STATS)
+#define OPTS_CONVERT_CMD (OPT_OUTPUT | OPT_MAX_RANGE | OPT_STATS)
 
 typedef struct options {
     const char *input;
@@ -249,7 +250,8 @@ static int set_value(options *o, const char *name, const char *val)
         o->max_range_m = d;
     } else if (strcmp(name, "--memory-mb") == 0) {
         if (parse_double(val, 1e-6, 1e9, &d))
-            return complain(EXIT_USAGE, "--memory-mb needs a positive number, not '%s'", val);
+            return complain(EXIT_USAGE, "--memory-mb needs MiB from 0.000001 to 1000000000,"
+                                        " not '%s'", val);
         o->memory_mb = d;
     } else {
         /* float config fields; polyc_config_check judges the values */
@@ -366,6 +368,34 @@ static int check_outputs(options *o)
     return 0;
 }
 
+/* polyc_config_check's message, in the options' names: "cell_m must be in
+ * [0.001, 10]" is "--cell must be in [0.001, 10]". */
+static int config_fail(const char *why)
+{
+    static const char *const names[][2] = {
+        {"cell_m", "--cell"}, {"contour_threshold", "--threshold"}, {"alpha", "--alpha"},
+        {"gamma", "--gamma"}, {"occupied_thresh", "--occupied-thresh"},
+        {"free_thresh", "--free-thresh"}};
+    char msg[200];
+    size_t n = 0;
+    while (*why && n + 40 < sizeof msg) {
+        size_t k = 0, len = 0;
+        for (; k < sizeof names / sizeof names[0]; k++) {
+            len = strlen(names[k][0]);
+            if (strncmp(why, names[k][0], len) == 0 && !(why[len] == '_' || isalnum((unsigned char)why[len])))
+                break;
+        }
+        if (k < sizeof names / sizeof names[0]) {
+            n += (size_t)sprintf(msg + n, "%s", names[k][1]);
+            why += len;
+        } else {
+            msg[n++] = *why++;
+        }
+    }
+    msg[n] = '\0';
+    return complain(EXIT_USAGE, "bad option value: %s", msg);
+}
+
 /* 0: run; -1: --help/--version done (exit 0); else an exit code. */
 static int parse_args(int argc, char **argv, options *o)
 {
@@ -387,9 +417,8 @@ static int parse_args(int argc, char **argv, options *o)
             fputs(usage_text, stdout);
             return -1;
         } else if (strcmp(a, "--version") == 0) {
-            uint32_t v = polyc_version();
-            printf("polyc %s (libpolyc %u.%u.%u)\n", TOOL_VERSION, (unsigned)(v / 10000),
-                   (unsigned)(v / 100 % 100), (unsigned)(v % 100));
+            printf("polyc %d.%d.%d\n", POLYC_VERSION_MAJOR, POLYC_VERSION_MINOR,
+                   POLYC_VERSION_PATCH);   /* the tool is libpolyc's, one version */
             return -1;
         } else if (set_flag(o, a) == 0) {
             o->given |= option_bit(a);
@@ -428,7 +457,7 @@ static int parse_args(int argc, char **argv, options *o)
         return rc;
     const char *why = NULL;
     if (polyc_config_check(&o->config, &why) != POLYC_OK)
-        return complain(EXIT_USAGE, "bad option value: %s", why ? why : "?");
+        return config_fail(why ? why : "?");
     return 0;
 }
 
@@ -524,6 +553,30 @@ typedef struct run {
 
 /* ---- --stats ---- */
 
+/* A copy of s for messages: bytes outside printable ASCII as \xNN. */
+static char *printable(const char *s)
+{
+    static const char hex[] = "0123456789abcdef";
+    size_t n = strlen(s), o = 0;
+    char *out = malloc(4 * n + 1);
+    if (!out)
+        return NULL;
+    for (size_t i = 0; i < n; i++) {
+        unsigned char c = (unsigned char)s[i];
+        if (c >= 0x20 && c < 0x7f) {
+            out[o++] = (char)c;
+        } else {
+            out[o++] = '\\';
+            out[o++] = 'x';
+            out[o++] = hex[c >> 4];
+            out[o++] = hex[c & 15];
+        }
+    }
+    out[o] = '\0';
+    return out;
+}
+
+
 static void print_input_stats(const scanlog *log)
 {
     FILE *e = stderr;
@@ -560,10 +613,12 @@ static void print_map_stats(const map_input *m)
 {
     static const char *const modes[] = {"trinary", "scale", "raw"};
     FILE *e = stderr;
+    char *shown = printable(m->image_path);   /* no raw bytes on the terminal */
     fprintf(e, "map            %u x %u cells of %g m, %s (%s, maxval %u), mode %s%s\n",
             (unsigned)m->pgm.width, (unsigned)m->pgm.height, m->yaml.resolution_m,
-            m->image_path, m->pgm.plain ? "P2" : "P5", (unsigned)m->pgm.maxval,
+            shown ? shown : "?", m->pgm.plain ? "P2" : "P5", (unsigned)m->pgm.maxval,
             modes[m->yaml.mode], m->yaml.negate ? ", negate" : "");
+    free(shown);
     fprintf(e, "origin         %.6f %.6f m, yaw %.6f rad\n", m->yaml.origin_x_m,
             m->yaml.origin_y_m, m->yaml.origin_yaw_rad);
     fprintf(e, "cells          occupied %llu, free %llu, unknown %llu\n",
@@ -615,6 +670,15 @@ static int library_fail(const char *stage, polyc_status st, const polyc_ctx *ctx
                         block, stage, msg ? msg : polyc_status_str(st));
     return complain(EXIT_INPUT, "%s failed: %s%s%s", stage, polyc_status_str(st),
                     msg && *msg ? ": " : "", msg ? msg : "");
+}
+
+/* The block needs more than --memory-mb allows: say the MiB to give. */
+static int budget_fail(const options *o, size_t size)
+{
+    double mib = (double)size / 1048576.0;
+    return complain(EXIT_MEMORY, "memory budget too small: need %zu bytes (%.1f MiB), --memory-mb"
+                                 " %g allows %g MiB: give --memory-mb %.0f or more",
+                    size, mib, o->memory_mb, o->memory_mb, ceil(mib));
 }
 
 static int struct_sizes_match(void)
@@ -684,14 +748,15 @@ static int extent_fail(const options *o, const scanlog *log, const polyc_config 
         }
     }
     double w = all.max_x_m - all.min_x_m, h = all.max_y_m - all.min_y_m;
+    double pad = 4.0 * (double)cfg->cell_m;    /* the grid's margin (polyc_limits_for_scans) */
     const polyc_scan *s = &log->scans[far];
-    if (w > (double)cfg->max_extent_m || h > (double)cfg->max_extent_m || worst < 0)
+    if (w + pad > (double)cfg->max_extent_m || h + pad > (double)cfg->max_extent_m || worst < 0)
         return complain(EXIT_INPUT,
                         "%s:%llu: this scan (pose %.2f %.2f) reaches %.0f m from the median pose"
-                        " (%.2f %.2f): the data would span %.0f x %.0f m, more than the grid's"
-                        " limit of %g m",
+                        " (%.2f %.2f): the data would span %.0f x %.0f m (plus the grid's margin"
+                        " of %g m), more than the grid's limit of %g m",
                         input_name(o), (unsigned long long)log->line_of_scan[far], s->pose_x_m,
-                        s->pose_y_m, worst, mx, my, w, h, (double)cfg->max_extent_m);
+                        s->pose_y_m, worst, mx, my, w, h, pad, (double)cfg->max_extent_m);
     return complain(EXIT_INPUT, "%s: the data span %.1f x %.1f m: more than 2^32 grid cells of"
                                 " %g m (try a larger --cell)",
                     input_name(o), w, h, (double)cfg->cell_m);
@@ -700,38 +765,30 @@ static int extent_fail(const options *o, const scanlog *log, const polyc_config 
 
 /* ---- a ROS map in ---- */
 
-/* A copy of s for messages: bytes outside printable ASCII as \xNN. */
-static char *printable(const char *s)
-{
-    static const char hex[] = "0123456789abcdef";
-    size_t n = strlen(s), o = 0;
-    char *out = malloc(4 * n + 1);
-    if (!out)
-        return NULL;
-    for (size_t i = 0; i < n; i++) {
-        unsigned char c = (unsigned char)s[i];
-        if (c >= 0x20 && c < 0x7f) {
-            out[o++] = (char)c;
-        } else {
-            out[o++] = '\\';
-            out[o++] = 'x';
-            out[o++] = hex[c >> 4];
-            out[o++] = hex[c & 15];
-        }
-    }
-    out[o] = '\0';
-    return out;
-}
-
-/* Reads a whole file of at most max bytes into *data (malloc'd, *len bytes).
- * 0, an errno value, or -1 if it holds more than max bytes. */
+/* Reads a whole regular file of at most max bytes into *data (malloc'd,
+ * *len bytes). 0, an errno value, READ_TOO_LARGE if it holds more than max
+ * bytes, or READ_NOT_FILE if it is not a regular file (a device, a FIFO:
+ * opened without waiting for a writer, and not read). */
+#define READ_TOO_LARGE (-1)
+#define READ_NOT_FILE (-2)
 static int read_whole(const char *path, size_t max, char **data, size_t *len)
 {
-    FILE *f = fopen(path, "rb");
     *data = NULL;
     *len = 0;
-    if (!f)
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY);
+    if (fd < 0)
         return errno;
+    struct stat st;
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        int e = S_ISDIR(st.st_mode) ? EISDIR : READ_NOT_FILE;
+        close(fd);
+        return e;
+    }
+    FILE *f = fdopen(fd, "rb");
+    if (!f) {
+        close(fd);
+        return errno;
+    }
     size_t cap = 0, n = 0;
     char *buf = NULL;
     int err = 0;
@@ -739,7 +796,7 @@ static int read_whole(const char *path, size_t max, char **data, size_t *len)
         if (n == cap) {
             size_t ncap = cap ? cap * 2 : 65536;
             if (cap > max) {
-                err = -1;
+                err = READ_TOO_LARGE;
                 break;
             }
             char *nb = realloc(buf, ncap);
@@ -760,7 +817,7 @@ static int read_whole(const char *path, size_t max, char **data, size_t *len)
     }
     fclose(f);
     if (!err && n > max)
-        err = -1;
+        err = READ_TOO_LARGE;
     if (err) {
         free(buf);
         return err;
@@ -776,9 +833,11 @@ static int load_map(const options *o, map_input *m)
     char *text;
     size_t len;
     int err = read_whole(o->input, MAPFILE_MAX_YAML_BYTES, &text, &len);
-    if (err < 0)
+    if (err == READ_TOO_LARGE)
         return complain(EXIT_INPUT, "%s: larger than %u bytes: not a map YAML", o->input,
                         MAPFILE_MAX_YAML_BYTES);
+    if (err == READ_NOT_FILE)
+        return complain(EXIT_INPUT, "%s: not a regular file", o->input);
     if (err)
         return complain(EXIT_INPUT, "%s: %s", o->input, strerror(err));
     int bad = mapfile_yaml_parse(&m->yaml, text, len, o->input);
@@ -792,10 +851,15 @@ static int load_map(const options *o, map_input *m)
         return complain(EXIT_INPUT, "out of memory");
     err = read_whole(m->image_path, MAPFILE_MAX_PGM_BYTES, &text, &len);
     if (err) {
-        int rc = err < 0 ? complain(EXIT_INPUT, "%s:%u: image %s: larger than %u bytes", o->input,
-                                    (unsigned)m->yaml.image_line, shown, MAPFILE_MAX_PGM_BYTES)
-                         : complain(EXIT_INPUT, "%s:%u: image %s: %s", o->input,
-                                    (unsigned)m->yaml.image_line, shown, strerror(err));
+        unsigned line = (unsigned)m->yaml.image_line;
+        int rc = err == READ_TOO_LARGE
+                     ? complain(EXIT_INPUT, "%s:%u: image %s: larger than %u bytes", o->input, line,
+                                shown, MAPFILE_MAX_PGM_BYTES)
+                 : err == READ_NOT_FILE
+                     ? complain(EXIT_INPUT, "%s:%u: image %s: not a regular file (a device or a"
+                                            " FIFO): give a PGM file", o->input, line, shown)
+                     : complain(EXIT_INPUT, "%s:%u: image %s: %s", o->input, line, shown,
+                                strerror(err));
         free(shown);
         return rc;
     }
@@ -893,7 +957,7 @@ static int make_map(const options *o, run *r, double t_start, mapout_times *t)
             return complain(EXIT_MEMORY, "memory budget too small: need more than %zu bytes",
                             (size_t)SIZE_MAX);
         if (o->memory_mb > 0 && (double)size > o->memory_mb * 1048576.0)
-            return complain(EXIT_MEMORY, "memory budget too small: need %zu bytes", size);
+            return budget_fail(o, size);
         free(r->block);
         r->block = malloc(size);
         if (!r->block)
@@ -1028,7 +1092,7 @@ static int grid_files(const options *o, run *r, double t_start)
         return complain(EXIT_MEMORY, "memory budget too small: need more than %zu bytes",
                         (size_t)SIZE_MAX);
     if (o->memory_mb > 0 && (double)size > o->memory_mb * 1048576.0)
-        return complain(EXIT_MEMORY, "memory budget too small: need %zu bytes", size);
+        return budget_fail(o, size);
     if (!(r->block = malloc(size)))
         return complain(EXIT_MEMORY, "memory budget too small: need %zu bytes (malloc failed)",
                         size);
@@ -1178,15 +1242,20 @@ int main(int argc, char **argv)
                 rc = make_map(&o, &r, t_start, &t);
         }
     } else {
-        rc = o.command == CMD_GRID ? refuse_options(&o, OPTS_GRID_CMD, "polyc grid")
-             : o.command == CMD_MAP ? refuse_options(&o, ~(unsigned)OPTS_MAP_ONLY, "a laser log")
-                                    : 0;
+        rc = o.command == CMD_GRID      ? refuse_options(&o, OPTS_GRID_CMD, "polyc grid")
+             : o.command == CMD_CONVERT ? refuse_options(&o, OPTS_CONVERT_CMD, "polyc convert")
+                                        : refuse_options(&o, ~(unsigned)OPTS_MAP_ONLY, "a laser log");
         FILE *in = NULL;
         if (!rc) {
             progress_stage("reading the log");
             in = strcmp(o.input, "-") == 0 ? stdin : fopen(o.input, "rb");
+            struct stat st;
             if (!in)
                 rc = complain(EXIT_INPUT, "%s: %s", o.input, strerror(errno));
+            else if (fstat(fileno(in), &st) == 0 && S_ISDIR(st.st_mode))
+                rc = complain(EXIT_INPUT, "%s: %s: give a log file", o.input, strerror(EISDIR));
+            if (rc && in && in != stdin)
+                fclose(in);
         }
         if (!rc) {
             scanlog_opts so = {o.max_range_m};
