@@ -76,18 +76,29 @@ $(BUILD)/tests/%: tests/%.c $(TOOL_OBJ) $(EVAL_OBJ) $(BUILD)/libpolyc.a $(wildca
 unit: $(TEST_BIN) $(BUILD)/polyc
 	@fail=0; for t in $(TEST_BIN); do echo "== $$t"; $$t || fail=1; done; exit $$fail
 
-# What a newcomer and CI run (README.md): dependencies, every suite, the
-# valgrind run and the Cortex-M cross build.
+# What a newcomer and CI run (README.md): dependencies, then every step of
+# CHECK_STEPS, each into build-check/STEP.log: one line per step (the log's
+# tail if it failed), and last a line `N passed, N failed` alone (CI reads it).
+CHECK_STEPS = unit test-cli test-fuzz-replay test-asan test-cxx test-install test-python \
+              test-embedded test-opt-O3 test-opt-Os test-valgrind cross
 check: deps
-	$(MAKE) test
-	$(MAKE) test-opt
-	$(MAKE) test-valgrind
-	$(MAKE) cross
+	@mkdir -p build-check; pass=0; fail=0; \
+	for s in $(CHECK_STEPS); do \
+	  if $(MAKE) --no-print-directory $$s > build-check/$$s.log 2>&1; then \
+	    pass=$$((pass + 1)); echo "ok    $$s"; \
+	  else \
+	    fail=$$((fail + 1)); echo "FAIL  $$s: the end of build-check/$$s.log:"; \
+	    tail -n 40 build-check/$$s.log | sed 's/^/      /'; \
+	  fi; \
+	done; \
+	echo "$$pass passed, $$fail failed"; test $$fail -eq 0
 
 # The unit suites again under other optimisation settings (-O3, -Os -flto).
-.PHONY: test-opt
-test-opt:
+.PHONY: test-opt test-opt-O3 test-opt-Os
+test-opt: test-opt-O3 test-opt-Os
+test-opt-O3:
 	$(MAKE) BUILD=build-O3 OPT='-O3 -g' unit
+test-opt-Os:
 	$(MAKE) BUILD=build-Os OPT='-Os -flto' unit
 deps:
 	sh tools/install-deps.sh
@@ -158,6 +169,7 @@ test-valgrind: $(BUILD)/polyc
 	$(VALGRIND) --error-exitcode=1 $(BUILD)/polyc --stats --iterations 5 -o $(BUILD)/valgrind.svg \
 	    $(BUILD)/valgrind_grid.yaml
 	printf 'SCAN 0 0 0 0 0.1 0.05 4 3 1 1 1\nSCAN 0 0 0 0 0.1 0.05 4 3 1 x 1\n' > $(BUILD)/valgrind_bad.log
+	@echo "test-valgrind: a bad log; the error line that follows is expected (exit 1)"
 	$(VALGRIND) --error-exitcode=99 $(BUILD)/polyc -o $(BUILD)/valgrind.svg $(BUILD)/valgrind_bad.log; \
 	    test $$? = 1
 	rm -f $(BUILD)/valgrind.svg $(BUILD)/valgrind.txt $(BUILD)/valgrind_bad.log $(BUILD)/valgrind_grid.*
