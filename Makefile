@@ -258,6 +258,23 @@ sweep:
 $(BUILD)/sweep: tools/eval/sweep.c $(EVAL_OBJ) $(TOOL_OBJ) $(BUILD)/libpolyc.a
 	$(CC) $(EVAL_CFLAGS) $^ -o $@ $(LDLIBS)
 
+# The README's pictures (docs/img/*.png but corridor.png, which is `make
+# sweep`'s): the tool's SVGs, from the bench build, rendered 700 px wide by
+# rsvg-convert (librsvg2-bin). intel.log is read from DATA.
+# `make images DATA=../shared/data`
+IMG_DIR = build-bench/img
+.PHONY: images
+images:
+	$(MAKE) BUILD=build-bench OPT='-O3 -march=native -DNDEBUG' build-bench/polyc
+	@mkdir -p $(IMG_DIR)
+	build-bench/polyc -o $(IMG_DIR)/office.svg examples/office.log
+	build-bench/polyc grid --cell 0.05 -o $(IMG_DIR)/office examples/office.log
+	build-bench/polyc --grid -o $(IMG_DIR)/office-map.svg $(IMG_DIR)/office.yaml
+	build-bench/polyc --no-optimize -o $(IMG_DIR)/intel-initial.svg $(DATA)/carmen/intel.log
+	build-bench/polyc -o $(IMG_DIR)/intel-optimised.svg $(DATA)/carmen/intel.log
+	for f in office office-map intel-initial intel-optimised; do \
+	    rsvg-convert -w 700 -o docs/img/$$f.png $(IMG_DIR)/$$f.svg || exit 1; done
+
 # Regenerate the bundled example (examples/office.*) with the simulator
 .PHONY: examples
 examples: $(BUILD)/gen_example

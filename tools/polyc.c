@@ -39,7 +39,8 @@ enum {
     OPT_ITERATIONS = 1u << 4, OPT_MAX_RANGE = 1u << 5, OPT_MEMORY = 1u << 6, OPT_CELL = 1u << 7,
     OPT_THRESHOLD = 1u << 8, OPT_ALPHA = 1u << 9, OPT_GAMMA = 1u << 10, OPT_OCCUPIED = 1u << 11,
     OPT_FREE = 1u << 12, OPT_STATS = 1u << 13, OPT_NO_OPTIMIZE = 1u << 14, OPT_EXACT = 1u << 15,
-    OPT_GRID_TRACE = 1u << 16, OPT_POINTS = 1u << 17, OPT_GRID = 1u << 18, OPT_VERTICES = 1u << 19
+    OPT_GRID_TRACE = 1u << 16, OPT_POINTS = 1u << 17, OPT_GRID = 1u << 18, OPT_VERTICES = 1u << 19,
+    OPT_COLOR_LINES = 1u << 20
 };
 static const struct {
     const char *name;
@@ -52,7 +53,7 @@ static const struct {
     {"--occupied-thresh", OPT_OCCUPIED}, {"--free-thresh", OPT_FREE}, {"--stats", OPT_STATS},
     {"--no-optimize", OPT_NO_OPTIMIZE}, {"--exact-points", OPT_EXACT},
     {"--grid-trace", OPT_GRID_TRACE}, {"--points", OPT_POINTS}, {"--grid", OPT_GRID},
-    {"--vertices", OPT_VERTICES},
+    {"--vertices", OPT_VERTICES},     {"--color-lines", OPT_COLOR_LINES},
 };
 /* what applies where */
 #define OPTS_LOG_ONLY (OPT_CELL | OPT_THRESHOLD | OPT_MAX_RANGE | OPT_EXACT | OPT_GRID_TRACE | OPT_POINTS)
@@ -67,7 +68,7 @@ typedef struct options {
     enum command command;
     enum format format;
     unsigned given;            /* OPT_* bits of the options on the command line */
-    int stats, no_optimize, points, grid, vertices, quiet;
+    int stats, no_optimize, points, grid, vertices, color_lines, quiet;
     double max_range_m;        /* 0: detect */
     double memory_mb;          /* 0: no cap */
     polyc_config config;
@@ -109,6 +110,7 @@ static const char usage_text[] =
     "                          over 2 s: stage, iteration, vertices, BIC)\n"
     "  --points, --grid, --vertices\n"
     "                          SVG layers: scan endpoints, grid cells, vertex dots\n"
+    "  --color-lines           SVG: a colour per polyline (default: one for the map)\n"
     "  --help, --version\n"
     "exit codes: 0 ok, 1 bad input or other failure, 2 usage, 3 memory budget too small\n";
 
@@ -297,6 +299,8 @@ static int set_flag(options *o, const char *name)
         o->grid = 1;
     else if (strcmp(name, "--vertices") == 0)
         o->vertices = 1;
+    else if (strcmp(name, "--color-lines") == 0)
+        o->color_lines = 1;
     else
         return -1;
     return 0;
@@ -1056,6 +1060,10 @@ static int make_map(const options *o, run *r, double t_start, mapout_times *t)
     map.grid = o->grid ? ctx : NULL;
     map.contour_threshold = cfg.contour_threshold;
     map.vertices = o->vertices;
+    map.color_lines = o->color_lines;
+    map.title = input_name(o);
+    map.cell_m = r->map ? r->map->yaml.resolution_m : (double)cfg.cell_m;
+    map.total_ms = now_ms() - t_start;
     if (membuf_open(&r->out))
         return EXIT_INPUT;
     int bad = o->format == FORMAT_JSON  ? mapout_json(r->out.f, &map)
