@@ -1,6 +1,7 @@
 /* mapout.c - the map out of the library, into a file.
  * Takes: polylines (and optionally stats, scans, the grid).
- * Gives: JSON, SVG (y up, scale bar, optional layers) or TXT on a FILE. */
+ * Gives: JSON, SVG (y up; title, axes, scale bar, legend, optional layers)
+ * or TXT on a FILE. */
 #include "mapout.h"
 
 #include <math.h>
