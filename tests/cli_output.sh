@@ -119,6 +119,16 @@ run -o /dev/stdout "$LOG"
 count=$((count + 1))
 "$POLYC" -o /dev/stdout "$LOG" 2> err.txt | cat > piped.svg
 is_svg piped.svg || bad "-o /dev/stdout into a pipe"
+name=dev-stdout-append
+echo first > all.txt
+count=$((count + 1))
+"$POLYC" --format txt -o /dev/stdout "$LOG" >> all.txt 2> err.txt
+[ "$(head -n 1 all.txt)" = first ] && grep -qE '^(open|closed) ' all.txt \
+    || bad "-o /dev/stdout did not append to a file opened with >>"
+name=dev-fd
+count=$((count + 1))
+"$POLYC" -o /dev/fd/3 "$LOG" 3> fd3.svg 2> err.txt
+is_svg fd3.svg || bad "-o /dev/fd/3 did not write descriptor 3"
 name=trace-dev-null
 run --iterations 2 --trace /dev/null -o t.svg "$LOG"
 [ $rc -eq 0 ] && is_svg t.svg || bad "exit $rc for --trace /dev/null"

@@ -85,6 +85,24 @@ static int is_magic(const char *p)
            strcmp(p, "/dev/stderr") == 0;
 }
 
+/* The descriptor of this process that a magic name stands for
+ * (/dev/stdout, /dev/fd/N, /proc/self/fd/N), or -1. */
+static int own_fd(const char *p)
+{
+    if (strcmp(p, "/dev/stdout") == 0)
+        return STDOUT_FILENO;
+    if (strcmp(p, "/dev/stderr") == 0)
+        return STDERR_FILENO;
+    const char *n = strncmp(p, "/dev/fd/", 8) == 0         ? p + 8
+                    : strncmp(p, "/proc/self/fd/", 14) == 0 ? p + 14
+                                                            : NULL;
+    if (!n || *n < '0' || *n > '9')
+        return -1;
+    char *end;
+    long fd = strtol(n, &end, 10);
+    return *end || fd > INT_MAX ? -1 : (int)fd;
+}
+
 /* The folder part of p ("" or up to its last '/'), with s appended. */
 static char *in_dir_of(const char *p, const char *s)
 {
@@ -202,6 +220,7 @@ int outfile_prepare(outfile *o, const char *path, const char *data, size_t len, 
     o->data = data;
     o->len = len;
     o->slot = -1;
+    o->fd = -1;
     *what = NULL;
     if (!path || strcmp(path, "-") == 0) {
         o->kind = OUTFILE_STDOUT;
@@ -216,6 +235,7 @@ int outfile_prepare(outfile *o, const char *path, const char *data, size_t len, 
         return EISDIR;
     if (is_magic(o->target) || (exists && !S_ISREG(st.st_mode))) {
         o->kind = OUTFILE_IN_PLACE;
+        o->fd = own_fd(o->target);     /* written as is: a shell's >> stays an append */
         return 0;
     }
     o->kind = OUTFILE_REPLACE;
@@ -268,8 +288,14 @@ int outfile_commit(outfile *o)
 {
     int err = 0;
     if (o->kind == OUTFILE_STDOUT) {
+        errno = 0;
         if (fwrite(o->data, 1, o->len, stdout) != o->len || fflush(stdout) != 0)
             err = errno ? errno : EIO;
+    } else if (o->kind == OUTFILE_IN_PLACE && o->fd >= 0) {
+        if (o->fd == STDOUT_FILENO && fflush(stdout) != 0)
+            err = errno;
+        if (!err)
+            err = write_all(o->fd, o->data, o->len);
     } else if (o->kind == OUTFILE_IN_PLACE) {
         struct stat st;
         int trunc = stat(o->target, &st) == 0 && S_ISREG(st.st_mode) ? O_TRUNC : 0;

@@ -12,7 +12,8 @@
 enum outfile_kind {
     OUTFILE_STDOUT,            /* "-" */
     OUTFILE_REPLACE,           /* a regular file or a new name: temp + rename */
-    OUTFILE_IN_PLACE           /* a device, a FIFO, /dev/stdout: opened and written */
+    OUTFILE_IN_PLACE           /* a device, a FIFO: opened and written; /dev/stdout,
+                                  /dev/fd/N: that descriptor written */
 };
 
 typedef struct outfile {
@@ -23,6 +24,8 @@ typedef struct outfile {
     size_t len;
     char *tmp;                 /* OUTFILE_REPLACE: the prepared temporary file */
     int slot;                  /* its place in the signal handlers' list, or -1 */
+    int fd;                    /* OUTFILE_IN_PLACE: this process's descriptor that the
+                                  name stands for (/dev/stdout: 1), written as is; or -1 */
 } outfile;
 
 /* Catches SIGINT, SIGTERM and SIGHUP (unless ignored when the program
