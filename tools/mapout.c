@@ -370,7 +370,8 @@ static void svg_axes(FILE *f, const view *v)
     double l = px_x(v, v->x0), r = px_x(v, v->x1), t = px_y(v, v->y1), b = px_y(v, v->y0);
     char label[32];
     fprintf(f, "<g id=\"axes\" " SVG_FONT " font-size=\"%.1f\">\n"
-               "<path fill=\"none\" stroke=\"#b0b0b0\" stroke-width=\"1\" d=\"M%.2f %.2fH%.2fV%.2fH%.2fZ",
+               "<path fill=\"none\" stroke=\"#b0b0b0\" stroke-width=\"1\""
+               " d=\"M%.2f %.2fH%.2fV%.2fH%.2fZ",
             v->small, l, t, r, b, l);
     for (double x = ceil(v->x0 / v->tick_m) * v->tick_m; x <= v->x1; x += v->tick_m)
         fprintf(f, "M%.2f %.2fv5", px_x(v, x), b);
@@ -426,7 +427,8 @@ static void svg_legend(FILE *f, const mapout_map *map, const view *v)
             fprintf(f, "<path stroke=\"%s\" stroke-width=\"%.2f\" d=\"M%.2f %.2fh%.2f\"/>\n",
                     palette[k], v->stroke, x + k * sw / 3, mid, sw / 3);
     else
-        fprintf(f, "<path stroke=\"" SVG_LINE_COLOUR "\" stroke-width=\"%.2f\" d=\"M%.2f %.2fh%.2f\"/>\n",
+        fprintf(f, "<path stroke=\"" SVG_LINE_COLOUR "\" stroke-width=\"%.2f\""
+                   " d=\"M%.2f %.2fh%.2f\"/>\n",
                 v->stroke, x, mid, sw);
     fprintf(f, "<text x=\"%.2f\" y=\"%.2f\">polylines%s</text>\n", tx, y,
             map->color_lines ? " (a colour each)" : "");

@@ -386,7 +386,8 @@ static int config_fail(const char *why)
         size_t k = 0, len = 0;
         for (; k < sizeof names / sizeof names[0]; k++) {
             len = strlen(names[k][0]);
-            if (strncmp(why, names[k][0], len) == 0 && !(why[len] == '_' || isalnum((unsigned char)why[len])))
+            if (strncmp(why, names[k][0], len) == 0 && why[len] != '_' &&
+                !isalnum((unsigned char)why[len]))   /* a whole name */
                 break;
         }
         if (k < sizeof names / sizeof names[0]) {
@@ -500,10 +501,10 @@ static int write_outputs(const char *const *paths, const membuf *const *bufs, si
     outfile *ptr[2];
     const char *what = NULL;
     int err = 0;
-    size_t i, made = 0;
-    for (i = 0; i < n && i < 2 && !err; i++, made++) {
-        ptr[i] = &of[i];
-        err = outfile_prepare(&of[i], paths[i], bufs[i]->data, bufs[i]->len, &what);
+    size_t made = 0;
+    for (; made < n && made < 2 && !err; made++) {
+        ptr[made] = &of[made];
+        err = outfile_prepare(&of[made], paths[made], bufs[made]->data, bufs[made]->len, &what);
     }
     if (err) {
         for (size_t j = 0; j < made; j++)
@@ -579,7 +580,6 @@ static char *printable(const char *s)
     out[o] = '\0';
     return out;
 }
-
 
 static void print_input_stats(const scanlog *log)
 {
@@ -1252,7 +1252,8 @@ int main(int argc, char **argv)
     } else {
         rc = o.command == CMD_GRID      ? refuse_options(&o, OPTS_GRID_CMD, "polyc grid")
              : o.command == CMD_CONVERT ? refuse_options(&o, OPTS_CONVERT_CMD, "polyc convert")
-                                        : refuse_options(&o, ~(unsigned)OPTS_MAP_ONLY, "a laser log");
+                                        : refuse_options(&o, ~(unsigned)OPTS_MAP_ONLY,
+                                                         "a laser log");
         FILE *in = NULL;
         if (!rc) {
             progress_stage("reading the log");
