@@ -76,18 +76,29 @@ $(BUILD)/tests/%: tests/%.c $(TOOL_OBJ) $(EVAL_OBJ) $(BUILD)/libpolyc.a $(wildca
 unit: $(TEST_BIN) $(BUILD)/polyc
 	@fail=0; for t in $(TEST_BIN); do echo "== $$t"; $$t || fail=1; done; exit $$fail
 
-# What a newcomer and CI run (README.md): dependencies, every suite, the
-# valgrind run and the Cortex-M cross build.
+# What a newcomer and CI run (README.md): dependencies, then every step of
+# CHECK_STEPS, each into build-check/STEP.log: one line per step (the log's
+# tail if it failed), and last a line `N passed, N failed` alone (CI reads it).
+CHECK_STEPS = unit test-cli test-fuzz-replay test-asan test-cxx test-install test-python \
+              test-embedded test-opt-O3 test-opt-Os test-valgrind cross
 check: deps
-	$(MAKE) test
-	$(MAKE) test-opt
-	$(MAKE) test-valgrind
-	$(MAKE) cross
+	@mkdir -p build-check; pass=0; fail=0; \
+	for s in $(CHECK_STEPS); do \
+	  if $(MAKE) --no-print-directory $$s > build-check/$$s.log 2>&1; then \
+	    pass=$$((pass + 1)); echo "ok    $$s"; \
+	  else \
+	    fail=$$((fail + 1)); echo "FAIL  $$s: the end of build-check/$$s.log:"; \
+	    tail -n 40 build-check/$$s.log | sed 's/^/      /'; \
+	  fi; \
+	done; \
+	echo "$$pass passed, $$fail failed"; test $$fail -eq 0
 
 # The unit suites again under other optimisation settings (-O3, -Os -flto).
-.PHONY: test-opt
-test-opt:
+.PHONY: test-opt test-opt-O3 test-opt-Os
+test-opt: test-opt-O3 test-opt-Os
+test-opt-O3:
 	$(MAKE) BUILD=build-O3 OPT='-O3 -g' unit
+test-opt-Os:
 	$(MAKE) BUILD=build-Os OPT='-Os -flto' unit
 deps:
 	sh tools/install-deps.sh
@@ -148,7 +159,8 @@ $(BUILD)/footprint8: examples/footprint.c $(EMB_OBJ)
 	$(CC) $(WARN) $(OPT) $(CFLAGS) -Iinclude $^ -o $@ $(LDLIBS)
 
 # Robustness (docs/security.md). test-cli: every bad input of the tool
-# (tests/cli_bad_input.sh). test-fuzz-replay: the committed fuzz corpus through
+# (tests/cli_bad_input.sh) and where it writes (tests/cli_output.sh: as root,
+# also as an ordinary user). test-fuzz-replay: the committed fuzz corpus through
 # the fuzz targets, built with $(CC). test-asan: unit tests, corpus replay and
 # the quick bad-input tests again in build-asan/ under ASan and UBSan.
 # test-valgrind: the tool over a sample log, its grid as a ROS map and a bad
@@ -163,6 +175,7 @@ test-fuzz-replay: $(FUZZ_REPLAY)
 CLI_TEST_ARGS ?=
 test-cli: $(BUILD)/polyc
 	tests/cli_bad_input.sh $(CLI_TEST_ARGS) $(BUILD)/polyc
+	tests/cli_output.sh $(BUILD)/polyc
 SAN_LIST  = address,undefined,float-cast-overflow
 SAN_FLAGS = -fsanitize=$(SAN_LIST) -fno-sanitize-recover=all
 test-asan:
@@ -179,6 +192,7 @@ test-valgrind: $(BUILD)/polyc
 	$(VALGRIND) --error-exitcode=1 $(BUILD)/polyc --stats --iterations 5 -o $(BUILD)/valgrind.svg \
 	    $(BUILD)/valgrind_grid.yaml
 	printf 'SCAN 0 0 0 0 0.1 0.05 4 3 1 1 1\nSCAN 0 0 0 0 0.1 0.05 4 3 1 x 1\n' > $(BUILD)/valgrind_bad.log
+	@echo "test-valgrind: a bad log; the error line that follows is expected (exit 1)"
 	$(VALGRIND) --error-exitcode=99 $(BUILD)/polyc -o $(BUILD)/valgrind.svg $(BUILD)/valgrind_bad.log; \
 	    test $$? = 1
 	rm -f $(BUILD)/valgrind.svg $(BUILD)/valgrind.txt $(BUILD)/valgrind_bad.log $(BUILD)/valgrind_grid.*
@@ -269,6 +283,23 @@ sweep:
 	build-bench/sweep $(SWEEP_ARGS)
 $(BUILD)/sweep: tools/eval/sweep.c $(EVAL_OBJ) $(TOOL_OBJ) $(BUILD)/libpolyc.a
 	$(CC) $(EVAL_CFLAGS) $^ -o $@ $(LDLIBS)
+
+# The README's pictures (docs/img/*.png but corridor.png, which is `make
+# sweep`'s): the tool's SVGs, from the bench build, rendered 700 px wide by
+# rsvg-convert (librsvg2-bin). intel.log is read from DATA.
+# `make images DATA=../shared/data`
+IMG_DIR = build-bench/img
+.PHONY: images
+images:
+	$(MAKE) BUILD=build-bench OPT='-O3 -march=native -DNDEBUG' build-bench/polyc
+	@mkdir -p $(IMG_DIR)
+	build-bench/polyc -o $(IMG_DIR)/office.svg examples/office.log
+	build-bench/polyc grid --cell 0.05 -o $(IMG_DIR)/office examples/office.log
+	build-bench/polyc --grid -o $(IMG_DIR)/office-map.svg $(IMG_DIR)/office.yaml
+	build-bench/polyc --no-optimize -o $(IMG_DIR)/intel-initial.svg $(DATA)/carmen/intel.log
+	build-bench/polyc -o $(IMG_DIR)/intel-optimised.svg $(DATA)/carmen/intel.log
+	for f in office office-map intel-initial intel-optimised; do \
+	    rsvg-convert -w 700 -o docs/img/$$f.png $(IMG_DIR)/$$f.svg || exit 1; done
 
 # Regenerate the bundled example (examples/office.*) with the simulator
 .PHONY: examples

@@ -1,7 +1,8 @@
 #!/bin/sh
 # install_test.sh - `make install` into a temporary prefix, then a small C
 # program built against the installed copy with `pkg-config --cflags --libs
-# polyc` must compile, load the installed libpolyc.so and map a scan. Also
+# polyc` must compile, load the installed libpolyc.so (found through the
+# rpath that polyc.pc gives, without LD_LIBRARY_PATH) and map a scan. Also
 # checks that libpolyc.so exports the polyc_ API and nothing else.
 # usage: tests/install_test.sh MAKE BUILD
 set -eu
@@ -61,8 +62,9 @@ export PKG_CONFIG_PATH="$prefix/lib/pkgconfig"
 flags=$(pkg-config --cflags --libs polyc) || fail "pkg-config does not know polyc"
 # shellcheck disable=SC2086 # the flags are words
 $cc -std=c99 -Wall -Wextra -Werror "$tmp/use.c" -o "$tmp/use" $flags -lm || fail "compile with: $flags"
-LD_LIBRARY_PATH="$prefix/lib" ldd "$tmp/use" | grep -q "$prefix/lib/$soname" ||
-    fail "the program does not load the installed $soname"
-LD_LIBRARY_PATH="$prefix/lib" "$tmp/use" || fail "the program failed"
+# as a user runs it: no LD_LIBRARY_PATH, no ldconfig (polyc.pc's rpath)
+env -u LD_LIBRARY_PATH ldd "$tmp/use" | grep -q "$prefix/lib/$soname" ||
+    fail "the program does not load the installed $soname without LD_LIBRARY_PATH"
+env -u LD_LIBRARY_PATH "$tmp/use" || fail "the program failed"
 "$prefix/bin/polyc" --version >/dev/null || fail "installed polyc does not run"
 echo "install_test: ok: $(pkg-config --modversion polyc), $flags, $soname"

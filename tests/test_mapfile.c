@@ -477,7 +477,7 @@ static void test_convert_scale_and_raw(void **state)
     /* in between: rint((p - free) / (occ - free) * 100), p = (255 - v) / 255 */
     for (uint32_t v = 90; v <= 191; v++) {
         double p = (255.0 - v) / 255.0;
-        int8_t want = p > 0.65 ? 100 : p < 0.25 ? 0 : (int8_t)rint((p - 0.25) / 0.4 * 100.0);
+        int8_t want = (int8_t)(p > 0.65 ? 100.0 : p < 0.25 ? 0.0 : rint((p - 0.25) / 0.4 * 100.0));
         assert_int_equal(mapfile_cell_value(v, 255, &y), want);
     }
     assert_int_equal(mapfile_cell_value(128, 255, &y), 62);    /* p 0.498: 62.0 */

@@ -231,15 +231,42 @@ static void test_svg(void **state)
     first_path_points(out, "<g id=\"polylines\"", &x0, &y0, &x1, &y1);
     assert_true(x1 > x0);
     assert_true(fabs(y1 - y0) < 1e-9);
-    first_path_points(out, "<path stroke=\"#2471a3\"", &cx0, &cy0, &cx1, &cy1);
+    /* one colour for the map: the closed polyline is the second path */
+    assert_null(strstr(out, "<path stroke=\"#2471a3\""));
+    assert_null(strstr(out, "<path stroke=\"#c0392b\""));
+    const char *second = strstr(strstr(out, "<g id=\"polylines\""), "<path stroke=\"#17407a\"");
+    assert_non_null(second);
+    first_path_points(second + 1, "<path stroke=\"#17407a\"", &cx0, &cy0, &cx1, &cy1);
     assert_true(cy0 < y0);
     assert_non_null(strstr(out, " Z\"/>"));             /* closed: Z */
-    assert_non_null(strstr(out, "<path stroke=\"#c0392b\""));   /* distinct colours */
     assert_null(strstr(out, " 0 1 0 "));              /* no vertex dots unless asked */
+    /* a title block, axes in metres, the origin (in view), a legend of the
+     * polylines only; no time unless given */
+    assert_non_null(strstr(out, "<g id=\"title\""));
+    assert_non_null(strstr(out, ">polyc map</text>"));
+    assert_non_null(strstr(out, ">2 polylines, 5 vertices</text>"));
+    assert_null(strstr(out, "id=\"time\""));
+    assert_non_null(strstr(out, "<g id=\"axes\""));
+    assert_non_null(strstr(out, " m</text>"));
+    assert_non_null(strstr(out, "<g id=\"origin\""));
+    assert_non_null(strstr(out, ">polylines</text>"));
+    assert_null(strstr(out, ">vertices</text>"));
     free(out);
+    m.color_lines = 1;                                /* a colour per polyline */
+    m.title = "some/dir/a<b>&\033.log";
+    m.cell_m = 0.05;
+    m.total_ms = 1234.0;
+    out = render(mapout_svg, &m);
+    assert_non_null(strstr(out, "<path stroke=\"#2471a3\""));
+    assert_non_null(strstr(out, ">a?b???.log</text>"));  /* the file name, XML-safe */
+    assert_non_null(strstr(out, ">2 polylines, 5 vertices, cells of 0.05 m</text>"));
+    assert_non_null(strstr(out, ">made in 1.23 s</text>"));
+    free(out);
+    m.color_lines = 0;
     m.vertices = 1;
     out = render(mapout_svg, &m);
     assert_non_null(strstr(out, " 0 1 0 "));
+    assert_non_null(strstr(out, ">vertices</text>"));
     free(out);
 }
 
@@ -265,6 +292,7 @@ static void test_svg_points_and_empty(void **state)
     for (const char *q = p; (q = strstr(q, "h1v1h-1z")) != NULL; q++)
         squares++;
     assert_int_equal(squares, 2);
+    assert_non_null(strstr(out, ">scan endpoints</text>"));
     free(out);
     m.scans = NULL;                                      /* nothing at all */
     out = render(mapout_svg, &m);
@@ -326,6 +354,14 @@ static void test_svg_grid(void **state)
         assert_int_equal(*p, '"');
         assert_true(squares > 10);          /* the wall is 2 x 2 tan(72.5 deg) m long */
     }
+    assert_non_null(strstr(out, ">occupied grid cells</text>"));
+    assert_non_null(strstr(out, ">contour cells</text>"));
+    /* the canvas follows the cells drawn (the wall at x = 2 m), not the
+     * whole grid: the view (a tenth of the wall's length wide) is near x = 2 m */
+    double x0, x1, y0, y1;
+    assert_int_equal(sscanf(strstr(out, "<!-- polyc map: "), "<!-- polyc map: x %lf..%lf m, y %lf..%lf m",
+                            &x0, &x1, &y0, &y1), 4);
+    assert_true(x0 > 1.0 && x1 < 3.0);                 /* the grid starts at the pose, x = 0 */
     free(out);
     free(block);
 }

@@ -429,8 +429,10 @@ static void test_errors(void **state)
     EXPECT_ERROR("ODOM 1\nFL\001ASER 1 2\n", "t.log:2: binary data (byte 0x01 at column 3)");
     EXPECT_ERROR("ODOM 1\nFLASER\0 1 2\n", "t.log:2: binary data (byte 0x00 at column 7)");
     EXPECT_ERROR("\x89PNG\r\n", "t.log:1: not a log line: starts with '\\x89PNG'");
-    EXPECT_ERROR("", "t.log: no scans found (0 lines read)");
-    EXPECT_ERROR("# only\nODOM 1\n", "t.log: no scans found (2 lines read)");
+    EXPECT_ERROR("", "t.log: no scans found (0"
+                     " lines read; polyc reads CARMEN FLASER and ROBOTLASER1 lines, polyc's SCAN lines, or a map_server map YAML)");
+    EXPECT_ERROR("# only\nODOM 1\n", "t.log: no scans found (2"
+                     " lines read; polyc reads CARMEN FLASER and ROBOTLASER1 lines, polyc's SCAN lines, or a map_server map YAML)");
 }
 
 /* Every scan read is one the library accepts (fuzz_scanlog findings): the

@@ -863,7 +863,9 @@ int8_t mapfile_cell_value(uint32_t sample, uint32_t maxval, const mapfile_yaml *
     double shade = (double)sample / (double)maxval;     /* 0 black .. 1 white */
     if (y->mode == MAPFILE_RAW) {
         double v = round(shade * 255.0);
-        return v >= 0.0 && v <= 100.0 ? (int8_t)v : -1;
+        if (v >= 0.0 && v <= 100.0)
+            return (int8_t)v;
+        return -1;
     }
     double occ = y->negate ? shade : 1.0 - shade;
     if (y->occupied_thresh < occ)

@@ -1,6 +1,7 @@
 /* mapout.c - the map out of the library, into a file.
  * Takes: polylines (and optionally stats, scans, the grid).
- * Gives: JSON, SVG (y up, scale bar, optional layers) or TXT on a FILE. */
+ * Gives: JSON, SVG (y up; title, axes, scale bar, legend, optional layers)
+ * or TXT on a FILE. */
 #include "mapout.h"
 
 #include <math.h>
@@ -96,26 +97,36 @@ int mapout_json(FILE *f, const mapout_map *map)
 /* ---- SVG ---- */
 
 #define SVG_MARGIN_PX 24.0
-#define SVG_FOOTER_PX 60.0             /* room for the scale bar */
 #define SVG_PX_PER_M 40.0              /* preferred scale, clamped by: */
 #define SVG_MIN_SIDE_PX 600.0
 #define SVG_MAX_SIDE_PX 4000.0
+#define SVG_CHAR_EM 0.6                /* a sans-serif character's width, in font sizes */
+#define SVG_LINE_COLOUR "#17407a"      /* the map, unless --color-lines: dark blue */
+#define SVG_INK "#404040"              /* text, axes, the origin */
+#define SVG_FONT "font-family=\"sans-serif\" fill=\"" SVG_INK "\""
 
-/* Distinct colours, cycled over the polylines. */
+/* --color-lines: distinct colours, cycled over the polylines. */
 static const char *const palette[] = {"#c0392b", "#2471a3", "#229954", "#d68910", "#7d3c98",
                                       "#17a589", "#a04000", "#e74c8c", "#2e4053", "#b7950b"};
+#define PALETTE_SIZE (sizeof palette / sizeof palette[0])
+static const char *const grid_fill[2] = {"#bcd0ea", "#f0a04b"};   /* occupied, contour */
 
 typedef struct view {
     double x0, y0, x1, y1;             /* metres shown */
     double scale;                      /* px per metre */
-    double width, height;              /* px */
+    double left, top;                  /* px: the map area's top left corner */
+    double width, height;              /* px: the whole picture */
     double stroke;                     /* line width, px */
-    double font;                       /* label size, px */
+    double font, small;                /* title and label sizes, px */
+    double tick_m;                     /* axis ticks, metres apart */
+    double footer;                     /* px: y of the scale bar */
+    char title[96], subtitle[96];
+    int legend_rows;
 } view;
 
-static double px_x(const view *v, double x) { return SVG_MARGIN_PX + (x - v->x0) * v->scale; }
+static double px_x(const view *v, double x) { return v->left + (x - v->x0) * v->scale; }
 /* SVG's y grows downwards; maps have y up. */
-static double px_y(const view *v, double y) { return SVG_MARGIN_PX + (v->y1 - y) * v->scale; }
+static double px_y(const view *v, double y) { return v->top + (v->y1 - y) * v->scale; }
 
 static void box_add(view *v, double x, double y)
 {
@@ -139,13 +150,62 @@ static int endpoint(const polyc_scan *s, uint32_t j, double *x, double *y)
     return 1;
 }
 
+/* The --grid layer's cell (ix, iy): bit 0 occupied, bit 1 contour. */
+static unsigned grid_bits(const mapout_map *map, uint32_t ix, uint32_t iy)
+{
+    uint32_t hits, misses, contour;
+    if (polyc_grid_cell(map->grid, ix, iy, &hits, &misses, &contour) != POLYC_OK)
+        return 0;
+    unsigned b = 0;
+    if (hits && (double)hits > (double)map->contour_threshold * ((double)hits + misses))
+        b |= 1;
+    if (contour)
+        b |= 2;
+    return b;
+}
+
+/* A round length of at most `target` metres: 1, 2 or 5 times a power of 10. */
+static double nice_length(double target)
+{
+    double p = pow(10, floor(log10(target)));
+    if (5 * p <= target)
+        return 5 * p;
+    if (2 * p <= target)
+        return 2 * p;
+    return p;
+}
+
+/* An axis label: t rounded to the tick spacing. */
+static int tick_label(char *buf, size_t n, double t, double step)
+{
+    double r = round(t / step) * step;
+    return snprintf(buf, n, "%g", fabs(r) < step * 1e-6 ? 0.0 : r);
+}
+
+/* name's last path component, at most n - 1 bytes, safe as XML text:
+ * markup characters and bytes outside printable ASCII become '?'. */
+static void xml_name(char *out, size_t n, const char *name)
+{
+    const char *slash = name ? strrchr(name, '/') : NULL;
+    const char *s = slash ? slash + 1 : name ? name : "";
+    size_t o = 0;
+    for (; *s && o + 1 < n; s++) {
+        unsigned char c = (unsigned char)*s;
+        out[o++] = c < 0x20 || c >= 0x7f || c == '<' || c == '>' || c == '&' ? '?' : (char)c;
+    }
+    out[o] = '\0';
+}
+
 static void make_view(const mapout_map *map, view *v)
 {
     v->x0 = v->y0 = HUGE_VAL;
     v->x1 = v->y1 = -HUGE_VAL;
-    for (uint32_t i = 0; i < map->line_count; i++)
+    uint64_t vertices = 0;
+    for (uint32_t i = 0; i < map->line_count; i++) {
+        vertices += map->lines[i].point_count;
         for (uint32_t j = 0; j < map->lines[i].point_count; j++)
             box_add(v, (double)map->lines[i].xy_m[2 * j], (double)map->lines[i].xy_m[2 * j + 1]);
+    }
     for (uint32_t i = 0; map->scans && i < map->scan_count; i++) {
         double x, y;
         for (uint32_t j = 0; j < map->scans[i].beam_count; j++)
@@ -155,10 +215,14 @@ static void make_view(const mapout_map *map, view *v)
     double gx, gy;
     float cell_m;
     uint32_t gw, gh;
-    if (map->grid && polyc_grid_info(map->grid, &gx, &gy, &cell_m, &gw, &gh) == POLYC_OK &&
-        gw && gh) {
-        box_add(v, gx, gy);
-        box_add(v, gx + gw * (double)cell_m, gy + gh * (double)cell_m);
+    if (map->grid && polyc_grid_info(map->grid, &gx, &gy, &cell_m, &gw, &gh) == POLYC_OK) {
+        double c = (double)cell_m;     /* the cells drawn, not the whole grid */
+        for (uint32_t iy = 0; iy < gh; iy++)
+            for (uint32_t ix = 0; ix < gw; ix++)
+                if (grid_bits(map, ix, iy)) {
+                    box_add(v, gx + ix * c, gy + iy * c);
+                    box_add(v, gx + (ix + 1) * c, gy + (iy + 1) * c);
+                }
     }
     if (!(v->x0 <= v->x1)) {           /* nothing to show */
         v->x0 = v->y0 = -0.5;
@@ -166,8 +230,9 @@ static void make_view(const mapout_map *map, view *v)
     }
     /* No side thinner than a tenth of the other (a single straight wall). */
     double side = fmax(fmax(v->x1 - v->x0, v->y1 - v->y0), 1e-3);
-    double padx = fmax(0, side / 10 - (v->x1 - v->x0)) / 2;
-    double pady = fmax(0, side / 10 - (v->y1 - v->y0)) / 2;
+    /* and 2 % of air inside the frame */
+    double padx = fmax(0, side / 10 - (v->x1 - v->x0)) / 2 + side / 50;
+    double pady = fmax(0, side / 10 - (v->y1 - v->y0)) / 2 + side / 50;
     v->x0 -= padx;
     v->x1 += padx;
     v->y0 -= pady;
@@ -177,8 +242,37 @@ static void make_view(const mapout_map *map, view *v)
     /* Big pictures are mostly viewed shrunk to a screen: thicker lines. */
     v->stroke = fmin(fmax(long_px / 800, 1.5), 3.0);
     v->font = fmin(fmax(long_px / 60, 14), 48);
-    v->width = ceil(2 * SVG_MARGIN_PX + (v->x1 - v->x0) * v->scale);
-    v->height = ceil(2 * SVG_MARGIN_PX + (v->y1 - v->y0) * v->scale + SVG_FOOTER_PX);
+    v->small = 0.75 * v->font;
+    v->tick_m = nice_length(side / 4);
+
+    /* the title block: the source, the map's size, its cells */
+    char name[64];
+    xml_name(name, sizeof name, map->title);
+    snprintf(v->title, sizeof v->title, "%s", *name ? name : "polyc map");
+    int n = snprintf(v->subtitle, sizeof v->subtitle, "%u polylines, %llu vertices",
+                     (unsigned)map->line_count, (unsigned long long)vertices);
+    if (map->cell_m > 0 && n > 0 && (size_t)n < sizeof v->subtitle)
+        n += snprintf(v->subtitle + n, sizeof v->subtitle - (size_t)n, ", cells of %g m",
+                      map->cell_m);
+    if (map->stats && map->stats->iterations == 0 && n > 0 && (size_t)n < sizeof v->subtitle)
+        snprintf(v->subtitle + n, sizeof v->subtitle - (size_t)n, ", not optimised");
+    v->legend_rows = 1 + (map->vertices != 0) + (map->scans != NULL) + 2 * (map->grid != NULL);
+
+    /* room for the y axis' labels on the left */
+    size_t widest = 1;
+    char label[32];
+    for (double t = ceil(v->y0 / v->tick_m) * v->tick_m; t <= v->y1; t += v->tick_m) {
+        int k = tick_label(label, sizeof label, t, v->tick_m);
+        widest = k > 0 && (size_t)k > widest ? (size_t)k : widest;
+    }
+    v->left = SVG_MARGIN_PX + (double)widest * SVG_CHAR_EM * v->small + 10;
+    v->top = SVG_MARGIN_PX + 1.2 * v->font + 1.6 * v->small + 10;
+    double map_w = (v->x1 - v->x0) * v->scale, map_h = (v->y1 - v->y0) * v->scale;
+    double title_w = SVG_CHAR_EM * fmax(v->font * (double)strlen(v->title),
+                                        v->small * ((double)strlen(v->subtitle) + 14));
+    v->width = ceil(fmax(v->left + map_w, SVG_MARGIN_PX + title_w) + SVG_MARGIN_PX);
+    v->footer = v->top + map_h + 1.6 * v->small + 10 + v->font + 6;
+    v->height = ceil(v->footer + v->legend_rows * 1.6 * v->small + 10 + SVG_MARGIN_PX);
 }
 
 /* Endpoints as 1 px grey squares, at most one per pixel (file size stays
@@ -227,20 +321,13 @@ static void svg_grid(FILE *f, const mapout_map *map, const view *v)
         return;
     for (uint32_t iy = 0; iy < gh; iy++)
         for (uint32_t ix = 0; ix < gw; ix++) {
-            uint32_t hits, misses, contour;
-            if (polyc_grid_cell(map->grid, ix, iy, &hits, &misses, &contour) != POLYC_OK)
-                continue;
             unsigned char *b = &block[(size_t)(iy / k) * bw + ix / k];
-            if (hits && (double)hits > (double)map->contour_threshold * ((double)hits + misses))
-                *b |= 1;
-            if (contour)
-                *b |= 2;
+            *b = (unsigned char)(*b | grid_bits(map, ix, iy));
         }
-    const char *fill[2] = {"#bcd0ea", "#f0a04b"};
     const char *id[2] = {"grid", "contour"};
     double bm = k * (double)cell_m;    /* block size in metres */
     for (int layer = 0; layer < 2; layer++) {
-        fprintf(f, "<path id=\"%s\" fill=\"%s\" d=\"", id[layer], fill[layer]);
+        fprintf(f, "<path id=\"%s\" fill=\"%s\" d=\"", id[layer], grid_fill[layer]);
         for (uint32_t by = 0; by < bh; by++)
             for (uint32_t bx = 0; bx < bw;) {
                 if (!(block[(size_t)by * bw + bx] & (1u << layer))) {
@@ -260,28 +347,114 @@ static void svg_grid(FILE *f, const mapout_map *map, const view *v)
     free(block);
 }
 
-/* A round length of at most `target` metres: 1, 2 or 5 times a power of 10. */
-static double nice_length(double target)
+/* The title block: the source's name, polylines, vertices, cell size, and
+ * the run's time (its own element, id "time": the one part that changes
+ * from run to run). */
+static void svg_title(FILE *f, const mapout_map *map, const view *v)
 {
-    double p = pow(10, floor(log10(target)));
-    if (5 * p <= target)
-        return 5 * p;
-    if (2 * p <= target)
-        return 2 * p;
-    return p;
+    double y1 = SVG_MARGIN_PX + v->font, y2 = y1 + 1.6 * v->small;
+    fprintf(f, "<g id=\"title\" " SVG_FONT ">\n"
+               "<text x=\"%.2f\" y=\"%.2f\" font-size=\"%.1f\" font-weight=\"bold\">%s</text>\n"
+               "<text x=\"%.2f\" y=\"%.2f\" font-size=\"%.1f\">%s</text>\n",
+            SVG_MARGIN_PX, y1, v->font, v->title, SVG_MARGIN_PX, y2, v->small, v->subtitle);
+    if (map->total_ms > 0)
+        fprintf(f, "<text id=\"time\" x=\"%.2f\" y=\"%.2f\" font-size=\"%.1f\""
+                   " text-anchor=\"end\">made in %.2f s</text>\n",
+                v->width - SVG_MARGIN_PX, y2, v->small, map->total_ms / 1e3);
+    fputs("</g>\n", f);
+}
+
+/* A frame round the map with ticks and labels in metres, and the origin. */
+static void svg_axes(FILE *f, const view *v)
+{
+    double l = px_x(v, v->x0), r = px_x(v, v->x1), t = px_y(v, v->y1), b = px_y(v, v->y0);
+    char label[32];
+    fprintf(f, "<g id=\"axes\" " SVG_FONT " font-size=\"%.1f\">\n"
+               "<path fill=\"none\" stroke=\"#b0b0b0\" stroke-width=\"1\""
+               " d=\"M%.2f %.2fH%.2fV%.2fH%.2fZ",
+            v->small, l, t, r, b, l);
+    for (double x = ceil(v->x0 / v->tick_m) * v->tick_m; x <= v->x1; x += v->tick_m)
+        fprintf(f, "M%.2f %.2fv5", px_x(v, x), b);
+    for (double y = ceil(v->y0 / v->tick_m) * v->tick_m; y <= v->y1; y += v->tick_m)
+        fprintf(f, "M%.2f %.2fh-5", l, px_y(v, y));
+    fputs("\"/>\n", f);
+    double last = -HUGE_VAL;
+    for (double x = ceil(v->x0 / v->tick_m) * v->tick_m; x <= v->x1; x += v->tick_m)
+        last = x;
+    for (double x = ceil(v->x0 / v->tick_m) * v->tick_m; x <= v->x1; x += v->tick_m) {
+        tick_label(label, sizeof label, x, v->tick_m);
+        fprintf(f, "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"middle\">%s%s</text>\n",
+                px_x(v, x), b + 7 + v->small, label, x == last ? " m" : "");
+    }
+    for (double y = ceil(v->y0 / v->tick_m) * v->tick_m; y <= v->y1; y += v->tick_m) {
+        tick_label(label, sizeof label, y, v->tick_m);
+        fprintf(f, "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"end\">%s</text>\n", l - 8,
+                px_y(v, y) + 0.35 * v->small, label);
+    }
+    fputs("</g>\n", f);
+    if (0 >= v->x0 && 0 <= v->x1 && 0 >= v->y0 && 0 <= v->y1) {
+        double ox = px_x(v, 0), oy = px_y(v, 0), a = 2.5 * v->font / 3;
+        fprintf(f, "<g id=\"origin\" stroke=\"" SVG_INK "\" stroke-width=\"1.5\" fill=\"none\">"
+                   "<path d=\"M%.2f %.2fh%.2fM%.2f %.2fv%.2f\"/>"
+                   "<circle cx=\"%.2f\" cy=\"%.2f\" r=\"%.2f\"/></g>\n",
+                ox - a / 2, oy, a, ox, oy - a / 2, a, ox, oy, a / 4);
+    }
 }
 
 static void svg_scalebar(FILE *f, const view *v)
 {
     double len_m = nice_length((v->x1 - v->x0) / 4);
-    double x0 = SVG_MARGIN_PX, x1 = x0 + len_m * v->scale;
-    double y = v->height - SVG_MARGIN_PX;
+    double x0 = v->left, x1 = x0 + len_m * v->scale;
+    double y = v->footer;
     fprintf(f,
             "<g id=\"scalebar\"><path d=\"M%.2f %.2fv-6M%.2f %.2fH%.2fv-6\" stroke=\"black\""
             " stroke-width=\"%.2f\" fill=\"none\"/>\n"
             "<text x=\"%.2f\" y=\"%.2f\" font-family=\"sans-serif\" font-size=\"%.0f\">%g m</text>"
             "</g>\n",
             x0, y, x0, y, x1, v->stroke + 0.5, x1 + 8, y, v->font, len_m);
+}
+
+/* One row of the legend for each layer drawn, under the scale bar. */
+static void svg_legend(FILE *f, const mapout_map *map, const view *v)
+{
+    double x = v->left, y = v->footer + 10, row = 1.6 * v->small, sw = 2 * v->small;
+    double tx = x + sw + 8;
+    fprintf(f, "<g id=\"legend\" " SVG_FONT " font-size=\"%.1f\">\n", v->small);
+    y += row;
+    double mid = y - 0.35 * v->small;
+    if (map->color_lines)
+        for (int k = 0; k < 3; k++)
+            fprintf(f, "<path stroke=\"%s\" stroke-width=\"%.2f\" d=\"M%.2f %.2fh%.2f\"/>\n",
+                    palette[k], v->stroke, x + k * sw / 3, mid, sw / 3);
+    else
+        fprintf(f, "<path stroke=\"" SVG_LINE_COLOUR "\" stroke-width=\"%.2f\""
+                   " d=\"M%.2f %.2fh%.2f\"/>\n",
+                v->stroke, x, mid, sw);
+    fprintf(f, "<text x=\"%.2f\" y=\"%.2f\">polylines%s</text>\n", tx, y,
+            map->color_lines ? " (a colour each)" : "");
+    if (map->vertices) {
+        y += row;
+        fprintf(f, "<circle cx=\"%.2f\" cy=\"%.2f\" r=\"%.2f\" fill=\"%s\"/>\n"
+                   "<text x=\"%.2f\" y=\"%.2f\">vertices</text>\n",
+                x + sw / 2, y - 0.35 * v->small, 1.4 * v->stroke,
+                map->color_lines ? palette[0] : SVG_LINE_COLOUR, tx, y);
+    }
+    if (map->scans) {
+        y += row;
+        fprintf(f, "<rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" height=\"%.2f\" fill=\"#707070\""
+                   " fill-opacity=\"0.6\"/>\n<text x=\"%.2f\" y=\"%.2f\">scan endpoints</text>\n",
+                x + sw / 2 - 2, y - 0.35 * v->small - 2, 4.0, 4.0, tx, y);
+    }
+    if (map->grid) {
+        static const char *const what[2] = {"occupied grid cells", "contour cells"};
+        for (int k = 0; k < 2; k++) {
+            y += row;
+            fprintf(f, "<rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" height=\"%.2f\" fill=\"%s\"/>\n"
+                       "<text x=\"%.2f\" y=\"%.2f\">%s</text>\n",
+                    x, y - 0.8 * v->small, sw, 0.8 * v->small, grid_fill[k], tx, y, what[k]);
+        }
+    }
+    fputs("</g>\n", f);
 }
 
 int mapout_svg(FILE *f, const mapout_map *map)
@@ -295,16 +468,18 @@ int mapout_svg(FILE *f, const mapout_map *map)
             "<!-- polyc map: x %.4f..%.4f m, y %.4f..%.4f m (y up), %.4f px/m -->\n"
             "<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n",
             v.width, v.height, v.width, v.height, v.x0, v.x1, v.y0, v.y1, v.scale);
+    svg_title(f, map, &v);
     if (map->grid)
         svg_grid(f, map, &v);
     if (map->scans)
         svg_points(f, map, &v);
+    svg_axes(f, &v);
     fprintf(f, "<g id=\"polylines\" fill=\"none\" stroke-width=\"%.2f\" stroke-linejoin=\"round\""
                " stroke-linecap=\"round\">\n",
             v.stroke);
     for (uint32_t i = 0; i < map->line_count; i++) {
         const polyc_polyline *pl = &map->lines[i];
-        const char *colour = palette[i % (sizeof palette / sizeof palette[0])];
+        const char *colour = map->color_lines ? palette[i % PALETTE_SIZE] : SVG_LINE_COLOUR;
         if (pl->point_count == 0)
             continue;
         fprintf(f, "<path stroke=\"%s\" d=\"", colour);
@@ -324,6 +499,7 @@ int mapout_svg(FILE *f, const mapout_map *map)
     }
     fputs("</g>\n", f);
     svg_scalebar(f, &v);
+    svg_legend(f, map, &v);
     fputs("</svg>\n", f);
     return ferror(f) ? -1 : 0;
 }

@@ -24,6 +24,10 @@ typedef struct mapout_map {
     const polyc_ctx *grid;         /* --grid: draw this context's grid; NULL: off */
     float contour_threshold;       /* a grid cell is drawn if hits/(hits+misses) > this */
     int vertices;                  /* --vertices: a dot on every vertex */
+    int color_lines;               /* --color-lines: a colour per polyline (else one) */
+    const char *title;             /* the title: this path's file name; NULL: "polyc map" */
+    double cell_m;                 /* shown in the title if > 0 */
+    double total_ms;               /* the run's time, shown if > 0 (element id "time") */
 } mapout_map;
 
 /* Each returns 0, or -1 if the stream reported an error. */

@@ -7,7 +7,9 @@
  *                                and PREFIX.yaml
  * Exit codes: 0 ok, 1 bad input or other failure, 2 usage, 3 memory budget.
  * Formats and rules: docs/formats.md. */
+#include <ctype.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -20,13 +22,13 @@
 #include "gridimage.h"
 #include "mapfile.h"
 #include "mapout.h"
+#include "outfile.h"
 #include "polyc.h"
 #include "scanlog.h"
 
 #define EXIT_INPUT 1
 #define EXIT_USAGE 2
 #define EXIT_MEMORY 3
-#define TOOL_VERSION "0.1.0"
 
 enum format { FORMAT_SVG, FORMAT_JSON, FORMAT_TXT };
 enum command { CMD_MAP, CMD_CONVERT, CMD_GRID };
@@ -37,7 +39,8 @@ enum {
     OPT_ITERATIONS = 1u << 4, OPT_MAX_RANGE = 1u << 5, OPT_MEMORY = 1u << 6, OPT_CELL = 1u << 7,
     OPT_THRESHOLD = 1u << 8, OPT_ALPHA = 1u << 9, OPT_GAMMA = 1u << 10, OPT_OCCUPIED = 1u << 11,
     OPT_FREE = 1u << 12, OPT_STATS = 1u << 13, OPT_NO_OPTIMIZE = 1u << 14, OPT_EXACT = 1u << 15,
-    OPT_GRID_TRACE = 1u << 16, OPT_POINTS = 1u << 17, OPT_GRID = 1u << 18, OPT_VERTICES = 1u << 19
+    OPT_GRID_TRACE = 1u << 16, OPT_POINTS = 1u << 17, OPT_GRID = 1u << 18, OPT_VERTICES = 1u << 19,
+    OPT_COLOR_LINES = 1u << 20
 };
 static const struct {
     const char *name;
@@ -50,12 +53,13 @@ static const struct {
     {"--occupied-thresh", OPT_OCCUPIED}, {"--free-thresh", OPT_FREE}, {"--stats", OPT_STATS},
     {"--no-optimize", OPT_NO_OPTIMIZE}, {"--exact-points", OPT_EXACT},
     {"--grid-trace", OPT_GRID_TRACE}, {"--points", OPT_POINTS}, {"--grid", OPT_GRID},
-    {"--vertices", OPT_VERTICES},
+    {"--vertices", OPT_VERTICES},     {"--color-lines", OPT_COLOR_LINES},
 };
 /* what applies where */
 #define OPTS_LOG_ONLY (OPT_CELL | OPT_THRESHOLD | OPT_MAX_RANGE | OPT_EXACT | OPT_GRID_TRACE | OPT_POINTS)
 #define OPTS_MAP_ONLY (OPT_OCCUPIED | OPT_FREE)
 #define OPTS_GRID_CMD (OPT_OUTPUT | OPT_CELL | OPT_MAX_RANGE | OPT_MEMORY | OPT_STATS)
+#define OPTS_CONVERT_CMD (OPT_OUTPUT | OPT_MAX_RANGE | OPT_STATS)
 
 typedef struct options {
     const char *input;
@@ -64,7 +68,7 @@ typedef struct options {
     enum command command;
     enum format format;
     unsigned given;            /* OPT_* bits of the options on the command line */
-    int stats, no_optimize, points, grid, vertices, quiet;
+    int stats, no_optimize, points, grid, vertices, color_lines, quiet;
     double max_range_m;        /* 0: detect */
     double memory_mb;          /* 0: no cap */
     polyc_config config;
@@ -83,8 +87,9 @@ static const char usage_text[] =
     "--exact-points, --grid-trace and --points act on scans and are refused for a\n"
     "map; --occupied-thresh and --free-thresh apply to maps only.\n"
     "options:\n"
-    "  --format svg|json|txt   output format (default svg)\n"
-    "  -o, --output FILE       write FILE (atomically) instead of stdout\n"
+    "  --format svg|json|txt   output format (default: -o's extension, else svg)\n"
+    "  -o, --output FILE       write FILE instead of stdout (a file is replaced\n"
+    "                          atomically, a device or FIFO written in place)\n"
     "  --stats                 counts, sizes and times per stage on stderr\n"
     "  --no-optimize           stop after tracing the initial polylines\n"
     "  --cell M                grid cell size in metres (default 0.025)\n"
@@ -105,6 +110,7 @@ static const char usage_text[] =
     "                          over 2 s: stage, iteration, vertices, BIC)\n"
     "  --points, --grid, --vertices\n"
     "                          SVG layers: scan endpoints, grid cells, vertex dots\n"
+    "  --color-lines           SVG: a colour per polyline (default: one for the map)\n"
     "  --help, --version\n"
     "exit codes: 0 ok, 1 bad input or other failure, 2 usage, 3 memory budget too small\n";
 
@@ -246,7 +252,8 @@ static int set_value(options *o, const char *name, const char *val)
         o->max_range_m = d;
     } else if (strcmp(name, "--memory-mb") == 0) {
         if (parse_double(val, 1e-6, 1e9, &d))
-            return complain(EXIT_USAGE, "--memory-mb needs a positive number, not '%s'", val);
+            return complain(EXIT_USAGE, "--memory-mb needs MiB from 0.000001 to 1000000000,"
+                                        " not '%s'", val);
         o->memory_mb = d;
     } else {
         /* float config fields; polyc_config_check judges the values */
@@ -292,6 +299,8 @@ static int set_flag(options *o, const char *name)
         o->grid = 1;
     else if (strcmp(name, "--vertices") == 0)
         o->vertices = 1;
+    else if (strcmp(name, "--color-lines") == 0)
+        o->color_lines = 1;
     else
         return -1;
     return 0;
@@ -307,6 +316,89 @@ static int takes_value(const char *name)
         if (strcmp(name, names[i]) == 0)
             return 1;
     return 0;
+}
+
+/* The format -o's extension names (.svg, .json, .txt), or -1. */
+static int format_of_name(const char *path)
+{
+    static const char *const ext[] = {".svg", ".json", ".txt"};
+    const char *slash = strrchr(path, '/');
+    const char *dot = strrchr(slash ? slash + 1 : path, '.');
+    for (int f = 0; dot && f < 3; f++) {
+        size_t i = 0;
+        while (dot[i] && ext[f][i] && tolower((unsigned char)dot[i]) == ext[f][i])
+            i++;
+        if (!dot[i] && !ext[f][i])
+            return f;
+    }
+    return -1;
+}
+
+/* Refuses (usage) outputs that cannot be written as asked, before any work:
+ * an empty or directory name, -o and --trace naming the same file, a
+ * --format that -o's extension contradicts; else takes the format from it. */
+static int check_outputs(options *o)
+{
+    const char *why;
+    if (o->command == CMD_GRID) {
+        size_t n = strlen(o->output);
+        char *p = malloc(n + 6);
+        if (!p)
+            return complain(EXIT_INPUT, "out of memory");
+        why = outfile_check(o->output);
+        for (int i = 0; i < 2 && !why; i++) {
+            snprintf(p, n + 6, "%s%s", o->output, i ? ".yaml" : ".pgm");
+            why = outfile_check(p);
+        }
+        free(p);
+        return why ? complain(EXIT_USAGE, "-o PREFIX '%s' %s (polyc grid writes PREFIX.pgm and"
+                                          " PREFIX.yaml)", o->output, why)
+                   : 0;
+    }
+    if ((why = outfile_check(o->output)))
+        return complain(EXIT_USAGE, "-o '%s' %s: give a file name", o->output, why);
+    if ((why = outfile_check(o->trace)))
+        return complain(EXIT_USAGE, "--trace '%s' %s: give a file name", o->trace, why);
+    if (o->trace && outfile_same(o->output, o->trace))
+        return complain(EXIT_USAGE, "-o and --trace name the same file ('%s', '%s')",
+                        o->output ? o->output : "-", o->trace);
+    int f = o->output && o->command == CMD_MAP ? format_of_name(o->output) : -1;
+    static const char *const names[] = {"svg", "json", "txt"};
+    if (f >= 0 && (o->given & OPT_FORMAT) && (int)o->format != f)
+        return complain(EXIT_USAGE, "--format %s contradicts -o %s (a .%s name)",
+                        names[o->format], o->output, names[f]);
+    if (f >= 0)
+        o->format = (enum format)f;
+    return 0;
+}
+
+/* polyc_config_check's message, in the options' names: "cell_m must be in
+ * [0.001, 10]" is "--cell must be in [0.001, 10]". */
+static int config_fail(const char *why)
+{
+    static const char *const names[][2] = {
+        {"cell_m", "--cell"}, {"contour_threshold", "--threshold"}, {"alpha", "--alpha"},
+        {"gamma", "--gamma"}, {"occupied_thresh", "--occupied-thresh"},
+        {"free_thresh", "--free-thresh"}};
+    char msg[200];
+    size_t n = 0;
+    while (*why && n + 40 < sizeof msg) {
+        size_t k = 0, len = 0;
+        for (; k < sizeof names / sizeof names[0]; k++) {
+            len = strlen(names[k][0]);
+            if (strncmp(why, names[k][0], len) == 0 && why[len] != '_' &&
+                !isalnum((unsigned char)why[len]))   /* a whole name */
+                break;
+        }
+        if (k < sizeof names / sizeof names[0]) {
+            n += (size_t)sprintf(msg + n, "%s", names[k][1]);
+            why += len;
+        } else {
+            msg[n++] = *why++;
+        }
+    }
+    msg[n] = '\0';
+    return complain(EXIT_USAGE, "bad option value: %s", msg);
 }
 
 /* 0: run; -1: --help/--version done (exit 0); else an exit code. */
@@ -330,9 +422,8 @@ static int parse_args(int argc, char **argv, options *o)
             fputs(usage_text, stdout);
             return -1;
         } else if (strcmp(a, "--version") == 0) {
-            uint32_t v = polyc_version();
-            printf("polyc %s (libpolyc %u.%u.%u)\n", TOOL_VERSION, (unsigned)(v / 10000),
-                   (unsigned)(v / 100 % 100), (unsigned)(v % 100));
+            printf("polyc %d.%d.%d\n", POLYC_VERSION_MAJOR, POLYC_VERSION_MINOR,
+                   POLYC_VERSION_PATCH);   /* the tool is libpolyc's, one version */
             return -1;
         } else if (set_flag(o, a) == 0) {
             o->given |= option_bit(a);
@@ -366,108 +457,12 @@ static int parse_args(int argc, char **argv, options *o)
     if (o->command == CMD_GRID && (!o->output || strcmp(o->output, "-") == 0))
         return complain(EXIT_USAGE, "polyc grid needs -o PREFIX (it writes PREFIX.pgm and"
                                     " PREFIX.yaml)");
+    int rc = check_outputs(o);
+    if (rc)
+        return rc;
     const char *why = NULL;
     if (polyc_config_check(&o->config, &why) != POLYC_OK)
-        return complain(EXIT_USAGE, "bad option value: %s", why ? why : "?");
-    return 0;
-}
-
-/* ---- output: all or nothing ---- */
-
-/* An output written in two steps, so that a run with two outputs (the map
- * and --trace) writes both or neither: emit_prepare writes a file's bytes to
- * a temporary file in the same directory, emit_commit renames it over the
- * file (or writes stdout), emit_abort removes what is left. */
-typedef struct pending {
-    const char *path;          /* NULL or "-": stdout, written at commit */
-    const char *data;
-    size_t len;
-    char *tmp;                 /* the prepared temporary file, or NULL */
-} pending;
-
-static int emit_file(const char *path, const char *data, size_t len, char **tmp_out);
-
-static int emit_prepare(pending *p, const char *path, const char *data, size_t len)
-{
-    p->path = path;
-    p->data = data;
-    p->len = len;
-    p->tmp = NULL;
-    if (!path || strcmp(path, "-") == 0)
-        return 0;
-    return emit_file(path, data, len, &p->tmp);
-}
-
-static int emit_commit(pending *p)
-{
-    if (!p->path || strcmp(p->path, "-") == 0) {
-        if (fwrite(p->data, 1, p->len, stdout) != p->len || fflush(stdout) != 0)
-            return complain(EXIT_INPUT, "writing stdout: %s", strerror(errno));
-        return 0;
-    }
-    int err = rename(p->tmp, p->path) != 0 ? errno : 0;
-    if (err)
-        unlink(p->tmp);
-    free(p->tmp);
-    p->tmp = NULL;
-    return err ? complain(EXIT_INPUT, "%s: %s", p->path, strerror(err)) : 0;
-}
-
-static void emit_abort(pending *p)
-{
-    if (p->tmp) {
-        unlink(p->tmp);
-        free(p->tmp);
-        p->tmp = NULL;
-    }
-}
-
-/* Writes len bytes to stdout, or to path through a temporary file in the
- * same directory renamed over it, so that a failure never leaves a partial
- * file. Returns 0 or EXIT_INPUT with a message. */
-static int emit(const char *path, const char *data, size_t len)
-{
-    pending p;
-    int rc = emit_prepare(&p, path, data, len);
-    return rc ? rc : emit_commit(&p);
-}
-
-/* The bytes in a synced temporary file next to path; *tmp_out gets its
- * name (to rename or remove). 0 or EXIT_INPUT with a message. */
-static int emit_file(const char *path, const char *data, size_t len, char **tmp_out)
-{
-    size_t n = strlen(path);
-    char *tmp = malloc(n + 16);
-    if (!tmp)
-        return complain(EXIT_INPUT, "out of memory");
-    memcpy(tmp, path, n);
-    memcpy(tmp + n, ".tmpXXXXXX", 11);
-    int fd = mkstemp(tmp);
-    if (fd < 0) {
-        int e = errno;
-        free(tmp);
-        return complain(EXIT_INPUT, "%s: cannot create a temporary file: %s", path, strerror(e));
-    }
-    mode_t mask = umask(0);            /* mkstemp makes 0600; give the usual mode */
-    umask(mask);
-    int err = fchmod(fd, 0666 & ~mask) ? errno : 0;
-    for (size_t done = 0; !err && done < len;) {
-        ssize_t w = write(fd, data + done, len - done);
-        if (w < 0 && errno != EINTR)
-            err = errno;
-        else if (w > 0)
-            done += (size_t)w;
-    }
-    if (!err && fsync(fd) != 0)
-        err = errno;
-    if (close(fd) != 0 && !err)
-        err = errno;
-    if (err) {
-        unlink(tmp);
-        free(tmp);
-        return complain(EXIT_INPUT, "%s: %s", path, strerror(err));
-    }
-    *tmp_out = tmp;
+        return config_fail(why ? why : "?");
     return 0;
 }
 
@@ -493,6 +488,38 @@ static int membuf_close(membuf *m, int write_failed)
     bad = fclose(m->f) != 0 || bad;
     m->f = NULL;
     return bad ? complain(EXIT_INPUT, "out of memory rendering the output") : 0;
+}
+
+/* ---- output: all or nothing ---- */
+
+/* Writes n rendered outputs to their paths (NULL or "-": stdout), all or
+ * none where it can (outfile.h): every temporary file is written before
+ * anything is renamed or written in place. 0 or EXIT_INPUT with a message. */
+static int write_outputs(const char *const *paths, const membuf *const *bufs, size_t n)
+{
+    outfile of[2];
+    outfile *ptr[2];
+    const char *what = NULL;
+    int err = 0;
+    size_t made = 0;
+    for (; made < n && made < 2 && !err; made++) {
+        ptr[made] = &of[made];
+        err = outfile_prepare(&of[made], paths[made], bufs[made]->data, bufs[made]->len, &what);
+    }
+    if (err) {
+        for (size_t j = 0; j < made; j++)
+            outfile_abort(&of[j]);
+        const char *p = paths[made - 1];
+        return what ? complain(EXIT_INPUT, "%s: %s: %s", p, what, strerror(err))
+                    : complain(EXIT_INPUT, "%s: %s", p, strerror(err));
+    }
+    progress_clear();                     /* before stdout, which may be the terminal */
+    const outfile *failed = NULL;
+    if ((err = outfile_commit_all(ptr, made, &failed)) != 0)
+        return failed && failed->kind != OUTFILE_STDOUT
+                   ? complain(EXIT_INPUT, "%s: %s", failed->path, strerror(err))
+                   : complain(EXIT_INPUT, "writing stdout: %s", strerror(err));
+    return 0;
 }
 
 /* ---- the optimiser's callback: --trace and the progress line ---- */
@@ -531,6 +558,29 @@ typedef struct run {
 
 /* ---- --stats ---- */
 
+/* A copy of s for messages: bytes outside printable ASCII as \xNN. */
+static char *printable(const char *s)
+{
+    static const char hex[] = "0123456789abcdef";
+    size_t n = strlen(s), o = 0;
+    char *out = malloc(4 * n + 1);
+    if (!out)
+        return NULL;
+    for (size_t i = 0; i < n; i++) {
+        unsigned char c = (unsigned char)s[i];
+        if (c >= 0x20 && c < 0x7f) {
+            out[o++] = (char)c;
+        } else {
+            out[o++] = '\\';
+            out[o++] = 'x';
+            out[o++] = hex[c >> 4];
+            out[o++] = hex[c & 15];
+        }
+    }
+    out[o] = '\0';
+    return out;
+}
+
 static void print_input_stats(const scanlog *log)
 {
     FILE *e = stderr;
@@ -567,10 +617,12 @@ static void print_map_stats(const map_input *m)
 {
     static const char *const modes[] = {"trinary", "scale", "raw"};
     FILE *e = stderr;
+    char *shown = printable(m->image_path);   /* no raw bytes on the terminal */
     fprintf(e, "map            %u x %u cells of %g m, %s (%s, maxval %u), mode %s%s\n",
             (unsigned)m->pgm.width, (unsigned)m->pgm.height, m->yaml.resolution_m,
-            m->image_path, m->pgm.plain ? "P2" : "P5", (unsigned)m->pgm.maxval,
+            shown ? shown : "?", m->pgm.plain ? "P2" : "P5", (unsigned)m->pgm.maxval,
             modes[m->yaml.mode], m->yaml.negate ? ", negate" : "");
+    free(shown);
     fprintf(e, "origin         %.6f %.6f m, yaw %.6f rad\n", m->yaml.origin_x_m,
             m->yaml.origin_y_m, m->yaml.origin_yaw_rad);
     fprintf(e, "cells          occupied %llu, free %llu, unknown %llu\n",
@@ -624,6 +676,15 @@ static int library_fail(const char *stage, polyc_status st, const polyc_ctx *ctx
                     msg && *msg ? ": " : "", msg ? msg : "");
 }
 
+/* The block needs more than --memory-mb allows: say the MiB to give. */
+static int budget_fail(const options *o, size_t size)
+{
+    double mib = (double)size / 1048576.0;
+    return complain(EXIT_MEMORY, "memory budget too small: need %zu bytes (%.1f MiB), --memory-mb"
+                                 " %g allows %g MiB: give --memory-mb %.0f or more",
+                    size, mib, o->memory_mb, o->memory_mb, ceil(mib));
+}
+
 static int struct_sizes_match(void)
 {
     return polyc_struct_size("polyc_config") == sizeof(polyc_config) &&
@@ -644,7 +705,9 @@ static int convert(const options *o, run *r)
         return EXIT_INPUT;
     if (o->stats)
         print_input_stats(&r->log);
-    return emit(o->output, r->out.data, r->out.len);
+    const char *paths[] = {o->output};
+    const membuf *bufs[] = {&r->out};
+    return write_outputs(paths, bufs, 1);
 }
 static const char *input_name(const options *o)
 {
@@ -689,14 +752,15 @@ static int extent_fail(const options *o, const scanlog *log, const polyc_config 
         }
     }
     double w = all.max_x_m - all.min_x_m, h = all.max_y_m - all.min_y_m;
+    double pad = 4.0 * (double)cfg->cell_m;    /* the grid's margin (polyc_limits_for_scans) */
     const polyc_scan *s = &log->scans[far];
-    if (w > (double)cfg->max_extent_m || h > (double)cfg->max_extent_m || worst < 0)
+    if (w + pad > (double)cfg->max_extent_m || h + pad > (double)cfg->max_extent_m || worst < 0)
         return complain(EXIT_INPUT,
                         "%s:%llu: this scan (pose %.2f %.2f) reaches %.0f m from the median pose"
-                        " (%.2f %.2f): the data would span %.0f x %.0f m, more than the grid's"
-                        " limit of %g m",
+                        " (%.2f %.2f): the data would span %.0f x %.0f m (plus the grid's margin"
+                        " of %g m), more than the grid's limit of %g m",
                         input_name(o), (unsigned long long)log->line_of_scan[far], s->pose_x_m,
-                        s->pose_y_m, worst, mx, my, w, h, (double)cfg->max_extent_m);
+                        s->pose_y_m, worst, mx, my, w, h, pad, (double)cfg->max_extent_m);
     return complain(EXIT_INPUT, "%s: the data span %.1f x %.1f m: more than 2^32 grid cells of"
                                 " %g m (try a larger --cell)",
                     input_name(o), w, h, (double)cfg->cell_m);
@@ -705,38 +769,30 @@ static int extent_fail(const options *o, const scanlog *log, const polyc_config 
 
 /* ---- a ROS map in ---- */
 
-/* A copy of s for messages: bytes outside printable ASCII as \xNN. */
-static char *printable(const char *s)
-{
-    static const char hex[] = "0123456789abcdef";
-    size_t n = strlen(s), o = 0;
-    char *out = malloc(4 * n + 1);
-    if (!out)
-        return NULL;
-    for (size_t i = 0; i < n; i++) {
-        unsigned char c = (unsigned char)s[i];
-        if (c >= 0x20 && c < 0x7f) {
-            out[o++] = (char)c;
-        } else {
-            out[o++] = '\\';
-            out[o++] = 'x';
-            out[o++] = hex[c >> 4];
-            out[o++] = hex[c & 15];
-        }
-    }
-    out[o] = '\0';
-    return out;
-}
-
-/* Reads a whole file of at most max bytes into *data (malloc'd, *len bytes).
- * 0, an errno value, or -1 if it holds more than max bytes. */
+/* Reads a whole regular file of at most max bytes into *data (malloc'd,
+ * *len bytes). 0, an errno value, READ_TOO_LARGE if it holds more than max
+ * bytes, or READ_NOT_FILE if it is not a regular file (a device, a FIFO:
+ * opened without waiting for a writer, and not read). */
+#define READ_TOO_LARGE (-1)
+#define READ_NOT_FILE (-2)
 static int read_whole(const char *path, size_t max, char **data, size_t *len)
 {
-    FILE *f = fopen(path, "rb");
     *data = NULL;
     *len = 0;
-    if (!f)
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY);
+    if (fd < 0)
         return errno;
+    struct stat st;
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        int e = S_ISDIR(st.st_mode) ? EISDIR : READ_NOT_FILE;
+        close(fd);
+        return e;
+    }
+    FILE *f = fdopen(fd, "rb");
+    if (!f) {
+        close(fd);
+        return errno;
+    }
     size_t cap = 0, n = 0;
     char *buf = NULL;
     int err = 0;
@@ -744,7 +800,7 @@ static int read_whole(const char *path, size_t max, char **data, size_t *len)
         if (n == cap) {
             size_t ncap = cap ? cap * 2 : 65536;
             if (cap > max) {
-                err = -1;
+                err = READ_TOO_LARGE;
                 break;
             }
             char *nb = realloc(buf, ncap);
@@ -765,7 +821,7 @@ static int read_whole(const char *path, size_t max, char **data, size_t *len)
     }
     fclose(f);
     if (!err && n > max)
-        err = -1;
+        err = READ_TOO_LARGE;
     if (err) {
         free(buf);
         return err;
@@ -781,9 +837,11 @@ static int load_map(const options *o, map_input *m)
     char *text;
     size_t len;
     int err = read_whole(o->input, MAPFILE_MAX_YAML_BYTES, &text, &len);
-    if (err < 0)
+    if (err == READ_TOO_LARGE)
         return complain(EXIT_INPUT, "%s: larger than %u bytes: not a map YAML", o->input,
                         MAPFILE_MAX_YAML_BYTES);
+    if (err == READ_NOT_FILE)
+        return complain(EXIT_INPUT, "%s: not a regular file", o->input);
     if (err)
         return complain(EXIT_INPUT, "%s: %s", o->input, strerror(err));
     int bad = mapfile_yaml_parse(&m->yaml, text, len, o->input);
@@ -797,10 +855,15 @@ static int load_map(const options *o, map_input *m)
         return complain(EXIT_INPUT, "out of memory");
     err = read_whole(m->image_path, MAPFILE_MAX_PGM_BYTES, &text, &len);
     if (err) {
-        int rc = err < 0 ? complain(EXIT_INPUT, "%s:%u: image %s: larger than %u bytes", o->input,
-                                    (unsigned)m->yaml.image_line, shown, MAPFILE_MAX_PGM_BYTES)
-                         : complain(EXIT_INPUT, "%s:%u: image %s: %s", o->input,
-                                    (unsigned)m->yaml.image_line, shown, strerror(err));
+        unsigned line = (unsigned)m->yaml.image_line;
+        int rc = err == READ_TOO_LARGE
+                     ? complain(EXIT_INPUT, "%s:%u: image %s: larger than %u bytes", o->input, line,
+                                shown, MAPFILE_MAX_PGM_BYTES)
+                 : err == READ_NOT_FILE
+                     ? complain(EXIT_INPUT, "%s:%u: image %s: not a regular file (a device or a"
+                                            " FIFO): give a PGM file", o->input, line, shown)
+                     : complain(EXIT_INPUT, "%s:%u: image %s: %s", o->input, line, shown,
+                                strerror(err));
         free(shown);
         return rc;
     }
@@ -898,7 +961,7 @@ static int make_map(const options *o, run *r, double t_start, mapout_times *t)
             return complain(EXIT_MEMORY, "memory budget too small: need more than %zu bytes",
                             (size_t)SIZE_MAX);
         if (o->memory_mb > 0 && (double)size > o->memory_mb * 1048576.0)
-            return complain(EXIT_MEMORY, "memory budget too small: need %zu bytes", size);
+            return budget_fail(o, size);
         free(r->block);
         r->block = malloc(size);
         if (!r->block)
@@ -997,6 +1060,10 @@ static int make_map(const options *o, run *r, double t_start, mapout_times *t)
     map.grid = o->grid ? ctx : NULL;
     map.contour_threshold = cfg.contour_threshold;
     map.vertices = o->vertices;
+    map.color_lines = o->color_lines;
+    map.title = input_name(o);
+    map.cell_m = r->map ? r->map->yaml.resolution_m : (double)cfg.cell_m;
+    map.total_ms = now_ms() - t_start;
     if (membuf_open(&r->out))
         return EXIT_INPUT;
     int bad = o->format == FORMAT_JSON  ? mapout_json(r->out.f, &map)
@@ -1007,18 +1074,9 @@ static int make_map(const options *o, run *r, double t_start, mapout_times *t)
     if (o->trace && membuf_close(&r->trace, 0))
         return EXIT_INPUT;
     /* both outputs or neither */
-    pending map_out, trace_out;
-    memset(&trace_out, 0, sizeof trace_out);
-    int rc = emit_prepare(&map_out, o->output, r->out.data, r->out.len);
-    if (!rc && o->trace)
-        rc = emit_prepare(&trace_out, o->trace, r->trace.data, r->trace.len);
-    progress_clear();                     /* before stdout, which may be the terminal */
-    if (!rc)
-        rc = emit_commit(&map_out);
-    if (!rc && o->trace)
-        rc = emit_commit(&trace_out);
-    emit_abort(&map_out);
-    emit_abort(&trace_out);
+    const char *paths[] = {o->output, o->trace};
+    const membuf *bufs[] = {&r->out, &r->trace};
+    int rc = write_outputs(paths, bufs, o->trace ? 2 : 1);
     double t6 = now_ms();
     if (o->stats)
         print_stats(o, r, &stats, t, t6 - t5, t6 - t_start);
@@ -1042,7 +1100,7 @@ static int grid_files(const options *o, run *r, double t_start)
         return complain(EXIT_MEMORY, "memory budget too small: need more than %zu bytes",
                         (size_t)SIZE_MAX);
     if (o->memory_mb > 0 && (double)size > o->memory_mb * 1048576.0)
-        return complain(EXIT_MEMORY, "memory budget too small: need %zu bytes", size);
+        return budget_fail(o, size);
     if (!(r->block = malloc(size)))
         return complain(EXIT_MEMORY, "memory budget too small: need %zu bytes (malloc failed)",
                         size);
@@ -1097,19 +1155,10 @@ static int grid_files(const options *o, run *r, double t_start)
         }
         /* both files or neither; the image first, so that the YAML never
          * names a missing one */
-        pending pgm_out, yaml_out;
-        memset(&pgm_out, 0, sizeof pgm_out);
-        memset(&yaml_out, 0, sizeof yaml_out);
+        const char *paths[] = {pgm_path, yaml_path};
+        const membuf *bufs[] = {&r->pgm, &r->yaml};
         if (!rc)
-            rc = emit_prepare(&pgm_out, pgm_path, r->pgm.data, r->pgm.len);
-        if (!rc)
-            rc = emit_prepare(&yaml_out, yaml_path, r->yaml.data, r->yaml.len);
-        if (!rc)
-            rc = emit_commit(&pgm_out);
-        if (!rc)
-            rc = emit_commit(&yaml_out);
-        emit_abort(&pgm_out);
-        emit_abort(&yaml_out);
+            rc = write_outputs(paths, bufs, 2);
     }
     free(pgm_path);
     free(yaml_path);
@@ -1168,6 +1217,7 @@ int main(int argc, char **argv)
     options o;
     run r;
     map_input map;
+    outfile_signals();
     int rc = parse_args(argc, argv, &o);
     if (rc)
         return rc < 0 ? 0 : rc;
@@ -1200,15 +1250,21 @@ int main(int argc, char **argv)
                 rc = make_map(&o, &r, t_start, &t);
         }
     } else {
-        rc = o.command == CMD_GRID ? refuse_options(&o, OPTS_GRID_CMD, "polyc grid")
-             : o.command == CMD_MAP ? refuse_options(&o, ~(unsigned)OPTS_MAP_ONLY, "a laser log")
-                                    : 0;
+        rc = o.command == CMD_GRID      ? refuse_options(&o, OPTS_GRID_CMD, "polyc grid")
+             : o.command == CMD_CONVERT ? refuse_options(&o, OPTS_CONVERT_CMD, "polyc convert")
+                                        : refuse_options(&o, ~(unsigned)OPTS_MAP_ONLY,
+                                                         "a laser log");
         FILE *in = NULL;
         if (!rc) {
             progress_stage("reading the log");
             in = strcmp(o.input, "-") == 0 ? stdin : fopen(o.input, "rb");
+            struct stat st;
             if (!in)
                 rc = complain(EXIT_INPUT, "%s: %s", o.input, strerror(errno));
+            else if (fstat(fileno(in), &st) == 0 && S_ISDIR(st.st_mode))
+                rc = complain(EXIT_INPUT, "%s: %s: give a log file", o.input, strerror(EISDIR));
+            if (rc && in && in != stdin)
+                fclose(in);
         }
         if (!rc) {
             scanlog_opts so = {o.max_range_m};

@@ -709,7 +709,9 @@ static int finish(reader *r)
 {
     scanlog *log = r->log;
     if (log->count == 0)
-        return fail(r, "no scans found (%llu lines read)", (unsigned long long)log->lines);
+        return fail(r, "no scans found (%llu lines read; polyc reads CARMEN FLASER and"
+                       " ROBOTLASER1 lines, polyc's SCAN lines, or a map_server map YAML)",
+                    (unsigned long long)log->lines);
     if (log->kind_counts[SCANLOG_FLASER]) {
         scanlog_noreturn *nr = &log->noreturn;
         if (r->max_range_m > 0) {
