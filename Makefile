@@ -300,6 +300,8 @@ images:
 	build-bench/polyc -o $(IMG_DIR)/intel-optimised.svg $(DATA)/carmen/intel.log
 	for f in office office-map intel-initial intel-optimised; do \
 	    rsvg-convert -w 700 -o docs/img/$$f.png $(IMG_DIR)/$$f.svg || exit 1; done
+	build-bench/polyc --points -o $(IMG_DIR)/fhw.svg $(DATA)/carmen/fhw.log
+	sh tools/eval/svgcrop.sh $(IMG_DIR)/fhw.svg docs/img/fhw-band.png 6 9 12 15 450
 
 # Regenerate the bundled example (examples/office.*) with the simulator
 .PHONY: examples

@@ -465,9 +465,11 @@ int mapout_svg(FILE *f, const mapout_map *map)
             "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
             "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\""
             " viewBox=\"0 0 %.0f %.0f\">\n"
-            "<!-- polyc map: x %.4f..%.4f m, y %.4f..%.4f m (y up), %.4f px/m -->\n"
+            "<!-- polyc map: x %.4f..%.4f m, y %.4f..%.4f m (y up), %.4f px/m,"
+            " x %.4f m at px %.2f, y %.4f m at px %.2f -->\n"
             "<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n",
-            v.width, v.height, v.width, v.height, v.x0, v.x1, v.y0, v.y1, v.scale);
+            v.width, v.height, v.width, v.height, v.x0, v.x1, v.y0, v.y1, v.scale, v.x0, v.left,
+            v.y1, v.top);
     svg_title(f, map, &v);
     if (map->grid)
         svg_grid(f, map, &v);
