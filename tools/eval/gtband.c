@@ -224,9 +224,11 @@ int gtband_scan_points(const polyc_scan *scans, uint32_t scan_count, double **xy
     uint64_t n = 0, p = 0;
     uint32_t s, i;
     double *xy, *from;
-    if (!xy_m || !sensors_xy_m || !count || (!scans && scan_count))
+    if (!xy_m || !count || (!scans && scan_count))
         return -1;
-    *xy_m = *sensors_xy_m = NULL;
+    *xy_m = NULL;
+    if (sensors_xy_m)
+        *sensors_xy_m = NULL;
     *count = 0;
     for (s = 0; s < scan_count; s++)
         for (i = 0; i < scans[s].beam_count; i++)
@@ -236,8 +238,8 @@ int gtband_scan_points(const polyc_scan *scans, uint32_t scan_count, double **xy
     if (n > SIZE_MAX / (2u * sizeof *xy))
         return -1;
     xy = malloc((size_t)n * 2u * sizeof *xy);
-    from = malloc((size_t)n * 2u * sizeof *from);
-    if (!xy || !from) {
+    from = sensors_xy_m ? malloc((size_t)n * 2u * sizeof *from) : NULL;
+    if (!xy || (sensors_xy_m && !from)) {
         free(xy);
         free(from);
         return -1;
@@ -253,13 +255,16 @@ int gtband_scan_points(const polyc_scan *scans, uint32_t scan_count, double **xy
             r = (double)scan->range_m[i];
             xy[2u * p] = scan->pose_x_m + r * cos(a);
             xy[2u * p + 1u] = scan->pose_y_m + r * sin(a);
-            from[2u * p] = scan->pose_x_m;
-            from[2u * p + 1u] = scan->pose_y_m;
+            if (from) {
+                from[2u * p] = scan->pose_x_m;
+                from[2u * p + 1u] = scan->pose_y_m;
+            }
             p++;
         }
     }
     *xy_m = xy;
-    *sensors_xy_m = from;
+    if (sensors_xy_m)
+        *sensors_xy_m = from;
     *count = n;
     return 0;
 }

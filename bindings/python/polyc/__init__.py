@@ -704,6 +704,20 @@ class Context:
         return {n: getattr(s, n) for n, _ in _Stats._fields_ if n != "reserved"}
 
 
+def _scans_and_limits(cfg, scans):
+    """The scans as held ctypes records (with the buffers they point into)
+    and the limits polyc_limits_for_scans gives for them."""
+    held = [_scan(s) for s in scans]
+    _int_field("number of scans", len(held), _u32)
+    arr = (_Scan * max(len(held), 1))(*[s for s, _ in held])
+    lim = _Limits()
+    status = _lib.polyc_limits_for_scans(ctypes.byref(cfg), arr, len(held), ctypes.byref(lim))
+    if status != OK:
+        raise PolycError(status, "limits for scans",
+                         "the data span more than max_extent_m" if status == ERR_EXTENT else "")
+    return held, lim
+
+
 def build_map(scans, memory_bytes=None, max_vertices=0, progress=None, **config):
     """Maps a sequence of scans (Scan or plain 6-sequences) as the polyc tool
     does: limits from the scans (polyc_limits_for_scans), one block, build;
@@ -715,14 +729,7 @@ def build_map(scans, memory_bytes=None, max_vertices=0, progress=None, **config)
     if progress is not None and not callable(progress):
         raise TypeError("progress must be callable or None, not %s" % type(progress).__name__)
     max_vertices = _int_field("max_vertices", max_vertices, _u32)
-    held = [_scan(s) for s in scans]
-    _int_field("number of scans", len(held), _u32)
-    arr = (_Scan * max(len(held), 1))(*[s for s, _ in held])
-    lim = _Limits()
-    status = _lib.polyc_limits_for_scans(ctypes.byref(cfg), arr, len(held), ctypes.byref(lim))
-    if status != OK:
-        raise PolycError(status, "limits for scans",
-                         "the data span more than max_extent_m" if status == ERR_EXTENT else "")
+    held, lim = _scans_and_limits(cfg, scans)
     if max_vertices:
         lim.max_vertices = max_vertices
     for attempt in (0, 1):
@@ -747,14 +754,7 @@ def grid_image(scans, **config):
     """The scans' hit/miss grid as map_saver's image, as `polyc grid` makes
     it (limits from the scans, build_grid): a GridImage."""
     cfg = _config(config)
-    held = [_scan(s) for s in scans]
-    _int_field("number of scans", len(held), _u32)
-    arr = (_Scan * max(len(held), 1))(*[s for s, _ in held])
-    lim = _Limits()
-    status = _lib.polyc_limits_for_scans(ctypes.byref(cfg), arr, len(held), ctypes.byref(lim))
-    if status != OK:
-        raise PolycError(status, "limits for scans",
-                         "the data span more than max_extent_m" if status == ERR_EXTENT else "")
+    held, lim = _scans_and_limits(cfg, scans)
     ctx = Context((lim.max_scans, lim.max_beams, lim.max_grid_cells, lim.max_vertices,
                    lim.max_points), **config)
     for i, (s, _) in enumerate(held):
