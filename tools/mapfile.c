@@ -5,40 +5,13 @@
  * PGM and YAML text; one "NAME:LINE:" (YAML) or "NAME: byte N:" (PGM)
  * message on failure. Rules are in docs/formats.md ("ROS maps"). */
 #include "mapfile.h"
+#include "textesc.h"
 
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
-
-/* Up to 24 bytes of s for a message, "..." if longer; bytes outside
- * printable ASCII as \xNN, so that a message never carries raw input. */
-typedef struct excerpt {
-    char text[24 * 4 + 4];
-} excerpt;
-
-static const char *quote(excerpt *e, const char *s, size_t len)
-{
-    static const char hex[] = "0123456789abcdef";
-    size_t o = 0, i;
-    for (i = 0; i < len && i < 24; i++) {
-        unsigned char c = (unsigned char)s[i];
-        if (c >= 0x20 && c < 0x7f) {
-            e->text[o++] = (char)c;
-        } else {
-            e->text[o++] = '\\';
-            e->text[o++] = 'x';
-            e->text[o++] = hex[c >> 4];
-            e->text[o++] = hex[c & 15];
-        }
-    }
-    if (i < len)
-        for (int k = 0; k < 3; k++)
-            e->text[o++] = '.';
-    e->text[o] = '\0';
-    return e->text;
-}
 
 /* ---- the YAML ---- */
 
@@ -121,7 +94,7 @@ static int read_scalar(yparser *p, const char *s, size_t n, size_t *pos, int in_
 {
     size_t i = *pos, o = 0;
     char *out = p->scratch;
-    excerpt e;
+    textesc_excerpt e;
     *has_nul = 0;
     if (i < n && s[i] == '\'') {
         for (i++;; i++) {
@@ -164,7 +137,7 @@ static int read_scalar(yparser *p, const char *s, size_t n, size_t *pos, int in_
             int digits = s[i] == 'x' ? 2 : s[i] == 'u' ? 4 : s[i] == 'U' ? 8 : 0;
             if (!digits)
                 return yfail(p, p->line, "unknown escape '\\%s' in a double-quoted string",
-                             quote(&e, s + i, 1));
+                             textesc_quote(&e, s + i, 1));
             uint32_t u = 0;
             for (int d = 0; d < digits; d++) {
                 int h = i + 1 + (size_t)d < n ? hex_value(s[i + 1 + (size_t)d]) : -1;
@@ -202,12 +175,13 @@ static int read_scalar(yparser *p, const char *s, size_t n, size_t *pos, int in_
 /* After a scalar in block context: only blanks and a comment may follow. */
 static int expect_line_end(yparser *p, const char *s, size_t n, size_t i, const char *what)
 {
-    excerpt e;
+    textesc_excerpt e;
     size_t j = i;
     while (j < n && is_blank(s[j]))
         j++;
     if (j < n && !(s[j] == '#' && j > i))
-        return yfail(p, p->line, "unexpected '%s' after the %s", quote(&e, s + j, n - j), what);
+        return yfail(p, p->line, "unexpected '%s' after the %s", textesc_quote(&e, s + j, n - j),
+                     what);
     return 0;
 }
 
@@ -254,10 +228,10 @@ static int parse_number(const char *s, double *out)
 /* One number of the origin list. */
 static int origin_item(yparser *p, const char *s, size_t len)
 {
-    excerpt e;
+    textesc_excerpt e;
     double v;
     if (parse_number(s, &v))
-        return yfail(p, p->line, "origin: '%s' is not a number", quote(&e, s, len));
+        return yfail(p, p->line, "origin: '%s' is not a number", textesc_quote(&e, s, len));
     if (p->origin_n < 3)
         p->origin[p->origin_n] = v;
     p->origin_n++;
@@ -285,7 +259,7 @@ static int is_bool(const char *s, int *out)
 static int set_scalar(yparser *p, const char *s, size_t len, int has_nul)
 {
     mapfile_yaml *y = p->y;
-    excerpt e;
+    textesc_excerpt e;
     double v;
     const char *k = key_names[p->key];
     switch (p->key) {
@@ -304,12 +278,13 @@ static int set_scalar(yparser *p, const char *s, size_t len, int has_nul)
         return 0;
     case K_RESOLUTION:
         if (parse_number(s, &v))
-            return yfail(p, p->line, "resolution: '%s' is not a number", quote(&e, s, len));
+            return yfail(p, p->line, "resolution: '%s' is not a number", textesc_quote(&e, s, len));
         if (!(v > 0))
-            return yfail(p, p->line, "resolution %s must be above 0 m", quote(&e, s, len));
+            return yfail(p, p->line, "resolution %s must be above 0 m", textesc_quote(&e, s, len));
         if (v < MAPFILE_MIN_RESOLUTION_M || v > MAPFILE_MAX_RESOLUTION_M)
-            return yfail(p, p->line, "resolution %s m is outside [%g, %g] m", quote(&e, s, len),
-                         MAPFILE_MIN_RESOLUTION_M, MAPFILE_MAX_RESOLUTION_M);
+            return yfail(p, p->line, "resolution %s m is outside [%g, %g] m",
+                         textesc_quote(&e, s, len), MAPFILE_MIN_RESOLUTION_M,
+                         MAPFILE_MAX_RESOLUTION_M);
         y->resolution_m = v;
         return 0;
     case K_NEGATE:
@@ -317,14 +292,14 @@ static int set_scalar(yparser *p, const char *s, size_t len, int has_nul)
             y->negate = s[0] == '1';
         else if (!is_bool(s, &y->negate))
             return yfail(p, p->line, "negate must be 0 or 1 (or true, false), not '%s'",
-                         quote(&e, s, len));
+                         textesc_quote(&e, s, len));
         return 0;
     case K_OCCUPIED:
     case K_FREE:
         if (parse_number(s, &v))
-            return yfail(p, p->line, "%s: '%s' is not a number", k, quote(&e, s, len));
+            return yfail(p, p->line, "%s: '%s' is not a number", k, textesc_quote(&e, s, len));
         if (!(v >= 0.0 && v <= 1.0))
-            return yfail(p, p->line, "%s %s is outside [0, 1]", k, quote(&e, s, len));
+            return yfail(p, p->line, "%s %s is outside [0, 1]", k, textesc_quote(&e, s, len));
         *(p->key == K_FREE ? &y->free_thresh : &y->occupied_thresh) = v;
         return 0;
     case K_MODE:
@@ -336,7 +311,7 @@ static int set_scalar(yparser *p, const char *s, size_t len, int has_nul)
             y->mode = MAPFILE_RAW;
         else
             return yfail(p, p->line, "mode must be trinary, scale or raw, not '%s'",
-                         quote(&e, s, len));
+                         textesc_quote(&e, s, len));
         return 0;
     default:
         return 0;
@@ -346,7 +321,7 @@ static int set_scalar(yparser *p, const char *s, size_t len, int has_nul)
 /* Feeds part of a flow list [x, y, yaw] (of origin) from s[i..n). */
 static int flow_feed(yparser *p, const char *s, size_t n, size_t i)
 {
-    excerpt e;
+    textesc_excerpt e;
     while (i < n) {
         if (is_blank(s[i])) {
             i++;
@@ -355,7 +330,8 @@ static int flow_feed(yparser *p, const char *s, size_t n, size_t i)
         if (s[i] == '#' && (i == 0 || is_blank(s[i - 1])))
             return 0;                          /* a comment: the list goes on */
         if (p->state == V_DONE)
-            return yfail(p, p->line, "unexpected '%s' after the list", quote(&e, s + i, n - i));
+            return yfail(p, p->line, "unexpected '%s' after the list",
+                         textesc_quote(&e, s + i, n - i));
         if (s[i] == ']') {
             p->state = V_DONE;
             i++;
@@ -376,7 +352,7 @@ static int flow_feed(yparser *p, const char *s, size_t n, size_t i)
             i++;
         } else {
             return yfail(p, p->line, "origin: expected ',' or ']', found '%s'",
-                         quote(&e, s + i, n - i));
+                         textesc_quote(&e, s + i, n - i));
         }
     }
     return 0;
@@ -385,7 +361,7 @@ static int flow_feed(yparser *p, const char *s, size_t n, size_t i)
 /* The value of a known key starts at s[i..n) (non-empty, not a comment). */
 static int value_start(yparser *p, const char *s, size_t n, size_t i)
 {
-    excerpt e;
+    textesc_excerpt e;
     const char *k = key_names[p->key];
     char c = s[i];
     if (c == '&' || c == '*' || c == '!')
@@ -395,7 +371,7 @@ static int value_start(yparser *p, const char *s, size_t n, size_t i)
     if (p->key == K_ORIGIN) {
         if (c != '[')
             return yfail(p, p->line, "origin must be a list [x, y, yaw], not '%s'",
-                         quote(&e, s + i, n - i));
+                         textesc_quote(&e, s + i, n - i));
         p->state = V_FLOW;
         p->flow_expect_item = 1;
         p->origin_n = 0;
@@ -446,7 +422,7 @@ static int is_seq_item(const char *s, size_t n)
  * the current key. */
 static int continuation(yparser *p, const char *s, size_t n)
 {
-    excerpt e;
+    textesc_excerpt e;
     if (p->key == K_UNKNOWN)
         return 0;
     if (p->key == K_NONE)
@@ -475,7 +451,8 @@ static int continuation(yparser *p, const char *s, size_t n)
         return origin_item(p, p->scratch, len);
     }
     if (p->state == V_BLOCK_SEQ)
-        return yfail(p, p->line, "origin: expected '- number', found '%s'", quote(&e, s, n));
+        return yfail(p, p->line, "origin: expected '- number', found '%s'",
+                     textesc_quote(&e, s, n));
     return yfail(p, p->line, "unexpected indented line after %s (line %u)", k,
                  (unsigned)p->key_line);
 }
@@ -483,7 +460,7 @@ static int continuation(yparser *p, const char *s, size_t n)
 /* A top-level `key: value` line (s is the line without its indent). */
 static int key_line(yparser *p, const char *s, size_t n)
 {
-    excerpt e;
+    textesc_excerpt e;
     size_t i = 0, klen;
     const char *kname;
     if (key_end(p))
@@ -510,7 +487,7 @@ static int key_line(yparser *p, const char *s, size_t n)
                 i = n;
         }
         if (i >= n)
-            return yfail(p, p->line, "expected 'key: value', found '%s'", quote(&e, s, n));
+            return yfail(p, p->line, "expected 'key: value', found '%s'", textesc_quote(&e, s, n));
         klen = i;
         while (klen > 0 && is_blank(s[klen - 1]))
             klen--;
@@ -734,7 +711,7 @@ static void pgm_skip(pgm_reader *r)
  * gets its offset. 0 or -1. */
 static int pgm_number(pgm_reader *r, const char *what, uint64_t max, uint64_t *out, size_t *at)
 {
-    excerpt e;
+    textesc_excerpt e;
     pgm_skip(r);
     *at = r->pos;
     if (r->pos >= r->len)
@@ -754,7 +731,7 @@ static int pgm_number(pgm_reader *r, const char *what, uint64_t max, uint64_t *o
         if (end == start)
             end++;
         return pfail(r, start, "%s is not a number: '%s'", what,
-                     quote(&e, (const char *)r->d + start, end - start));
+                     textesc_quote(&e, (const char *)r->d + start, end - start));
     }
     *out = v;
     return 0;
@@ -763,7 +740,7 @@ static int pgm_number(pgm_reader *r, const char *what, uint64_t max, uint64_t *o
 int mapfile_pgm_parse(mapfile_pgm *p, const uint8_t *data, size_t len, const char *name)
 {
     pgm_reader r = {p, name, data, len, 0};
-    excerpt e;
+    textesc_excerpt e;
     memset(p, 0, sizeof *p);
     if (len >= 8 && memcmp(data, "\x89PNG\r\n\x1a\n", 8) == 0)
         return pfail(&r, 0, "a PNG image: polyc reads PGM (P5 or P2) only; save the map as"
@@ -771,7 +748,7 @@ int mapfile_pgm_parse(mapfile_pgm *p, const uint8_t *data, size_t len, const cha
     if (len < 2 || data[0] != 'P' || (data[1] != '5' && data[1] != '2') ||
         (len > 2 && !pgm_space(data[2]) && data[2] != '#'))
         return pfail(&r, 0, "not a PGM image (P5 or P2): it starts with '%s'; save the map"
-                            " as PGM", quote(&e, (const char *)data, len < 4 ? len : 4));
+                            " as PGM", textesc_quote(&e, (const char *)data, len < 4 ? len : 4));
     p->plain = data[1] == '2';
     r.pos = 2;
     uint64_t w, h, maxval;

@@ -25,6 +25,7 @@
 #include "outfile.h"
 #include "polyc.h"
 #include "scanlog.h"
+#include "textesc.h"
 
 #define EXIT_INPUT 1
 #define EXIT_USAGE 2
@@ -558,29 +559,6 @@ typedef struct run {
 
 /* ---- --stats ---- */
 
-/* A copy of s for messages: bytes outside printable ASCII as \xNN. */
-static char *printable(const char *s)
-{
-    static const char hex[] = "0123456789abcdef";
-    size_t n = strlen(s), o = 0;
-    char *out = malloc(4 * n + 1);
-    if (!out)
-        return NULL;
-    for (size_t i = 0; i < n; i++) {
-        unsigned char c = (unsigned char)s[i];
-        if (c >= 0x20 && c < 0x7f) {
-            out[o++] = (char)c;
-        } else {
-            out[o++] = '\\';
-            out[o++] = 'x';
-            out[o++] = hex[c >> 4];
-            out[o++] = hex[c & 15];
-        }
-    }
-    out[o] = '\0';
-    return out;
-}
-
 static void print_input_stats(const scanlog *log)
 {
     FILE *e = stderr;
@@ -617,7 +595,7 @@ static void print_map_stats(const map_input *m)
 {
     static const char *const modes[] = {"trinary", "scale", "raw"};
     FILE *e = stderr;
-    char *shown = printable(m->image_path);   /* no raw bytes on the terminal */
+    char *shown = textesc_dup(m->image_path);   /* no raw bytes on the terminal */
     fprintf(e, "map            %u x %u cells of %g m, %s (%s, maxval %u), mode %s%s\n",
             (unsigned)m->pgm.width, (unsigned)m->pgm.height, m->yaml.resolution_m,
             shown ? shown : "?", m->pgm.plain ? "P2" : "P5", (unsigned)m->pgm.maxval,
@@ -850,7 +828,7 @@ static int load_map(const options *o, map_input *m)
         return complain(EXIT_INPUT, "%s", m->yaml.error);
     if (!(m->image_path = mapfile_image_path(o->input, m->yaml.image)))
         return complain(EXIT_INPUT, "out of memory");
-    char *shown = printable(m->image_path);
+    char *shown = textesc_dup(m->image_path);
     if (!shown)
         return complain(EXIT_INPUT, "out of memory");
     err = read_whole(m->image_path, MAPFILE_MAX_PGM_BYTES, &text, &len);

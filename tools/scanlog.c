@@ -3,6 +3,7 @@
  * Gives: owned scans, line counters, the FLASER no-return threshold, or
  * one "NAME:LINE: message" error. Rules are in docs/formats.md. */
 #include "scanlog.h"
+#include "textesc.h"
 
 #include <errno.h>
 #include <float.h>
@@ -193,33 +194,11 @@ static int is_space(int c)
     return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
 }
 
-/* Up to 24 bytes of field s for a message, with "..." if longer. Bytes
- * outside printable ASCII are written as \xNN, so that a message never
- * carries raw bytes of the input (terminal escapes, broken UTF-8). */
-typedef struct excerpt {
-    char text[24 * 4 + 4];
-} excerpt;
-
-static const char *quote(excerpt *e, const char *s)
+/* Up to 24 bytes of field s for a message, with "..." if longer, bytes
+ * outside printable ASCII as \xNN (textesc.h). */
+static const char *quote(textesc_excerpt *e, const char *s)
 {
-    static const char hex[] = "0123456789abcdef";
-    size_t o = 0, i;
-    for (i = 0; s[i] && i < 24; i++) {
-        unsigned char c = (unsigned char)s[i];
-        if (c >= 0x20 && c < 0x7f) {
-            e->text[o++] = (char)c;
-        } else {
-            e->text[o++] = '\\';
-            e->text[o++] = 'x';
-            e->text[o++] = hex[c >> 4];
-            e->text[o++] = hex[c & 15];
-        }
-    }
-    if (s[i])
-        for (int k = 0; k < 3; k++)
-            e->text[o++] = '.';
-    e->text[o] = '\0';
-    return e->text;
+    return textesc_quote(e, s, strlen(s));
 }
 
 /* Reads one line into r->buf without its '\n' (a final line may lack it).
@@ -345,7 +324,7 @@ static int take_double(reader *r, fields *fs, const char *what, double *out)
     if (len <= MAX_NUMBER_CHARS)
         *out = strtod(s, &end);
     if (len > MAX_NUMBER_CHARS || end != s + len) {
-        excerpt e;
+        textesc_excerpt e;
         return fail(r, "%s is not a number: '%s' (field %u)", what, quote(&e, s), fs->index);
     }
     /* Overflow gives +-HUGE_VAL, underflow a tiny number (errno ERANGE):
@@ -360,7 +339,7 @@ static int take_count(reader *r, fields *fs, const char *what, uint32_t max, uin
         return fail(r, "missing %s (field %u)", what, fs->index + 1);
     size_t len = strlen(s);
     unsigned long long v = 0;
-    excerpt e;
+    textesc_excerpt e;
     for (size_t i = 0; i < len; i++) {
         if (s[i] < '0' || s[i] > '9')
             return fail(r, "%s is not a count: '%s' (field %u)", what, quote(&e, s), fs->index);
@@ -668,7 +647,7 @@ static int parse_comment(reader *r, char *line)
     char *w = next_field(&fs);
     if (w && strcmp(w, "polyc-scans") == 0) {
         char *v = next_field(&fs);
-        excerpt e;
+        textesc_excerpt e;
         if (!v || strcmp(v, "1") != 0)
             return fail(r, "unsupported polyc-scans version '%s' (this reader: 1)",
                         quote(&e, v ? v : ""));
@@ -697,7 +676,7 @@ static int parse_line(reader *r, char *line)
     if (strcmp(word, "SCAN") == 0)
         return parse_plain(r, &fs);
     if (!is_keyword(word)) {
-        excerpt e;
+        textesc_excerpt e;
         return fail(r, "not a log line: starts with '%s'", quote(&e, word));
     }
     count_keyword(r->log, word);
