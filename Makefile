@@ -12,11 +12,15 @@ LDLIBS  = -lm
 
 LIB_SRC  = $(wildcard src/*.c)
 LIB_OBJ  = $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
-# tools/: the shipped tool (polyc.c) and its modules (log reader, map
-# files, SVG/JSON/TXT output). tools/eval/: the evaluation harness (bench,
-# sweep, simulator, ground-truth and topology scores), which the tests and
-# the benchmark use and the tool does not.
-TOOL_MOD = $(filter-out tools/polyc.c,$(wildcard tools/*.c))
+# tools/: the shipped tool (POLYC_SRC: main, command line, input, run,
+# messages) and its modules (log reader, map files, SVG/JSON/TXT output,
+# the library's block), which the tests, the bench and the binding use too.
+# tools/eval/: the evaluation harness (bench, sweep, simulator, ground-truth
+# and topology scores), which the tests and the benchmark use and the tool
+# does not.
+POLYC_SRC = tools/polyc.c tools/cli.c tools/options.c tools/load.c tools/run.c
+POLYC_OBJ = $(POLYC_SRC:tools/%.c=$(BUILD)/tobj/%.o)
+TOOL_MOD = $(filter-out $(POLYC_SRC),$(wildcard tools/*.c))
 TOOL_OBJ = $(TOOL_MOD:tools/%.c=$(BUILD)/tobj/%.o)
 EVAL_MOD = $(filter-out tools/eval/bench.c tools/eval/sweep.c tools/eval/mapscore.c,$(wildcard tools/eval/*.c))
 EVAL_OBJ = $(EVAL_MOD:tools/eval/%.c=$(BUILD)/eobj/%.o)
@@ -41,7 +45,7 @@ $(BUILD)/eobj/%.o: tools/eval/%.c include/polyc.h $(wildcard tools/*.h tools/eva
 	$(CC) $(EVAL_CFLAGS) -c $< -o $@
 $(BUILD)/libpolyc.a: $(LIB_OBJ)
 	rm -f $@ && ar rcs $@ $^
-$(BUILD)/polyc: tools/polyc.c $(TOOL_OBJ) $(BUILD)/libpolyc.a
+$(BUILD)/polyc: $(POLYC_OBJ) $(TOOL_OBJ) $(BUILD)/libpolyc.a
 	$(CC) $(TOOL_CFLAGS) $^ -o $@ $(LDLIBS)
 
 # Shared library: exports only the POLYC_API functions (-fvisibility=hidden)
