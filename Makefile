@@ -22,7 +22,8 @@ POLYC_SRC = tools/polyc.c tools/cli.c tools/options.c tools/load.c tools/run.c
 POLYC_OBJ = $(POLYC_SRC:tools/%.c=$(BUILD)/tobj/%.o)
 TOOL_MOD = $(filter-out $(POLYC_SRC),$(wildcard tools/*.c))
 TOOL_OBJ = $(TOOL_MOD:tools/%.c=$(BUILD)/tobj/%.o)
-EVAL_MOD = $(filter-out tools/eval/bench.c tools/eval/sweep.c tools/eval/mapscore.c,$(wildcard tools/eval/*.c))
+BENCH_SRC = $(wildcard tools/eval/bench*.c)
+EVAL_MOD = $(filter-out $(BENCH_SRC) tools/eval/sweep.c tools/eval/mapscore.c,$(wildcard tools/eval/*.c))
 EVAL_OBJ = $(EVAL_MOD:tools/eval/%.c=$(BUILD)/eobj/%.o)
 TOOL_CFLAGS = $(WARN) $(OPT) $(CFLAGS) -Iinclude -Itools -D_POSIX_C_SOURCE=200809L
 EVAL_CFLAGS = $(TOOL_CFLAGS) -Itools/eval
@@ -273,8 +274,8 @@ BENCH_ARGS ?=
 bench:
 	$(MAKE) BUILD=build-bench OPT='-O3 -march=native -DNDEBUG' build-bench/bench build-bench/mapscore
 	build-bench/bench $(BENCH_ARGS) $(DATA)
-$(BUILD)/bench: tools/eval/bench.c $(EVAL_OBJ) $(TOOL_OBJ) $(BUILD)/libpolyc.a
-	$(CC) $(EVAL_CFLAGS) $^ -o $@ $(LDLIBS)
+$(BUILD)/bench: $(BENCH_SRC) tools/eval/bench.h $(EVAL_OBJ) $(TOOL_OBJ) $(BUILD)/libpolyc.a
+	$(CC) $(EVAL_CFLAGS) $(filter-out %.h,$^) -o $@ $(LDLIBS)
 $(BUILD)/mapscore: tools/eval/mapscore.c $(EVAL_OBJ) $(TOOL_OBJ) $(BUILD)/libpolyc.a
 	$(CC) $(EVAL_CFLAGS) $^ -o $@ $(LDLIBS)
 

@@ -1,8 +1,8 @@
 /* ctxblock.h - the one block the library runs in, as the tools make it:
  * polyc_memory_size for a configuration and limits, malloc, and polyc_init
  * on it. The library never allocates; this is the tools' side of "ask for
- * the size, then pass the block" (the polyc tool, the bench, the sweep and
- * the tests all use it). */
+ * the size, then pass the block" (the polyc tool, and the bench and the
+ * sweep through tools/eval/pipeline.c). */
 #ifndef POLYC_CTXBLOCK_H
 #define POLYC_CTXBLOCK_H
 
