@@ -85,7 +85,7 @@ unit: $(TEST_BIN) $(BUILD)/polyc
 # CHECK_STEPS, each into build-check/STEP.log: one line per step (the log's
 # tail if it failed), and last a line `N passed, N failed` alone (CI reads it).
 CHECK_STEPS = unit test-cli test-fuzz-replay test-asan test-cxx test-install test-python \
-              test-embedded test-opt-O3 test-opt-Os test-valgrind cross
+              test-embedded test-opt-O3 test-opt-Os test-golden test-valgrind cross
 check: deps
 	@mkdir -p build-check; pass=0; fail=0; \
 	for s in $(CHECK_STEPS); do \
@@ -110,8 +110,16 @@ deps:
 
 
 # Also: the header as C++, an installed copy used through pkg-config, the
-# Python binding against build/libpolyc.so, the 128 KiB example on the host
-test: unit test-cli test-fuzz-replay test-asan test-cxx test-install test-python test-embedded
+# Python binding against build/libpolyc.so, the 128 KiB example on the host,
+# and the tool's bytes across optimisation levels (test-golden)
+test: unit test-cli test-fuzz-replay test-asan test-cxx test-install test-python test-embedded \
+      test-golden
+# tests/golden.sh: the tool built at -O0, -O2, -O3 and -Os -flto (in
+# build-golden-*/) writes the same bytes on simulated scenes, examples/office.log
+# and its grid as a ROS map
+.PHONY: test-golden
+test-golden: $(BUILD)/gen_example
+	tests/golden.sh "$(MAKE)" $(BUILD)/gen_example
 test-cxx: $(BUILD)/tests/cxx_header
 	$(BUILD)/tests/cxx_header
 $(BUILD)/tests/cxx_header: tests/cxx_header.cpp include/polyc.h $(BUILD)/libpolyc.a
