@@ -221,47 +221,9 @@ done:
 int gtband_scan_points(const polyc_scan *scans, uint32_t scan_count, double **xy_m,
                        double **sensors_xy_m, uint64_t *count)
 {
-    uint64_t n = 0, p = 0;
-    uint32_t s, i;
-    double *xy, *from;
-    if (!xy_m || !sensors_xy_m || !count || (!scans && scan_count))
+    if (!sensors_xy_m)
         return -1;
-    *xy_m = *sensors_xy_m = NULL;
-    *count = 0;
-    for (s = 0; s < scan_count; s++)
-        for (i = 0; i < scans[s].beam_count; i++)
-            n += (uint64_t)gtscore_beam_reflected(&scans[s], i);
-    if (n == 0)
-        return 0;
-    if (n > SIZE_MAX / (2u * sizeof *xy))
-        return -1;
-    xy = malloc((size_t)n * 2u * sizeof *xy);
-    from = malloc((size_t)n * 2u * sizeof *from);
-    if (!xy || !from) {
-        free(xy);
-        free(from);
-        return -1;
-    }
-    for (s = 0; s < scan_count; s++) {
-        const polyc_scan *scan = &scans[s];
-        for (i = 0; i < scan->beam_count; i++) {
-            double a, r;
-            if (!gtscore_beam_reflected(scan, i))
-                continue;
-            a = scan->pose_theta_rad + (double)scan->start_angle_rad +
-                (double)i * (double)scan->angle_step_rad;
-            r = (double)scan->range_m[i];
-            xy[2u * p] = scan->pose_x_m + r * cos(a);
-            xy[2u * p + 1u] = scan->pose_y_m + r * sin(a);
-            from[2u * p] = scan->pose_x_m;
-            from[2u * p + 1u] = scan->pose_y_m;
-            p++;
-        }
-    }
-    *xy_m = xy;
-    *sensors_xy_m = from;
-    *count = n;
-    return 0;
+    return gtscore_scan_endpoints(scans, scan_count, xy_m, sensors_xy_m, count);
 }
 
 double gtband_share(uint64_t within, uint64_t points)

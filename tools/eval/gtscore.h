@@ -159,6 +159,14 @@ typedef struct gtscore_scan_score {
 void gtscore_score_scan(const gtscore_index *map, const polyc_scan *scan,
                         gtscore_scan_score *acc);
 
+/* The endpoints of the reflected beams (gtscore_beam_reflected) of `scans`,
+ * in order: *xy_m gets a malloc'ed array of *count (x, y) pairs, and with
+ * sensors_xy_m (may be NULL) another of each endpoint's scan pose (x, y);
+ * the caller frees them (NULL when there are none). 0, or -1 for a NULL
+ * argument or out of memory. */
+int gtscore_scan_endpoints(const polyc_scan *scans, uint32_t scan_count, double **xy_m,
+                           double **sensors_xy_m, uint64_t *count);
+
 /* Endpoints of the reflected beams of `scans` within d_m (<=) of the map:
  * *within of *total. */
 void gtscore_endpoints_within(const gtscore_index *map, const polyc_scan *scans,
