@@ -130,7 +130,8 @@ test-install: all
 # The Python package's library: libpolyc with the tool's readers
 # (scanlog, mapfile, gridimage) and the binding's glue (polyc_io.c), as
 # `pip install ./bindings/python` builds it (bindings/python/setup.py).
-PY_MOD = tools/scanlog.c tools/mapfile.c tools/gridimage.c tools/textesc.c bindings/python/polyc_io.c
+PY_MOD = tools/scanlog.c tools/scanlog_noreturn.c tools/mapfile.c tools/mapfile_pgm.c \
+         tools/gridimage.c tools/textesc.c bindings/python/polyc_io.c
 PY_OBJ = $(PY_MOD:%.c=$(BUILD)/pyobj/%.o)
 $(BUILD)/pyobj/%.o: %.c include/polyc.h $(wildcard tools/*.h)
 	@mkdir -p $(dir $@)
@@ -219,13 +220,15 @@ FUZZ_TIME ?= 60
 FUZZ_BIN   = $(FUZZ_TARGETS:%=build-fuzz/fuzz_%)
 FUZZ_CFLAGS = $(WARN) -g -O2 -fno-omit-frame-pointer -fsanitize=fuzzer,$(SAN_LIST) -fno-sanitize-recover=all \
               -Iinclude -Itools -D_POSIX_C_SOURCE=200809L
-build-fuzz/fuzz_scanlog: tests/fuzz_scanlog.c tools/scanlog.c tools/textesc.c $(LIB_SRC)
+build-fuzz/fuzz_scanlog: tests/fuzz_scanlog.c tools/scanlog.c tools/scanlog_noreturn.c tools/textesc.c \
+                         $(LIB_SRC)
 build-fuzz/fuzz_library: tests/fuzz_library.c $(LIB_SRC)
-build-fuzz/fuzz_mapyaml: tests/fuzz_mapyaml.c tools/mapfile.c tools/textesc.c
-build-fuzz/fuzz_pgm: tests/fuzz_pgm.c tools/mapfile.c tools/textesc.c
+build-fuzz/fuzz_mapyaml: tests/fuzz_mapyaml.c tools/mapfile.c tools/mapfile_pgm.c tools/textesc.c
+build-fuzz/fuzz_pgm: tests/fuzz_pgm.c tools/mapfile.c tools/mapfile_pgm.c tools/textesc.c
 # the optimiser's float compares drown the run in comparison tracing: off
 build-fuzz/fuzz_library: FUZZ_CFLAGS += -fno-sanitize-coverage=trace-cmp
-$(FUZZ_BIN): include/polyc.h $(wildcard src/*.h) tools/scanlog.h tools/mapfile.h tools/textesc.h
+$(FUZZ_BIN): include/polyc.h $(wildcard src/*.h) tools/scanlog.h tools/scanlog_noreturn.h \
+             tools/mapfile.h tools/textesc.h
 	@mkdir -p $(dir $@)
 	$(FUZZ_CC) $(FUZZ_CFLAGS) $(filter %.c,$^) -o $@ -lm
 fuzz: $(FUZZ_BIN)
