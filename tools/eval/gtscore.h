@@ -85,6 +85,11 @@ int gtscore_index_box(const gtscore_index *index, double x_m, double y_m, double
 /* Squared distance from (x, y) to the segment seg_m (x0 y0 x1 y1). */
 double gtscore_segment_distance2(const double *seg_m, double x_m, double y_m);
 
+/* Is a segment that `accept` takes (accept(ctx, segment index) != 0; NULL:
+ * any) within r_m (squared distance <= r_m^2) of (x, y)? */
+int gtscore_index_any_near(const gtscore_index *index, double x_m, double y_m, double r_m,
+                           int (*accept)(const void *ctx, uint32_t seg), const void *ctx);
+
 /* Range to the first segment met by the ray from (x, y) at angle_rad,
  * within (0, max_range_m]; INFINITY if none. */
 double gtscore_index_ray(const gtscore_index *index, double x_m, double y_m, double angle_rad,

@@ -232,27 +232,24 @@ static void unsupported_runs(const topo_map *m, const polyc_polyline *lines, uin
 
 /* ---- double cover --------------------------------------------------------- */
 
+typedef struct cover_pick {
+    const topo_map *m;
+    uint32_t s;
+} cover_pick;
+
+/* Any segment but s and its neighbours. */
+static int cover_accepts(const void *ctx, uint32_t o)
+{
+    const cover_pick *p = ctx;
+    const topo_seg *t = &p->m->segs[p->s];
+    return o != p->s && o != t->prev && o != t->next;
+}
+
 /* Is a segment other than s and its neighbours within reach of (x, y)? */
 static int covered(const topo_map *m, uint32_t s, double x, double y)
 {
-    const gtscore_index *ix = &m->index;
-    const topo_seg *t = &m->segs[s];
-    double r2 = GTTOPO_COVER_M * GTTOPO_COVER_M;
-    uint32_t box[4], cx, cy, k;
-    if (!gtscore_index_box(ix, x, y, GTTOPO_COVER_M, box))
-        return 0;
-    for (cy = box[1]; cy <= box[3]; cy++)
-        for (cx = box[0]; cx <= box[2]; cx++) {
-            size_t c = (size_t)cy * ix->width + cx;
-            for (k = ix->cell_start[c]; k < ix->cell_start[c + 1u]; k++) {
-                uint32_t o = ix->cell_seg[k];
-                if (o == s || o == t->prev || o == t->next)
-                    continue;
-                if (gtscore_segment_distance2(&ix->seg_m[4u * o], x, y) <= r2)
-                    return 1;
-            }
-        }
-    return 0;
+    cover_pick p = {m, s};
+    return gtscore_index_any_near(&m->index, x, y, GTTOPO_COVER_M, cover_accepts, &p);
 }
 
 static void double_cover(const topo_map *m, gttopo_score *out)

@@ -91,11 +91,7 @@ int scansim_kind_hall(scansim_scene *s)
         rc |= layout_scatter_boxes(&L, upick(&L.rng, 4u, 10u), case_w, case_h, -1.0, 1.0, 1.0,
                                    w - 1.0, h - 1.0, 1.0);
     }
-    rc |= layout_add_people(&L, 3u, 2u);
-    if (rc != 0)
-        return -1;
-    layout_place_anywhere(&L);
-    return 0;
+    return layout_finish(&L, rc, 3u, 2u);
 }
 
 /* ---- shelves ------------------------------------------------------------------- */
@@ -162,11 +158,7 @@ int scansim_kind_shelves(scansim_scene *s)
                 placed += (uint32_t)got;
         }
     }
-    rc |= layout_add_people(&L, 2u, 2u);
-    if (rc != 0)
-        return -1;
-    layout_place_anywhere(&L);
-    return 0;
+    return layout_finish(&L, rc, 2u, 2u);
 }
 
 /* ---- flat ------------------------------------------------------------------- */
@@ -295,11 +287,7 @@ int scansim_kind_flat(scansim_scene *s)
                 placed += (uint32_t)got;
         }
     }
-    rc |= layout_add_people(&L, 1u, 2u);
-    if (rc != 0)
-        return -1;
-    layout_place_anywhere(&L);
-    return 0;
+    return layout_finish(&L, rc, 1u, 2u);
 }
 
 /* ---- curved --------------------------------------------------------------------- */
@@ -368,11 +356,7 @@ int scansim_kind_curved(scansim_scene *s)
         rc |= layout_scatter_boxes(&L, upick(&L.rng, 2u, 4u), fw, fh, -1.0, 0.5, 0.5, w - 0.5,
                                    h - 0.5, 0.3);
     }
-    rc |= layout_add_people(&L, 1u, 1u);
-    if (rc != 0)
-        return -1;
-    layout_place_anywhere(&L);
-    return 0;
+    return layout_finish(&L, rc, 1u, 1u);
 }
 
 /* ---- thinwalls ------------------------------------------------------------------ */
@@ -447,11 +431,7 @@ int scansim_kind_thinwalls(scansim_scene *s)
         rc |= layout_scatter_boxes(&L, upick(&L.rng, 0u, 2u), fw, fh, -1.0, 0.5, 0.5, w - 0.5,
                                    h - 0.5, 0.3);
     }
-    rc |= layout_add_people(&L, 1u, 1u);
-    if (rc != 0)
-        return -1;
-    layout_place_anywhere(&L);
-    return 0;
+    return layout_finish(&L, rc, 1u, 1u);
 }
 
 /* ---- drift and farhall: poses that drift --------------------------------------- */
@@ -562,11 +542,7 @@ int scansim_kind_drift(scansim_scene *s)
     }
     layout_way(&L, m, m + 0.2);
     rc |= layout_path(&L, 1000.0);
-    rc |= layout_add_people(&L, 2u, 1u);
-    if (rc != 0)
-        return -1;
-    layout_place_anywhere(&L);
-    return 0;
+    return layout_finish(&L, rc, 2u, 1u);
 }
 
 /* The hall (the same layout, path and people for a seed) with drift: its

@@ -6,16 +6,6 @@
 
 #include <string.h>
 
-static double point_seg_dist(double px, double py, const double *a, const double *b)
-{
-    double ex = b[0] - a[0], ey = b[1] - a[1], len2 = ex * ex + ey * ey, t = 0.0;
-    if (len2 > 0.0) {
-        t = ((px - a[0]) * ex + (py - a[1]) * ey) / len2;
-        t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
-    }
-    return hypot(px - a[0] - t * ex, py - a[1] - t * ey);
-}
-
 static double cross3(const double *o, const double *a, const double *b)
 {
     return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
@@ -29,10 +19,10 @@ static double seg_seg_dist(const double *a, const double *b, const double *c, co
     if (((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0)) &&
         ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0)))
         return 0.0;
-    m = point_seg_dist(a[0], a[1], c, d);
-    m = fmin(m, point_seg_dist(b[0], b[1], c, d));
-    m = fmin(m, point_seg_dist(c[0], c[1], a, b));
-    return fmin(m, point_seg_dist(d[0], d[1], a, b));
+    m = scansim_point_segment_m(a[0], a[1], c, d);
+    m = fmin(m, scansim_point_segment_m(b[0], b[1], c, d));
+    m = fmin(m, scansim_point_segment_m(c[0], c[1], a, b));
+    return fmin(m, scansim_point_segment_m(d[0], d[1], a, b));
 }
 
 static int point_in_poly(const double *xy, uint32_t n, double x, double y)
@@ -271,4 +261,13 @@ void layout_place_anywhere(layout *L)
     double a = urange(&L->rng, 0.0, 2.0 * PI);
     double dx = urange(&L->rng, -10.0, 10.0), dy = urange(&L->rng, -10.0, 10.0);
     scansim_transform(L->s, a, dx, dy);
+}
+
+int layout_finish(layout *L, int rc, uint32_t walkers, uint32_t standers)
+{
+    rc |= layout_add_people(L, walkers, standers);
+    if (rc != 0)
+        return -1;
+    layout_place_anywhere(L);
+    return 0;
 }

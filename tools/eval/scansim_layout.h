@@ -104,4 +104,9 @@ int layout_path(layout *L, double target);
 /* Turns the scene by a random angle and shifts it by up to 10 m. */
 void layout_place_anywhere(layout *L);
 
+/* A kind's last steps: its people (layout_add_people), then the whole scene
+ * placed anywhere. 0, or -1 if rc (the kind's own result so far) or the
+ * people failed (the scene is then not moved). */
+int layout_finish(layout *L, int rc, uint32_t walkers, uint32_t standers);
+
 #endif /* SCANSIM_LAYOUT_H */
