@@ -131,7 +131,7 @@ test-install: all
 # (scanlog, mapfile, gridimage) and the binding's glue (polyc_io.c), as
 # `pip install ./bindings/python` builds it (bindings/python/setup.py).
 PY_MOD = tools/scanlog.c tools/scanlog_noreturn.c tools/mapfile.c tools/mapfile_pgm.c \
-         tools/gridimage.c tools/textesc.c bindings/python/polyc_io.c
+         tools/gridimage.c tools/readfile.c tools/textesc.c bindings/python/polyc_io.c
 PY_OBJ = $(PY_MOD:%.c=$(BUILD)/pyobj/%.o)
 $(BUILD)/pyobj/%.o: %.c include/polyc.h $(wildcard tools/*.h)
 	@mkdir -p $(dir $@)

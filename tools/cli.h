@@ -79,7 +79,8 @@ typedef struct run {
 /* ---- cli.c ---- */
 
 double now_ms(void);
-/* The progress line on stderr (on: shown at all), from t_start on. */
+/* The progress line on stderr: shown if `on` (stderr a terminal, no
+ * --quiet), timed from t_start_ms. */
 void progress_start(int on, double t_start_ms);
 int progress_on(void);
 void progress_clear(void);
@@ -88,9 +89,14 @@ void progress_stage(const char *stage);
 /* "polyc: message" on stderr (and a pointer to --help for EXIT_USAGE);
  * returns code. */
 int complain(int code, const char *fmt, ...);
+/* The input as messages name it ("<stdin>" for -). */
 const char *input_name(const options *o);
+/* 0, or EXIT_INPUT with a message; membuf_close: 0 if all of it was
+ * written to the stream. */
 int membuf_open(membuf *m);
 int membuf_close(membuf *m, int write_failed);
+/* The rendered outputs to their paths, all or none (outfile.h); 0 or
+ * EXIT_INPUT with a message. */
 int write_outputs(const char *const *paths, const membuf *const *bufs, size_t n);
 
 /* ---- options.c ---- */
