@@ -12,13 +12,18 @@ LDLIBS  = -lm
 
 LIB_SRC  = $(wildcard src/*.c)
 LIB_OBJ  = $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
-# tools/: the shipped tool (polyc.c) and its modules (log reader, map
-# files, SVG/JSON/TXT output). tools/eval/: the evaluation harness (bench,
-# sweep, simulator, ground-truth and topology scores), which the tests and
-# the benchmark use and the tool does not.
-TOOL_MOD = $(filter-out tools/polyc.c,$(wildcard tools/*.c))
+# tools/: the shipped tool (POLYC_SRC: main, command line, input, run,
+# messages) and its modules (log reader, map files, SVG/JSON/TXT output,
+# the library's block), which the tests, the bench and the binding use too.
+# tools/eval/: the evaluation harness (bench, sweep, simulator, ground-truth
+# and topology scores), which the tests and the benchmark use and the tool
+# does not.
+POLYC_SRC = tools/polyc.c tools/cli.c tools/options.c tools/load.c tools/run.c
+POLYC_OBJ = $(POLYC_SRC:tools/%.c=$(BUILD)/tobj/%.o)
+TOOL_MOD = $(filter-out $(POLYC_SRC),$(wildcard tools/*.c))
 TOOL_OBJ = $(TOOL_MOD:tools/%.c=$(BUILD)/tobj/%.o)
-EVAL_MOD = $(filter-out tools/eval/bench.c tools/eval/sweep.c tools/eval/mapscore.c,$(wildcard tools/eval/*.c))
+BENCH_SRC = $(wildcard tools/eval/bench*.c)
+EVAL_MOD = $(filter-out $(BENCH_SRC) tools/eval/sweep.c tools/eval/mapscore.c,$(wildcard tools/eval/*.c))
 EVAL_OBJ = $(EVAL_MOD:tools/eval/%.c=$(BUILD)/eobj/%.o)
 TOOL_CFLAGS = $(WARN) $(OPT) $(CFLAGS) -Iinclude -Itools -D_POSIX_C_SOURCE=200809L
 EVAL_CFLAGS = $(TOOL_CFLAGS) -Itools/eval
@@ -41,7 +46,7 @@ $(BUILD)/eobj/%.o: tools/eval/%.c include/polyc.h $(wildcard tools/*.h tools/eva
 	$(CC) $(EVAL_CFLAGS) -c $< -o $@
 $(BUILD)/libpolyc.a: $(LIB_OBJ)
 	rm -f $@ && ar rcs $@ $^
-$(BUILD)/polyc: tools/polyc.c $(TOOL_OBJ) $(BUILD)/libpolyc.a
+$(BUILD)/polyc: $(POLYC_OBJ) $(TOOL_OBJ) $(BUILD)/libpolyc.a
 	$(CC) $(TOOL_CFLAGS) $^ -o $@ $(LDLIBS)
 
 # Shared library: exports only the POLYC_API functions (-fvisibility=hidden)
@@ -80,7 +85,7 @@ unit: $(TEST_BIN) $(BUILD)/polyc
 # CHECK_STEPS, each into build-check/STEP.log: one line per step (the log's
 # tail if it failed), and last a line `N passed, N failed` alone (CI reads it).
 CHECK_STEPS = unit test-cli test-fuzz-replay test-asan test-cxx test-install test-python \
-              test-embedded test-opt-O3 test-opt-Os test-valgrind cross
+              test-embedded test-opt-O3 test-opt-Os test-golden test-valgrind cross
 check: deps
 	@mkdir -p build-check; pass=0; fail=0; \
 	for s in $(CHECK_STEPS); do \
@@ -105,8 +110,16 @@ deps:
 
 
 # Also: the header as C++, an installed copy used through pkg-config, the
-# Python binding against build/libpolyc.so, the 128 KiB example on the host
-test: unit test-cli test-fuzz-replay test-asan test-cxx test-install test-python test-embedded
+# Python binding against build/libpolyc.so, the 128 KiB example on the host,
+# and the tool's bytes across optimisation levels (test-golden)
+test: unit test-cli test-fuzz-replay test-asan test-cxx test-install test-python test-embedded \
+      test-golden
+# tests/golden.sh: the tool built at -O0, -O2, -O3 and -Os -flto (in
+# build-golden-*/) writes the same bytes on simulated scenes, examples/office.log
+# and its grid as a ROS map
+.PHONY: test-golden
+test-golden: $(BUILD)/gen_example
+	tests/golden.sh "$(MAKE)" $(BUILD)/gen_example
 test-cxx: $(BUILD)/tests/cxx_header
 	$(BUILD)/tests/cxx_header
 $(BUILD)/tests/cxx_header: tests/cxx_header.cpp include/polyc.h $(BUILD)/libpolyc.a
@@ -117,7 +130,8 @@ test-install: all
 # The Python package's library: libpolyc with the tool's readers
 # (scanlog, mapfile, gridimage) and the binding's glue (polyc_io.c), as
 # `pip install ./bindings/python` builds it (bindings/python/setup.py).
-PY_MOD = tools/scanlog.c tools/mapfile.c tools/gridimage.c bindings/python/polyc_io.c
+PY_MOD = tools/scanlog.c tools/scanlog_noreturn.c tools/mapfile.c tools/mapfile_pgm.c \
+         tools/gridimage.c tools/readfile.c tools/textesc.c bindings/python/polyc_io.c
 PY_OBJ = $(PY_MOD:%.c=$(BUILD)/pyobj/%.o)
 $(BUILD)/pyobj/%.o: %.c include/polyc.h $(wildcard tools/*.h)
 	@mkdir -p $(dir $@)
@@ -206,13 +220,15 @@ FUZZ_TIME ?= 60
 FUZZ_BIN   = $(FUZZ_TARGETS:%=build-fuzz/fuzz_%)
 FUZZ_CFLAGS = $(WARN) -g -O2 -fno-omit-frame-pointer -fsanitize=fuzzer,$(SAN_LIST) -fno-sanitize-recover=all \
               -Iinclude -Itools -D_POSIX_C_SOURCE=200809L
-build-fuzz/fuzz_scanlog: tests/fuzz_scanlog.c tools/scanlog.c $(LIB_SRC)
+build-fuzz/fuzz_scanlog: tests/fuzz_scanlog.c tools/scanlog.c tools/scanlog_noreturn.c tools/textesc.c \
+                         $(LIB_SRC)
 build-fuzz/fuzz_library: tests/fuzz_library.c $(LIB_SRC)
-build-fuzz/fuzz_mapyaml: tests/fuzz_mapyaml.c tools/mapfile.c
-build-fuzz/fuzz_pgm: tests/fuzz_pgm.c tools/mapfile.c
+build-fuzz/fuzz_mapyaml: tests/fuzz_mapyaml.c tools/mapfile.c tools/mapfile_pgm.c tools/textesc.c
+build-fuzz/fuzz_pgm: tests/fuzz_pgm.c tools/mapfile.c tools/mapfile_pgm.c tools/textesc.c
 # the optimiser's float compares drown the run in comparison tracing: off
 build-fuzz/fuzz_library: FUZZ_CFLAGS += -fno-sanitize-coverage=trace-cmp
-$(FUZZ_BIN): include/polyc.h $(wildcard src/*.h) tools/scanlog.h tools/mapfile.h
+$(FUZZ_BIN): include/polyc.h $(wildcard src/*.h) tools/scanlog.h tools/scanlog_noreturn.h \
+             tools/mapfile.h tools/textesc.h
 	@mkdir -p $(dir $@)
 	$(FUZZ_CC) $(FUZZ_CFLAGS) $(filter %.c,$^) -o $@ -lm
 fuzz: $(FUZZ_BIN)
@@ -269,8 +285,8 @@ BENCH_ARGS ?=
 bench:
 	$(MAKE) BUILD=build-bench OPT='-O3 -march=native -DNDEBUG' build-bench/bench build-bench/mapscore
 	build-bench/bench $(BENCH_ARGS) $(DATA)
-$(BUILD)/bench: tools/eval/bench.c $(EVAL_OBJ) $(TOOL_OBJ) $(BUILD)/libpolyc.a
-	$(CC) $(EVAL_CFLAGS) $^ -o $@ $(LDLIBS)
+$(BUILD)/bench: $(BENCH_SRC) tools/eval/bench.h $(EVAL_OBJ) $(TOOL_OBJ) $(BUILD)/libpolyc.a
+	$(CC) $(EVAL_CFLAGS) $(filter-out %.h,$^) -o $@ $(LDLIBS)
 $(BUILD)/mapscore: tools/eval/mapscore.c $(EVAL_OBJ) $(TOOL_OBJ) $(BUILD)/libpolyc.a
 	$(CC) $(EVAL_CFLAGS) $^ -o $@ $(LDLIBS)
 

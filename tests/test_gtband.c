@@ -15,18 +15,9 @@
 
 #include "gtband.h"
 #include "gtscore.h"
-
-#define assert_near(a, b, tol) \
-    near_check((double)(a), (double)(b), (double)(tol), #a, __FILE__, __LINE__)
+#include "near.h"
 
 #define MAX_POINTS 512
-
-static void near_check(double a, double b, double tol, const char *what, const char *file,
-                       int line)
-{
-    if (!(fabs(a - b) <= tol))
-        fail_msg("%s:%d: %s = %.9g, expected %.9g +- %.3g", file, line, what, a, b, tol);
-}
 
 typedef struct data {
     double xy[2 * MAX_POINTS], from[2 * MAX_POINTS];
@@ -57,6 +48,19 @@ static gtband_score score(const polyc_polyline *lines, uint32_t count, const dat
     return sc;
 }
 
+/* The score of two-line `lines` against two runs of 50 points: along
+ * y = 0 from x = 0 (1 m, seen from below), and from (x_b, y_b) along
+ * (dx_b, dy_b), seen from sensor_dy_b above or below. */
+static gtband_score score_two_runs(const polyc_polyline *lines, double x_b, double y_b,
+                                   double dx_b, double dy_b, double sensor_dy_b)
+{
+    static data d;
+    memset(&d, 0, sizeof d);
+    add_points(&d, 0.0, 0.0, 1.0, 0.0, 49, -1.0);
+    add_points(&d, x_b, y_b, dx_b, dy_b, 49, sensor_dy_b);
+    return score(lines, 2, &d);
+}
+
 /* Two parallel 1 m lines 8 cm apart, both seen from below (y = -1): each
  * one's 100 samples (0 .. 99 cm) lie 8 cm from the other, so each is one
  * band-doubled run of 100 x 1 cm: 2.00 m. Seen from opposite sides (the
@@ -66,21 +70,14 @@ static void test_parallel_same_side(void **state)
     static const float a[] = {0.0f, 0.0f, 1.0f, 0.0f};
     static const float b[] = {0.0f, 0.08f, 1.0f, 0.08f};
     polyc_polyline lines[2] = {{a, 2, 0}, {b, 2, 0}};
-    static data d;
     gtband_score sc;
     (void)state;
-    memset(&d, 0, sizeof d);
-    add_points(&d, 0.0, 0.0, 1.0, 0.0, 49, -1.0);
-    add_points(&d, 0.0, 0.08, 1.0, 0.0, 49, -1.0);
-    sc = score(lines, 2, &d);
+    sc = score_two_runs(lines, 0.0, 0.08, 1.0, 0.0, -1.0);
     assert_near(sc.map_length_m, 2.0, 1e-9);
     assert_int_equal(sc.sided_segments, 2);
     assert_near(sc.band_m, 2.0, 1e-9);
 
-    memset(&d, 0, sizeof d);
-    add_points(&d, 0.0, 0.0, 1.0, 0.0, 49, -1.0);
-    add_points(&d, 0.0, 0.08, 1.0, 0.0, 49, 1.0);
-    sc = score(lines, 2, &d);
+    sc = score_two_runs(lines, 0.0, 0.08, 1.0, 0.0, 1.0);
     assert_int_equal(sc.sided_segments, 2);
     assert_near(sc.band_m, 0.0, 0.0);
 
@@ -88,11 +85,8 @@ static void test_parallel_same_side(void **state)
      * normals agree however the segments run */
     {
         static const float b_back[] = {1.0f, 0.08f, 0.0f, 0.08f};
-        memset(&d, 0, sizeof d);
-        add_points(&d, 0.0, 0.0, 1.0, 0.0, 49, -1.0);
-        add_points(&d, 0.0, 0.08, 1.0, 0.0, 49, -1.0);
         lines[1].xy_m = b_back;
-        sc = score(lines, 2, &d);
+        sc = score_two_runs(lines, 0.0, 0.08, 1.0, 0.0, -1.0);
         assert_near(sc.band_m, 2.0, 1e-9);
     }
 }
@@ -106,13 +100,9 @@ static void test_parallel_overlap(void **state)
     static const float a[] = {0.0f, 0.0f, 1.0f, 0.0f};
     static const float b[] = {0.5f, 0.08f, 1.5f, 0.08f};
     polyc_polyline lines[2] = {{a, 2, 0}, {b, 2, 0}};
-    static data d;
     gtband_score sc;
     (void)state;
-    memset(&d, 0, sizeof d);
-    add_points(&d, 0.0, 0.0, 1.0, 0.0, 49, -1.0);
-    add_points(&d, 0.5, 0.08, 1.0, 0.0, 49, -1.0);
-    sc = score(lines, 2, &d);
+    sc = score_two_runs(lines, 0.5, 0.08, 1.0, 0.0, -1.0);
     assert_near(sc.band_m, 1.25, 1e-9);
 }
 
@@ -164,18 +154,12 @@ static void test_not_bands(void **state)
     slant[1] = 0.05f;
     slant[2] = (float)c;
     slant[3] = (float)(0.05 + s);
-    memset(&d, 0, sizeof d);
-    add_points(&d, 0.0, 0.0, 1.0, 0.0, 49, -1.0);
-    add_points(&d, 0.0, 0.05, c, s, 49, -1.0);
-    sc = score(lines, 2, &d);
+    sc = score_two_runs(lines, 0.0, 0.05, c, s, -1.0);
     assert_int_equal(sc.sided_segments, 2);
     assert_near(sc.band_m, 0.0, 0.0);
 
-    memset(&d, 0, sizeof d);
-    add_points(&d, 0.0, 0.0, 1.0, 0.0, 49, -1.0);
-    add_points(&d, 0.0, 0.2, 1.0, 0.0, 49, -1.0);
     lines[1].xy_m = far_b;
-    sc = score(lines, 2, &d);
+    sc = score_two_runs(lines, 0.0, 0.2, 1.0, 0.0, -1.0);
     assert_int_equal(sc.sided_segments, 2);
     assert_near(sc.band_m, 0.0, 0.0);
 

@@ -12,17 +12,8 @@
 #include <string.h>
 
 #include "gtscore.h"
+#include "near.h"
 #include "scansim.h"
-
-#define assert_near(a, b, tol) \
-    near_check((double)(a), (double)(b), (double)(tol), #a, __FILE__, __LINE__)
-
-static void near_check(double a, double b, double tol, const char *what, const char *file,
-                       int line)
-{
-    if (!(fabs(a - b) <= tol))
-        fail_msg("%s:%d: %s = %.9g, expected %.9g +- %.3g", file, line, what, a, b, tol);
-}
 
 /* Reads truth from text; fails the test on error. */
 static void truth_from_text(gtscore_truth *t, const char *text)

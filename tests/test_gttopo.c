@@ -15,16 +15,7 @@
 
 #include "gtscore.h"
 #include "gttopo.h"
-
-#define assert_near(a, b, tol) \
-    near_check((double)(a), (double)(b), (double)(tol), #a, __FILE__, __LINE__)
-
-static void near_check(double a, double b, double tol, const char *what, const char *file,
-                       int line)
-{
-    if (!(fabs(a - b) <= tol))
-        fail_msg("%s:%d: %s = %.9g, expected %.9g +- %.3g", file, line, what, a, b, tol);
-}
+#include "near.h"
 
 static void score(const polyc_polyline *lines, uint32_t count, const double *xy, uint64_t n,
                   gttopo_score *sc)

@@ -13,21 +13,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "near.h"
 #include "occmap.h"
 #include "pipeline.h"
 
 #define RES 0.1
 #define WALL_X 1.05
-
-#define assert_near(a, b, tol) \
-    near_check((double)(a), (double)(b), (double)(tol), #a, __FILE__, __LINE__)
-
-static void near_check(double a, double b, double tol, const char *what, const char *file,
-                       int line)
-{
-    if (!(fabs(a - b) <= tol))
-        fail_msg("%s:%d: %s = %.9g, expected %.9g +- %.3g", file, line, what, a, b, tol);
-}
 
 /* The cell holding world point (x, y): its index, asserted inside. */
 static size_t cell_at(const occmap *m, double x, double y)

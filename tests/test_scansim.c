@@ -14,18 +14,9 @@
 #include <string.h>
 
 #include "gtscore.h"
+#include "near.h"
 #include "scanlog.h"
 #include "scansim.h"
-
-#define assert_near(a, b, tol) \
-    near_check((double)(a), (double)(b), (double)(tol), #a, __FILE__, __LINE__)
-
-static void near_check(double a, double b, double tol, const char *what, const char *file,
-                       int line)
-{
-    if (!(fabs(a - b) <= tol))
-        fail_msg("%s:%d: %s = %.9g, expected %.9g +- %.3g", file, line, what, a, b, tol);
-}
 
 /* splitmix64 from seed 0: the published first outputs. Pins the integer
  * stream on every platform. */

@@ -11,149 +11,13 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "scanlog_noreturn.h"
+#include "textesc.h"
+
 #define PI_D 3.14159265358979323846
 #define MAX_NUMBER_CHARS 64          /* longer tokens are not numbers we accept */
 #define FLASER_TAIL 9                /* x y theta ox oy otheta ipc_ts host log_ts */
 #define ROBOTLASER1_TAIL 14          /* laser pose, robot pose, 5 motion, 3 stamps */
-
-/* ---- the FLASER no-return rule: a histogram in 1 cm bins ---- */
-
-#define NR_BIN_M 0.01
-#define NR_BINS 100000u              /* 0 .. 1000 m; beyond counts as no return */
-#define NR_WINDOW 50u                /* the cluster lies within 0.5 m */
-#define NR_SHOULDER 200u             /* compared with the 2 m just below it */
-
-typedef struct nr_hist {
-    uint32_t *bin;
-    uint64_t total;                  /* valid ranges seen, beyond included */
-    uint64_t beyond;                 /* >= NR_BINS * NR_BIN_M */
-} nr_hist;
-
-static void nr_add(nr_hist *h, float range_m)
-{
-    if (!(range_m >= SCANLOG_MIN_RANGE_M) || !isfinite(range_m))
-        return;
-    h->total++;
-    /* + 0.002: 51.05f is 51.0499992, which belongs to the 51.05 bin */
-    double k = floor((double)range_m / NR_BIN_M + 0.002);
-    if (k >= (double)NR_BINS)
-        h->beyond++;
-    else
-        h->bin[(uint32_t)k]++;
-}
-
-static int cmp_u32(const void *a, const void *b)
-{
-    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
-    return (x > y) - (x < y);
-}
-
-/* Median beams per bin over bins [lo, hi): the background density of real
- * returns, blind to a second code's spike (acapulco's 50.0 below 51.15). */
-static double nr_median(const nr_hist *h, uint32_t lo, uint32_t hi)
-{
-    uint32_t tmp[NR_SHOULDER];
-    uint32_t n = hi - lo;
-    if (n == 0)
-        return 0;
-    memcpy(tmp, h->bin + lo, n * sizeof tmp[0]);
-    qsort(tmp, n, sizeof tmp[0], cmp_u32);
-    return n % 2 ? tmp[n / 2] : 0.5 * ((double)tmp[n / 2 - 1] + tmp[n / 2]);
-}
-
-/* Is [b-0.5 m, b] a code cluster: at least 3 beams and 0.05% of all, half
- * of them in one 1 cm bin (a code repeats one value; real returns spread),
- * and at least 16x the background density of the 2 m below it (median beams
- * per bin)? If so, *bottom is its lowest bin holding more than 1 + 4x that
- * median, so that stray real returns in the window stay hits. */
-static int nr_cluster(const nr_hist *h, const uint64_t *prefix, uint32_t b, uint32_t *bottom)
-{
-    uint32_t lo = b >= NR_WINDOW ? b - NR_WINDOW : 0;
-    uint32_t slo = lo >= NR_SHOULDER ? lo - NR_SHOULDER : 0;
-    uint64_t t = prefix[b + 1] - prefix[lo];
-    if (!h->bin[b] || t < 3 || t * 2000u < h->total)
-        return 0;
-    uint32_t peak = 0;
-    for (uint32_t k = lo; k <= b; k++)
-        peak = h->bin[k] > peak ? h->bin[k] : peak;
-    if (2u * (uint64_t)peak < t)
-        return 0;
-    double median = nr_median(h, slo, lo);
-    if ((double)t < 16.0 * median * (b - lo + 1))
-        return 0;
-    double dense = 1.0 + 4.0 * median;
-    uint32_t k = lo;
-    while (k < b && (double)h->bin[k] <= dense)
-        k++;
-    *bottom = k;
-    return 1;
-}
-
-/* Walks down from the largest range to the first cluster that also holds at
- * least as many beams as everything above it: the main no-return code. Then
- * looks for more codes (acapulco has 50.0 besides 51.15) in the 10% of range
- * below, again and again. The threshold goes half a bin below the lowest
- * code. Without a cluster every range is a hit. prefix: NR_BINS + 1. */
-static void nr_pick(const nr_hist *h, uint64_t *prefix, scanlog_noreturn *out)
-{
-    uint32_t top = 0, b, bottom = 0, next;
-    int any = 0;
-    prefix[0] = 0;
-    for (b = 0; b < NR_BINS; b++) {
-        prefix[b + 1] = prefix[b] + h->bin[b];
-        if (h->bin[b]) {
-            top = b;
-            any = 1;
-        }
-    }
-    memset(out, 0, sizeof *out);
-    out->beams = h->total;
-    out->max_range_m = any ? (float)((top + 1) * NR_BIN_M) : (float)(NR_BINS * NR_BIN_M);
-    for (b = top + 1; any && b-- > 0;) {
-        uint64_t above = prefix[top + 1] - prefix[b + 1] + h->beyond;
-        if (nr_cluster(h, prefix, b, &bottom) && above <= prefix[b + 1] - prefix[bottom]) {
-            out->found = 1;
-            break;
-        }
-    }
-    if (!out->found)
-        return;
-    out->code_hi_m = b * NR_BIN_M;
-    for (int more = 1; more;) {
-        more = 0;
-        uint32_t limit = bottom - bottom / 10;
-        for (b = bottom; b-- > limit;)
-            if (nr_cluster(h, prefix, b, &next)) {
-                bottom = next;
-                more = 1;
-                break;
-            }
-    }
-    uint32_t mode = top;
-    for (b = bottom; b <= top; b++)
-        if (h->bin[b] > h->bin[mode])
-            mode = b;
-    out->max_range_m = (float)((bottom - 0.5) * NR_BIN_M);
-    if (out->max_range_m <= SCANLOG_MIN_RANGE_M)   /* a code at 2 cm: keep max > min */
-        out->max_range_m = SCANLOG_MIN_RANGE_M + (float)(NR_BIN_M / 2);
-    out->code_lo_m = bottom * NR_BIN_M;
-    out->code_mode_m = mode * NR_BIN_M;
-    out->code_beams = prefix[top + 1] - prefix[bottom] + h->beyond;
-}
-
-void scanlog_detect_noreturn(const float *range_m, size_t count, scanlog_noreturn *out)
-{
-    nr_hist h = {calloc(NR_BINS, sizeof(uint32_t)), 0, 0};
-    uint64_t *prefix = malloc((NR_BINS + 1) * sizeof *prefix);
-    memset(out, 0, sizeof *out);
-    if (h.bin && prefix) {
-        for (size_t i = 0; i < count; i++)
-            nr_add(&h, range_m[i]);
-        nr_pick(&h, prefix, out);
-    }
-    free(h.bin);
-    free(prefix);
-}
 
 /* ---- the reader ---- */
 
@@ -193,33 +57,11 @@ static int is_space(int c)
     return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
 }
 
-/* Up to 24 bytes of field s for a message, with "..." if longer. Bytes
- * outside printable ASCII are written as \xNN, so that a message never
- * carries raw bytes of the input (terminal escapes, broken UTF-8). */
-typedef struct excerpt {
-    char text[24 * 4 + 4];
-} excerpt;
-
-static const char *quote(excerpt *e, const char *s)
+/* Up to 24 bytes of field s for a message, with "..." if longer, bytes
+ * outside printable ASCII as \xNN (textesc.h). */
+static const char *quote(textesc_excerpt *e, const char *s)
 {
-    static const char hex[] = "0123456789abcdef";
-    size_t o = 0, i;
-    for (i = 0; s[i] && i < 24; i++) {
-        unsigned char c = (unsigned char)s[i];
-        if (c >= 0x20 && c < 0x7f) {
-            e->text[o++] = (char)c;
-        } else {
-            e->text[o++] = '\\';
-            e->text[o++] = 'x';
-            e->text[o++] = hex[c >> 4];
-            e->text[o++] = hex[c & 15];
-        }
-    }
-    if (s[i])
-        for (int k = 0; k < 3; k++)
-            e->text[o++] = '.';
-    e->text[o] = '\0';
-    return e->text;
+    return textesc_quote(e, s, strlen(s));
 }
 
 /* Reads one line into r->buf without its '\n' (a final line may lack it).
@@ -345,7 +187,7 @@ static int take_double(reader *r, fields *fs, const char *what, double *out)
     if (len <= MAX_NUMBER_CHARS)
         *out = strtod(s, &end);
     if (len > MAX_NUMBER_CHARS || end != s + len) {
-        excerpt e;
+        textesc_excerpt e;
         return fail(r, "%s is not a number: '%s' (field %u)", what, quote(&e, s), fs->index);
     }
     /* Overflow gives +-HUGE_VAL, underflow a tiny number (errno ERANGE):
@@ -360,7 +202,7 @@ static int take_count(reader *r, fields *fs, const char *what, uint32_t max, uin
         return fail(r, "missing %s (field %u)", what, fs->index + 1);
     size_t len = strlen(s);
     unsigned long long v = 0;
-    excerpt e;
+    textesc_excerpt e;
     for (size_t i = 0; i < len; i++) {
         if (s[i] < '0' || s[i] > '9')
             return fail(r, "%s is not a count: '%s' (field %u)", what, quote(&e, s), fs->index);
@@ -668,7 +510,7 @@ static int parse_comment(reader *r, char *line)
     char *w = next_field(&fs);
     if (w && strcmp(w, "polyc-scans") == 0) {
         char *v = next_field(&fs);
-        excerpt e;
+        textesc_excerpt e;
         if (!v || strcmp(v, "1") != 0)
             return fail(r, "unsupported polyc-scans version '%s' (this reader: 1)",
                         quote(&e, v ? v : ""));
@@ -697,7 +539,7 @@ static int parse_line(reader *r, char *line)
     if (strcmp(word, "SCAN") == 0)
         return parse_plain(r, &fs);
     if (!is_keyword(word)) {
-        excerpt e;
+        textesc_excerpt e;
         return fail(r, "not a log line: starts with '%s'", quote(&e, word));
     }
     count_keyword(r->log, word);
@@ -719,22 +561,18 @@ static int finish(reader *r)
             nr->overridden = 1;
             nr->max_range_m = (float)r->max_range_m;
         } else {
-            nr_hist h = {calloc(NR_BINS, sizeof(uint32_t)), 0, 0};
-            uint64_t *prefix = malloc((NR_BINS + 1) * sizeof *prefix);
-            if (h.bin && prefix) {
-                for (uint32_t i = 0; i < log->count; i++) {
-                    if (log->kind_of_scan[i] != SCANLOG_FLASER || !log->scans[i].beam_count)
-                        continue;         /* no ranges: the pool may be NULL */
-                    const float *a = log->pool + log->offset_of_scan[i];
-                    for (uint32_t j = 0; j < log->scans[i].beam_count; j++)
-                        nr_add(&h, a[j]);
-                }
-                nr_pick(&h, prefix, nr);
-            }
-            free(h.bin);
-            free(prefix);
-            if (!h.bin || !prefix)
+            scanlog_nr_hist h;
+            if (scanlog_nr_open(&h) != 0)
                 return fail(r, "out of memory");
+            for (uint32_t i = 0; i < log->count; i++) {
+                if (log->kind_of_scan[i] != SCANLOG_FLASER || !log->scans[i].beam_count)
+                    continue;         /* no ranges: the pool may be NULL */
+                const float *a = log->pool + log->offset_of_scan[i];
+                for (uint32_t j = 0; j < log->scans[i].beam_count; j++)
+                    scanlog_nr_add(&h, a[j]);
+            }
+            scanlog_nr_pick(&h, nr);
+            scanlog_nr_close(&h);
         }
         for (uint32_t i = 0; i < log->count; i++)
             if (log->kind_of_scan[i] == SCANLOG_FLASER)

@@ -19,6 +19,7 @@
 #include "gridimage.h"
 #include "mapfile.h"
 #include "polyc.h"
+#include "readfile.h"
 #include "scanlog.h"
 
 #if defined(__GNUC__)
@@ -127,53 +128,6 @@ void polyc_io_log_free(scanlog *log)
 
 /* ---- maps ---- */
 
-/* A whole file of at most max bytes into *data (malloc'd); 0, an errno
- * value, or -1 if it holds more than max bytes. */
-static int read_whole(const char *path, size_t max, char **data, size_t *len)
-{
-    *data = NULL;
-    *len = 0;
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return errno ? errno : EIO;
-    size_t cap = 0, n = 0;
-    char *buf = NULL;
-    int err = 0;
-    for (;;) {
-        if (n == cap) {
-            if (cap > max) {
-                err = -1;
-                break;
-            }
-            size_t ncap = cap ? cap * 2 : 65536;
-            char *nb = realloc(buf, ncap);
-            if (!nb) {
-                err = ENOMEM;
-                break;
-            }
-            buf = nb;
-            cap = ncap;
-        }
-        size_t got = fread(buf + n, 1, cap - n, f);
-        n += got;
-        if (got == 0) {
-            if (ferror(f))
-                err = EIO;
-            break;
-        }
-    }
-    fclose(f);
-    if (!err && n > max)
-        err = -1;
-    if (err) {
-        free(buf);
-        return err;
-    }
-    *data = buf;
-    *len = n;
-    return 0;
-}
-
 /* Reads a map YAML, its image (map_server's rule for where it is) and
  * converts its pixels as `polyc map.yaml` does. 0 and *out, or -1. */
 int polyc_io_read_map(const char *path, polyc_io_map **out, char *error, size_t error_size)
@@ -183,9 +137,11 @@ int polyc_io_read_map(const char *path, polyc_io_map **out, char *error, size_t 
     *out = NULL;
     char *text = NULL;
     size_t len = 0;
-    int err = read_whole(path, MAPFILE_MAX_YAML_BYTES, &text, &len);
-    if (err < 0)
+    int err = readfile(path, MAPFILE_MAX_YAML_BYTES, &text, &len);
+    if (err == READFILE_TOO_LARGE)
         return fail(error, error_size, "%s: %s", path, "too large to be a map YAML");
+    if (err == READFILE_NOT_FILE)
+        return fail(error, error_size, "%s: %s", path, "not a regular file");
     if (err)
         return fail(error, error_size, "%s: %s", path, strerror(err));
     mapfile_yaml yaml;
@@ -206,11 +162,13 @@ int polyc_io_read_map(const char *path, polyc_io_map **out, char *error, size_t 
         return fail(error, error_size, "%s%s", "out of memory", "");
     }
     m->image_path = image;
-    err = read_whole(image, MAPFILE_MAX_PGM_BYTES, &text, &len);
+    err = readfile(image, MAPFILE_MAX_PGM_BYTES, &text, &len);
     if (err) {
         if (error && error_size)
             snprintf(error, error_size, "%s:%u: image %s: %s", path, (unsigned)yaml.image_line,
-                     image, err < 0 ? "too large" : strerror(err));
+                     image, err == READFILE_TOO_LARGE ? "too large"
+                            : err == READFILE_NOT_FILE ? "not a regular file"
+                                                       : strerror(err));
         mapfile_yaml_free(&yaml);
         polyc_io_map_free(m);
         return -1;

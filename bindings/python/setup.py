@@ -2,7 +2,8 @@
 
 libpolyc.so is a plain shared library (loaded with ctypes, not a CPython
 extension module): the library (src/*.c), the polyc tool's readers
-(tools/scanlog.c, tools/mapfile.c, tools/gridimage.c) and the binding's glue
+(tools/scanlog.c, tools/scanlog_noreturn.c, tools/mapfile.c, tools/mapfile_pgm.c,
+tools/gridimage.c, tools/readfile.c, tools/textesc.c) and the binding's glue
 (polyc_io.c), compiled with the compiler Python was built with. The C
 sources are the repository's own (../../src from here): pip builds a local
 folder in place, so `pip install ./bindings/python` and `pip install .` at
@@ -36,7 +37,9 @@ def _version():
 # build time (setup() takes only paths inside its own folder; the objects go
 # under build_temp, never into src/)
 REPO_SOURCES = (sorted(glob.glob(os.path.join(REPO, "src", "*.c"))) +
-                [os.path.join(REPO, "tools", n) for n in ("scanlog.c", "mapfile.c", "gridimage.c")])
+                [os.path.join(REPO, "tools", n)
+                 for n in ("scanlog.c", "scanlog_noreturn.c", "mapfile.c", "mapfile_pgm.c",
+                           "gridimage.c", "readfile.c", "textesc.c")])
 REPO_HEADERS = [HEADER] + sorted(glob.glob(os.path.join(REPO, "src", "*.h")) +
                                  glob.glob(os.path.join(REPO, "tools", "*.h")))
 

@@ -117,31 +117,31 @@ static void vote(const gtscore_index *ix, band_seg *segs, const double *xy, cons
     }
 }
 
+/* The segments that may band-double segment s: not s or its neighbours,
+ * with a side, near parallel (sine of the angle <= sin_max) and facing the
+ * same way. */
+typedef struct band_pick {
+    const band_seg *segs;
+    uint32_t s;
+    double sin_max;
+} band_pick;
+
+static int band_accepts(const void *ctx, uint32_t o)
+{
+    const band_pick *p = ctx;
+    const band_seg *t = &p->segs[p->s], *u = &p->segs[o];
+    if (o == p->s || o == t->prev || o == t->next || u->side == 0)
+        return 0;
+    return !(fabs(t->ux * u->uy - t->uy * u->ux) > p->sin_max ||
+             t->fx * u->fx + t->fy * u->fy <= 0.0);
+}
+
 /* Is sample (x, y) of segment s band-doubled? */
 static int doubled(const gtscore_index *ix, const band_seg *segs, uint32_t s, double sin_max,
                    double x, double y)
 {
-    const band_seg *t = &segs[s];
-    double r2 = GTBAND_REACH_M * GTBAND_REACH_M;
-    uint32_t box[4], cx, cy, k;
-    if (!gtscore_index_box(ix, x, y, GTBAND_REACH_M, box))
-        return 0;
-    for (cy = box[1]; cy <= box[3]; cy++)
-        for (cx = box[0]; cx <= box[2]; cx++) {
-            size_t c = (size_t)cy * ix->width + cx;
-            for (k = ix->cell_start[c]; k < ix->cell_start[c + 1u]; k++) {
-                uint32_t o = ix->cell_seg[k];
-                const band_seg *u = &segs[o];
-                if (o == s || o == t->prev || o == t->next || u->side == 0)
-                    continue;
-                if (fabs(t->ux * u->uy - t->uy * u->ux) > sin_max ||
-                    t->fx * u->fx + t->fy * u->fy <= 0.0)
-                    continue;
-                if (gtscore_segment_distance2(&ix->seg_m[4u * o], x, y) <= r2)
-                    return 1;
-            }
-        }
-    return 0;
+    band_pick p = {segs, s, sin_max};
+    return gtscore_index_any_near(ix, x, y, GTBAND_REACH_M, band_accepts, &p);
 }
 
 static void band(const gtscore_index *ix, const band_seg *segs, gtband_score *out)
@@ -221,52 +221,9 @@ done:
 int gtband_scan_points(const polyc_scan *scans, uint32_t scan_count, double **xy_m,
                        double **sensors_xy_m, uint64_t *count)
 {
-    uint64_t n = 0, p = 0;
-    uint32_t s, i;
-    double *xy, *from;
-    if (!xy_m || !count || (!scans && scan_count))
+    if (!sensors_xy_m)
         return -1;
-    *xy_m = NULL;
-    if (sensors_xy_m)
-        *sensors_xy_m = NULL;
-    *count = 0;
-    for (s = 0; s < scan_count; s++)
-        for (i = 0; i < scans[s].beam_count; i++)
-            n += (uint64_t)gtscore_beam_reflected(&scans[s], i);
-    if (n == 0)
-        return 0;
-    if (n > SIZE_MAX / (2u * sizeof *xy))
-        return -1;
-    xy = malloc((size_t)n * 2u * sizeof *xy);
-    from = sensors_xy_m ? malloc((size_t)n * 2u * sizeof *from) : NULL;
-    if (!xy || (sensors_xy_m && !from)) {
-        free(xy);
-        free(from);
-        return -1;
-    }
-    for (s = 0; s < scan_count; s++) {
-        const polyc_scan *scan = &scans[s];
-        for (i = 0; i < scan->beam_count; i++) {
-            double a, r;
-            if (!gtscore_beam_reflected(scan, i))
-                continue;
-            a = scan->pose_theta_rad + (double)scan->start_angle_rad +
-                (double)i * (double)scan->angle_step_rad;
-            r = (double)scan->range_m[i];
-            xy[2u * p] = scan->pose_x_m + r * cos(a);
-            xy[2u * p + 1u] = scan->pose_y_m + r * sin(a);
-            if (from) {
-                from[2u * p] = scan->pose_x_m;
-                from[2u * p + 1u] = scan->pose_y_m;
-            }
-            p++;
-        }
-    }
-    *xy_m = xy;
-    if (sensors_xy_m)
-        *sensors_xy_m = from;
-    *count = n;
-    return 0;
+    return gtscore_scan_endpoints(scans, scan_count, xy_m, sensors_xy_m, count);
 }
 
 double gtband_share(uint64_t within, uint64_t points)

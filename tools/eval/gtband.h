@@ -75,7 +75,7 @@ int gtband_score_map(const polyc_polyline *lines, uint32_t count, const double *
 /* The endpoints of the reflected beams (gtscore_beam_reflected) of `scans`
  * in gttopo_scan_points' order, and for each its scan's pose (x, y): two
  * malloc'ed arrays of *count (x, y) pairs that the caller frees (both NULL
- * when there are none); sensors_xy_m may be NULL (no poses). */
+ * when there are none). */
 int gtband_scan_points(const polyc_scan *scans, uint32_t scan_count, double **xy_m,
                        double **sensors_xy_m, uint64_t *count);
 

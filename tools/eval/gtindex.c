@@ -255,6 +255,27 @@ int gtscore_index_box(const gtscore_index *index, double x_m, double y_m, double
     return 1;
 }
 
+int gtscore_index_any_near(const gtscore_index *index, double x_m, double y_m, double r_m,
+                           int (*accept)(const void *ctx, uint32_t seg), const void *ctx)
+{
+    double r2 = r_m * r_m;
+    uint32_t box[4], cx, cy, k;
+    if (!gtscore_index_box(index, x_m, y_m, r_m, box))
+        return 0;
+    for (cy = box[1]; cy <= box[3]; cy++)
+        for (cx = box[0]; cx <= box[2]; cx++) {
+            size_t c = (size_t)cy * index->width + cx;
+            for (k = index->cell_start[c]; k < index->cell_start[c + 1u]; k++) {
+                uint32_t o = index->cell_seg[k];
+                if (accept && !accept(ctx, o))
+                    continue;
+                if (gtscore_segment_distance2(&index->seg_m[4u * o], x_m, y_m) <= r2)
+                    return 1;
+            }
+        }
+    return 0;
+}
+
 /* A short-limit query: only the cells that meet the square of half-side
  * limit_m around the point can hold a segment that near. */
 static double box_distance(const gtscore_index *index, double x_m, double y_m, double limit_m)

@@ -410,25 +410,81 @@ void gtscore_score_scan(const gtscore_index *map, const polyc_scan *scan,
     acc->ray_rmse_m = acc->hits ? sqrt(acc->sum_sq_m2 / (double)acc->hits) : 0.0;
 }
 
+/* The endpoint (x, y) of the next reflected beam from beam *i of scan *s
+ * on: 1, with *s its scan and *i the beam after it; 0 after the last.
+ * Start with *s = *i = 0. */
+static int next_endpoint(const polyc_scan *scans, uint32_t scan_count, uint32_t *s, uint32_t *i,
+                         double *x, double *y)
+{
+    for (; *s < scan_count; (*s)++, *i = 0) {
+        const polyc_scan *scan = &scans[*s];
+        for (; *i < scan->beam_count; (*i)++) {
+            if (!gtscore_beam_reflected(scan, *i))
+                continue;
+            double a = beam_angle(scan, *i), r = (double)scan->range_m[*i];
+            *x = scan->pose_x_m + r * cos(a);
+            *y = scan->pose_y_m + r * sin(a);
+            (*i)++;
+            return 1;
+        }
+    }
+    return 0;
+}
+
+int gtscore_scan_endpoints(const polyc_scan *scans, uint32_t scan_count, double **xy_m,
+                           double **sensors_xy_m, uint64_t *count)
+{
+    uint64_t n = 0, p;
+    uint32_t s, i;
+    double *xy, *from = NULL, x, y;
+    if (!xy_m || !count || (!scans && scan_count))
+        return -1;
+    *xy_m = NULL;
+    if (sensors_xy_m)
+        *sensors_xy_m = NULL;
+    *count = 0;
+    for (s = 0; s < scan_count; s++)
+        for (i = 0; i < scans[s].beam_count; i++)
+            n += (uint64_t)gtscore_beam_reflected(&scans[s], i);
+    if (n == 0)
+        return 0;
+    if (n > SIZE_MAX / (2u * sizeof *xy))
+        return -1;
+    xy = malloc((size_t)n * 2u * sizeof *xy);
+    if (sensors_xy_m)
+        from = malloc((size_t)n * 2u * sizeof *from);
+    if (!xy || (sensors_xy_m && !from)) {
+        free(xy);
+        free(from);
+        return -1;
+    }
+    s = i = 0;
+    for (p = 0; next_endpoint(scans, scan_count, &s, &i, &x, &y); p++) {
+        xy[2u * p] = x;
+        xy[2u * p + 1u] = y;
+        if (from) {
+            from[2u * p] = scans[s].pose_x_m;
+            from[2u * p + 1u] = scans[s].pose_y_m;
+        }
+    }
+    *xy_m = xy;
+    if (sensors_xy_m)
+        *sensors_xy_m = from;
+    *count = n;
+    return 0;
+}
+
 void gtscore_endpoints_within(const gtscore_index *map, const polyc_scan *scans,
                               uint32_t scan_count, double d_m, uint64_t *within,
                               uint64_t *total)
 {
-    uint32_t s, i;
+    uint32_t s = 0, i = 0;
+    double x, y;
     *within = 0;
     *total = 0;
-    for (s = 0; s < scan_count; s++) {
-        const polyc_scan *scan = &scans[s];
-        for (i = 0; i < scan->beam_count; i++) {
-            double a, r;
-            if (!gtscore_beam_reflected(scan, i))
-                continue;
-            a = beam_angle(scan, i);
-            r = (double)scan->range_m[i];
-            (*total)++;
-            if (gtscore_index_distance(map, scan->pose_x_m + r * cos(a),
-                                       scan->pose_y_m + r * sin(a), d_m) <= d_m)
-                (*within)++;
-        }
+    while (next_endpoint(scans, scan_count, &s, &i, &x, &y)) {
+        (*total)++;
+        if (gtscore_index_distance(map, x, y, d_m) <= d_m)
+            (*within)++;
     }
 }

@@ -85,6 +85,11 @@ int gtscore_index_box(const gtscore_index *index, double x_m, double y_m, double
 /* Squared distance from (x, y) to the segment seg_m (x0 y0 x1 y1). */
 double gtscore_segment_distance2(const double *seg_m, double x_m, double y_m);
 
+/* Is a segment that `accept` takes (accept(ctx, segment index) != 0; NULL:
+ * any) within r_m (squared distance <= r_m^2) of (x, y)? */
+int gtscore_index_any_near(const gtscore_index *index, double x_m, double y_m, double r_m,
+                           int (*accept)(const void *ctx, uint32_t seg), const void *ctx);
+
 /* Range to the first segment met by the ray from (x, y) at angle_rad,
  * within (0, max_range_m]; INFINITY if none. */
 double gtscore_index_ray(const gtscore_index *index, double x_m, double y_m, double angle_rad,
@@ -158,6 +163,14 @@ typedef struct gtscore_scan_score {
  * may be accumulated) and updates acc->f and acc->ray_rmse_m. */
 void gtscore_score_scan(const gtscore_index *map, const polyc_scan *scan,
                         gtscore_scan_score *acc);
+
+/* The endpoints of the reflected beams (gtscore_beam_reflected) of `scans`,
+ * in order: *xy_m gets a malloc'ed array of *count (x, y) pairs, and with
+ * sensors_xy_m (may be NULL) another of each endpoint's scan pose (x, y);
+ * the caller frees them (NULL when there are none). 0, or -1 for a NULL
+ * argument or out of memory. */
+int gtscore_scan_endpoints(const polyc_scan *scans, uint32_t scan_count, double **xy_m,
+                           double **sensors_xy_m, uint64_t *count);
 
 /* Endpoints of the reflected beams of `scans` within d_m (<=) of the map:
  * *within of *total. */

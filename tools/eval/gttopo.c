@@ -11,7 +11,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "gtband.h"
 #include "gtscore.h"
 
 #define MAP_CELL_M 0.10            /* the map's grid, as gtscore.c builds it for 5 cm */
@@ -233,27 +232,24 @@ static void unsupported_runs(const topo_map *m, const polyc_polyline *lines, uin
 
 /* ---- double cover --------------------------------------------------------- */
 
+typedef struct cover_pick {
+    const topo_map *m;
+    uint32_t s;
+} cover_pick;
+
+/* Any segment but s and its neighbours. */
+static int cover_accepts(const void *ctx, uint32_t o)
+{
+    const cover_pick *p = ctx;
+    const topo_seg *t = &p->m->segs[p->s];
+    return o != p->s && o != t->prev && o != t->next;
+}
+
 /* Is a segment other than s and its neighbours within reach of (x, y)? */
 static int covered(const topo_map *m, uint32_t s, double x, double y)
 {
-    const gtscore_index *ix = &m->index;
-    const topo_seg *t = &m->segs[s];
-    double r2 = GTTOPO_COVER_M * GTTOPO_COVER_M;
-    uint32_t box[4], cx, cy, k;
-    if (!gtscore_index_box(ix, x, y, GTTOPO_COVER_M, box))
-        return 0;
-    for (cy = box[1]; cy <= box[3]; cy++)
-        for (cx = box[0]; cx <= box[2]; cx++) {
-            size_t c = (size_t)cy * ix->width + cx;
-            for (k = ix->cell_start[c]; k < ix->cell_start[c + 1u]; k++) {
-                uint32_t o = ix->cell_seg[k];
-                if (o == s || o == t->prev || o == t->next)
-                    continue;
-                if (gtscore_segment_distance2(&ix->seg_m[4u * o], x, y) <= r2)
-                    return 1;
-            }
-        }
-    return 0;
+    cover_pick p = {m, s};
+    return gtscore_index_any_near(&m->index, x, y, GTTOPO_COVER_M, cover_accepts, &p);
 }
 
 static void double_cover(const topo_map *m, gttopo_score *out)
@@ -433,5 +429,5 @@ int gttopo_score_map(const polyc_polyline *lines, uint32_t count, const double *
 int gttopo_scan_points(const polyc_scan *scans, uint32_t scan_count, double **xy_m,
                        uint64_t *count)
 {
-    return gtband_scan_points(scans, scan_count, xy_m, NULL, count);
+    return gtscore_scan_endpoints(scans, scan_count, xy_m, NULL, count);
 }

@@ -8,6 +8,8 @@
 #include <string.h>
 #include <time.h>
 
+#include "ctxblock.h"
+
 double pipeline_now_ms(void)
 {
     struct timespec ts;
@@ -30,6 +32,24 @@ static int step(pipeline *p, polyc_status st, const char *what)
     return -1;
 }
 
+/* The block for p's config and limits (ctxblock.h), and with init a
+ * context on it; 0 or -1 with the step that failed. */
+static int make_block(pipeline *p, int init)
+{
+    polyc_status st = POLYC_OK;
+    switch (ctxblock_make(&p->config, &p->limits, 0, &p->block, &p->block_size,
+                          init ? &p->ctx : NULL, &st)) {
+    case CTXBLOCK_OK:
+        return 0;
+    case CTXBLOCK_UNSIZED:
+        return step(p, POLYC_ERR_CONFIG, "polyc_memory_size");
+    case CTXBLOCK_INIT:
+        return step(p, st, "polyc_init");
+    default:
+        return step(p, POLYC_ERR_NOMEM, "malloc of the block");
+    }
+}
+
 int pipeline_open(pipeline *p, const polyc_config *config, const polyc_scan *scans, uint32_t n)
 {
     memset(p, 0, sizeof *p);
@@ -37,13 +57,7 @@ int pipeline_open(pipeline *p, const polyc_config *config, const polyc_scan *sca
     if (step(p, polyc_limits_for_scans(&p->config, scans, n, &p->limits),
              "polyc_limits_for_scans"))
         return -1;
-    p->block_size = polyc_memory_size(&p->config, &p->limits);
-    if (p->block_size == 0)
-        return step(p, POLYC_ERR_CONFIG, "polyc_memory_size");
-    p->block = malloc(p->block_size);
-    if (!p->block)
-        return step(p, POLYC_ERR_NOMEM, "malloc of the block");
-    return 0;
+    return make_block(p, 0);
 }
 
 void pipeline_close(pipeline *p)
@@ -59,10 +73,8 @@ static int pipeline_grow(pipeline *p)
     if (p->status != POLYC_ERR_NOMEM || (!p->limits.max_vertices && !p->limits.max_points))
         return -1;
     p->limits.max_vertices = p->limits.max_points = 0;
-    free(p->block);
-    p->block_size = polyc_memory_size(&p->config, &p->limits);
-    p->block = p->block_size ? malloc(p->block_size) : NULL;
-    if (!p->block)
+    if (ctxblock_make(&p->config, &p->limits, 0, &p->block, &p->block_size, NULL, NULL) !=
+        CTXBLOCK_OK)
         return -1;
     p->failed_at = NULL;
     p->status = POLYC_OK;
@@ -107,14 +119,7 @@ int pipeline_run_grid(pipeline *p, const polyc_config *config, const polyc_occup
     *ms = 0.0;
     if (step(p, polyc_limits_for_grid(&p->config, grid, &p->limits), "polyc_limits_for_grid"))
         return -1;
-    p->block_size = polyc_memory_size(&p->config, &p->limits);
-    if (p->block_size == 0)
-        return step(p, POLYC_ERR_CONFIG, "polyc_memory_size");
-    p->block = malloc(p->block_size);
-    if (!p->block)
-        return step(p, POLYC_ERR_NOMEM, "malloc of the block");
-    if (step(p, polyc_init(p->block, p->block_size, &p->config, &p->limits, &p->ctx),
-             "polyc_init") ||
+    if (make_block(p, 1) ||
         step(p, polyc_add_grid(p->ctx, grid), "polyc_add_grid") ||
         step(p, polyc_build(p->ctx, NULL, NULL), "polyc_build"))
         return -1;

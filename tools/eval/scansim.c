@@ -287,7 +287,7 @@ int scansim_keep_every(scansim_scene *scene, uint32_t step)
     return 0;
 }
 
-static double point_segment_distance(double px, double py, const double *a, const double *b)
+double scansim_point_segment_m(double px, double py, const double *a, const double *b)
 {
     double ex = b[0] - a[0], ey = b[1] - a[1], len2 = ex * ex + ey * ey, t = 0.0;
     if (len2 > 0.0) {
@@ -309,7 +309,8 @@ double scansim_path_clearance(const scansim_scene *scene)
                 const double *a = &scene->wall_xy_m[2u * (wall->first_point + j)];
                 const double *b =
                     &scene->wall_xy_m[2u * (wall->first_point + (j + 1u) % wall->point_count)];
-                double d = point_segment_distance(scene->poses[p].x_m, scene->poses[p].y_m, a, b);
+                double d =
+                    scansim_point_segment_m(scene->poses[p].x_m, scene->poses[p].y_m, a, b);
                 if (d < best)
                     best = d;
             }

@@ -174,6 +174,9 @@ int scansim_keep_every(scansim_scene *scene, uint32_t step);
  * without poses or walls): how close the robot comes to a wall. */
 double scansim_path_clearance(const scansim_scene *scene);
 
+/* Distance in metres from (px, py) to the segment from a to b (x, y). */
+double scansim_point_segment_m(double px, double py, const double *a, const double *b);
+
 /* ---- simulation -------------------------------------------------------- */
 
 /* First intersection of the ray from (x, y) at angle_rad with the walls and

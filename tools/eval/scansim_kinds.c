@@ -10,343 +10,15 @@
  * wall, a person only if they stay in free space, in view of the robot and
  * away from it. The whole scene is then turned by a random angle and
  * shifted, as the fixed scenes are. (Random draws are never two arguments
- * of one call: C leaves their order to the compiler.)
+ * of one call: C leaves their order to the compiler.) The placing by
+ * rejection and the path are scansim_layout.c's (scansim_layout.h).
  */
 #include "scansim.h"
 
 #include <math.h>
 #include <string.h>
 
-#define PI 3.14159265358979323846
-#define PATH_CLEAR_M 0.5     /* furniture keeps this far from the path */
-#define OBJECT_GAP_M 0.3     /* and this far from other furniture */
-#define FLUSH_CHECK_M 0.01  /* a piece flush with a wall keeps this off the others */
-#define ARC_STEP_M 0.10      /* side of the polygons that stand for curves */
-#define PLACE_TRIES 400u
-#define MAX_WAY 256u         /* waypoints of one path */
-#define PERSON_RADIUS_M 0.2
-
-/* ---- geometry -------------------------------------------------------------- */
-
-static double urange(scansim_rng *rng, double lo, double hi)
-{
-    return lo + (hi - lo) * scansim_rng_uniform(rng);
-}
-
-/* An integer in lo..hi. */
-static uint32_t upick(scansim_rng *rng, uint32_t lo, uint32_t hi)
-{
-    return lo + (uint32_t)(scansim_rng_u64(rng) % (uint64_t)(hi - lo + 1u));
-}
-
-static double point_seg_dist(double px, double py, const double *a, const double *b)
-{
-    double ex = b[0] - a[0], ey = b[1] - a[1], len2 = ex * ex + ey * ey, t = 0.0;
-    if (len2 > 0.0) {
-        t = ((px - a[0]) * ex + (py - a[1]) * ey) / len2;
-        t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
-    }
-    return hypot(px - a[0] - t * ex, py - a[1] - t * ey);
-}
-
-static double cross3(const double *o, const double *a, const double *b)
-{
-    return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
-}
-
-/* Distance between segments ab and cd (0 if they cross). */
-static double seg_seg_dist(const double *a, const double *b, const double *c, const double *d)
-{
-    double d1 = cross3(a, b, c), d2 = cross3(a, b, d), d3 = cross3(c, d, a),
-           d4 = cross3(c, d, b), m;
-    if (((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0)) &&
-        ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0)))
-        return 0.0;
-    m = point_seg_dist(a[0], a[1], c, d);
-    m = fmin(m, point_seg_dist(b[0], b[1], c, d));
-    m = fmin(m, point_seg_dist(c[0], c[1], a, b));
-    return fmin(m, point_seg_dist(d[0], d[1], a, b));
-}
-
-static int point_in_poly(const double *xy, uint32_t n, double x, double y)
-{
-    uint32_t i, j;
-    int in = 0;
-    for (i = 0, j = n - 1u; i < n; j = i++) {
-        double yi = xy[2u * i + 1u], yj = xy[2u * j + 1u];
-        if ((yi > y) != (yj > y) &&
-            x < xy[2u * j] + (xy[2u * i] - xy[2u * j]) * (y - yj) / (yi - yj))
-            in = !in;
-    }
-    return in;
-}
-
-/* A w x h rectangle centred on (cx, cy), its w side at angle a. */
-static void rect_xy(double *xy, double cx, double cy, double w, double h, double a)
-{
-    static const double sx[4] = {-0.5, 0.5, 0.5, -0.5}, sy[4] = {-0.5, -0.5, 0.5, 0.5};
-    double c = cos(a), s = sin(a);
-    uint32_t i;
-    for (i = 0; i < 4u; i++) {
-        double u = sx[i] * w, v = sy[i] * h;
-        xy[2u * i] = cx + c * u - s * v;
-        xy[2u * i + 1u] = cy + s * u + c * v;
-    }
-}
-
-/* Points every <= ARC_STEP_M on the arc of radius r about (cx, cy) from
- * angle a0 to a1 (either way round), both ends included; returns the count
- * written to xy (at most max). */
-static uint32_t arc_xy(double *xy, uint32_t max, double cx, double cy, double r, double a0,
-                       double a1)
-{
-    double n = ceil(fabs(a1 - a0) * r / ARC_STEP_M);
-    uint32_t k, count = (uint32_t)(n < 1.0 ? 1.0 : n) + 1u;
-    if (count > max)
-        count = max;
-    for (k = 0; k < count; k++) {
-        double a = a0 + (a1 - a0) * (double)k / (double)(count - 1u);
-        xy[2u * k] = cx + r * cos(a);
-        xy[2u * k + 1u] = cy + r * sin(a);
-    }
-    return count;
-}
-
-/* ---- a layout under construction -------------------------------------------- */
-
-typedef struct layout {
-    scansim_scene *s;
-    scansim_rng rng;
-    double way[2u * MAX_WAY];  /* the path's waypoints */
-    uint32_t way_count;
-    uint32_t outline;          /* a closed wall round everything, or UINT32_MAX */
-    uint32_t first_object;     /* walls from here on are furniture */
-} layout;
-
-static void layout_init(layout *L, scansim_scene *s, uint64_t kind_salt)
-{
-    memset(L, 0, sizeof *L);
-    L->s = s;
-    scansim_rng_seed(&L->rng, s->seed * UINT64_C(0x9E3779B97F4A7C15) ^ kind_salt);
-    L->outline = UINT32_MAX;
-    L->first_object = UINT32_MAX;
-}
-
-static void way(layout *L, double x, double y)
-{
-    if (L->way_count < MAX_WAY) {
-        L->way[2u * L->way_count] = x;
-        L->way[2u * L->way_count + 1u] = y;
-        L->way_count++;
-    }
-}
-
-static const double *wall_point(const scansim_scene *s, uint32_t w, uint32_t j)
-{
-    const scansim_wall *wall = &s->walls[w];
-    return &s->wall_xy_m[2u * (wall->first_point + j % wall->point_count)];
-}
-
-/* Does the closed polygon (n points) keep PATH_CLEAR_M off the path, gap_m
- * off the structure's walls and OBJECT_GAP_M off the furniture, neither
- * inside another closed wall (the outline aside) nor round one? */
-static int fits(const layout *L, const double *poly, uint32_t n, double gap_m)
-{
-    const scansim_scene *s = L->s;
-    uint32_t i, j, w;
-    for (i = 0; i < n; i++) {
-        const double *a = &poly[2u * i], *b = &poly[2u * ((i + 1u) % n)];
-        for (j = 0; j + 1u < L->way_count; j++)
-            if (seg_seg_dist(a, b, &L->way[2u * j], &L->way[2u * j + 2u]) < PATH_CLEAR_M)
-                return 0;
-        for (w = 0; w < s->wall_count; w++) {
-            const scansim_wall *wall = &s->walls[w];
-            uint32_t nseg = wall->closed ? wall->point_count : wall->point_count - 1u;
-            double need = w >= L->first_object ? OBJECT_GAP_M : gap_m;
-            for (j = 0; j < nseg; j++)
-                if (seg_seg_dist(a, b, wall_point(s, w, j), wall_point(s, w, j + 1u)) < need)
-                    return 0;
-        }
-    }
-    for (w = 0; w < s->wall_count; w++) {
-        const double *p = wall_point(s, w, 0);
-        if (point_in_poly(poly, n, p[0], p[1]))
-            return 0;
-        if (w != L->outline && s->walls[w].closed &&
-            point_in_poly(&s->wall_xy_m[2u * s->walls[w].first_point], s->walls[w].point_count,
-                          poly[0], poly[1]))
-            return 0;
-    }
-    return 1;
-}
-
-/* Adds the polygon if `check` (the polygon itself, or a copy of it moved
- * off the wall it stands against) fits; 1 added, 0 not, -1 out of memory. */
-static int try_add_checked(layout *L, const double *poly, const double *check, uint32_t n,
-                           double gap_m)
-{
-    if (L->first_object == UINT32_MAX)
-        L->first_object = L->s->wall_count;
-    if (!fits(L, check, n, gap_m))
-        return 0;
-    return scansim_add_wall(L->s, poly, n, 1) == 0 ? 1 : -1;
-}
-
-static int try_add(layout *L, const double *poly, uint32_t n, double gap_m)
-{
-    return try_add_checked(L, poly, poly, n, gap_m);
-}
-
-/* Up to `count` w x h boxes (sizes drawn per box from the ranges) at random
- * places in [x0, x1] x [y0, y1]; angle_rad < 0: any angle. -1 out of memory. */
-static int scatter_boxes(layout *L, uint32_t count, const double *w_range,
-                         const double *h_range, double angle_rad, double x0, double y0,
-                         double x1, double y1, double gap_m)
-{
-    uint32_t placed = 0, tries;
-    for (tries = 0; placed < count && tries < PLACE_TRIES; tries++) {
-        double xy[8];
-        double w = urange(&L->rng, w_range[0], w_range[1]);
-        double h = urange(&L->rng, h_range[0], h_range[1]);
-        double a = angle_rad < 0.0 ? urange(&L->rng, 0.0, PI) : angle_rad;
-        double cx = urange(&L->rng, x0, x1), cy = urange(&L->rng, y0, y1);
-        int rc;
-        rect_xy(xy, cx, cy, w, h, a);
-        rc = try_add(L, xy, 4u, gap_m);
-        if (rc < 0)
-            return -1;
-        placed += (uint32_t)rc;
-    }
-    return 0;
-}
-
-/* A box of w along the wall and depth d into the room, flush with one of
- * the four inner faces of the room [x0, x1] x [y0, y1] (side 0..3: south,
- * east, north, west) and 0.3 m or more from the room's corners, as
- * cupboards, beds and crates stand: no slot behind it for a beam to look
- * into. The box is checked moved FLUSH_CHECK_M off its wall, so that it may
- * touch that wall but keeps FLUSH_CHECK_M from every other one (and the
- * usual distances from the path and the furniture). 1 added, 0 not, -1 out
- * of memory. */
-static int against_wall(layout *L, double x0, double y0, double x1, double y1, double w,
-                        double d)
-{
-    uint32_t side = upick(&L->rng, 0u, 3u);
-    double along, xy[8], check[8], off = 2.0 * FLUSH_CHECK_M;
-    if (side == 0u || side == 2u) {
-        double cy = side == 0u ? y0 + d / 2.0 : y1 - d / 2.0;
-        if (x1 - x0 < w + 0.6)
-            return 0;
-        along = urange(&L->rng, x0 + 0.3 + w / 2.0, x1 - 0.3 - w / 2.0);
-        rect_xy(xy, along, cy, w, d, 0.0);
-        rect_xy(check, along, side == 0u ? cy + off : cy - off, w, d, 0.0);
-    } else {
-        double cx = side == 3u ? x0 + d / 2.0 : x1 - d / 2.0;
-        if (y1 - y0 < w + 0.6)
-            return 0;
-        along = urange(&L->rng, y0 + 0.3 + w / 2.0, y1 - 0.3 - w / 2.0);
-        rect_xy(xy, cx, along, d, w, 0.0);
-        rect_xy(check, side == 3u ? cx + off : cx - off, along, d, w, 0.0);
-    }
-    return try_add_checked(L, xy, check, 4u, FLUSH_CHECK_M);
-}
-
-/* The smallest distance from the segment ab to any wall. */
-static double seg_wall_dist(const scansim_scene *s, const double *a, const double *b)
-{
-    double m = HUGE_VAL;
-    uint32_t w, j;
-    for (w = 0; w < s->wall_count; w++) {
-        uint32_t nseg = s->walls[w].closed ? s->walls[w].point_count
-                                           : s->walls[w].point_count - 1u;
-        for (j = 0; j < nseg; j++)
-            m = fmin(m, seg_seg_dist(a, b, wall_point(s, w, j), wall_point(s, w, j + 1u)));
-    }
-    return m;
-}
-
-/* People near the path: `walkers` who cross the robot's view in a straight
- * line at walking pace, `standers` who stop in one place for 20-60 scans.
- * Each stays clear of every wall, is in view of the robot when it appears
- * (no wall in between) and never comes within 0.3 m of the robot. Call
- * after the path's poses are laid. -1 out of memory. */
-static int add_people(layout *L, uint32_t walkers, uint32_t standers)
-{
-    scansim_scene *s = L->s;
-    uint32_t person_index, tries;
-    if (s->pose_count < 2u)
-        return 0;
-    for (person_index = 0; person_index < walkers + standers; person_index++)
-        for (tries = 0; tries < PLACE_TRIES; tries++) {
-            int stands = person_index >= walkers, ok = 1;
-            double len = stands ? 0.0 : urange(&L->rng, 1.5, 4.0);
-            /* 1.0-1.5 m/s at 10 scans a second; all of it within the scans */
-            uint32_t dur = stands ? upick(&L->rng, 20u, 60u)
-                                  : (uint32_t)(len / urange(&L->rng, 0.10, 0.15));
-            uint32_t k = dur + 1u < s->pose_count ? upick(&L->rng, 0u, s->pose_count - 1u - dur)
-                                                  : 0u, i;
-            const scansim_pose *p = &s->poses[k];
-            double a = urange(&L->rng, -PI, PI), r = urange(&L->rng, 1.0, 3.0);
-            double from[2], to[2], heading;
-            scansim_person person;
-            from[0] = p->x_m + r * cos(a);
-            from[1] = p->y_m + r * sin(a);
-            heading = urange(&L->rng, -PI, PI);
-            to[0] = from[0] + len * cos(heading);
-            to[1] = from[1] + len * sin(heading);
-            memset(&person, 0, sizeof person);
-            person.from_x_m = from[0];
-            person.from_y_m = from[1];
-            person.to_x_m = to[0];
-            person.to_y_m = to[1];
-            person.radius_m = PERSON_RADIUS_M;
-            person.first_scan = k;
-            person.last_scan = k + dur < s->pose_count ? k + dur : s->pose_count - 1u;
-            if (seg_wall_dist(s, from, to) < PERSON_RADIUS_M + 0.05 ||
-                scansim_cast(s, p->x_m, p->y_m, a, UINT32_MAX, NULL) < r)
-                continue;
-            for (i = 0; i < s->wall_count && ok; i++)
-                ok = i == L->outline || !s->walls[i].closed ||
-                     !point_in_poly(&s->wall_xy_m[2u * s->walls[i].first_point],
-                                    s->walls[i].point_count, from[0], from[1]);
-            for (i = person.first_scan; i <= person.last_scan && ok; i++) {
-                double f = person.last_scan > person.first_scan
-                               ? (double)(i - person.first_scan) /
-                                     (double)(person.last_scan - person.first_scan)
-                               : 0.0;
-                ok = hypot(from[0] + (to[0] - from[0]) * f - s->poses[i].x_m,
-                           from[1] + (to[1] - from[1]) * f - s->poses[i].y_m) >=
-                     PERSON_RADIUS_M + 0.3;
-            }
-            if (!ok)
-                continue;
-            if (scansim_add_person(s, &person) != 0)
-                return -1;
-            break;
-        }
-    return 0;
-}
-
-/* Lays the poses along the waypoints, about `target` of them (spacing kept
- * within 5-20 cm). */
-static int lay_path(layout *L, double target)
-{
-    double len = 0.0, spacing;
-    uint32_t i;
-    for (i = 0; i + 1u < L->way_count; i++)
-        len += hypot(L->way[2u * i + 2u] - L->way[2u * i],
-                     L->way[2u * i + 3u] - L->way[2u * i + 1u]);
-    spacing = fmin(0.20, fmax(0.05, len / target));
-    return scansim_add_path(L->s, L->way, L->way_count, spacing);
-}
-
-/* Turns the scene by a random angle and shifts it by up to 10 m. */
-static void place_anywhere(layout *L)
-{
-    double a = urange(&L->rng, 0.0, 2.0 * PI);
-    double dx = urange(&L->rng, -10.0, 10.0), dy = urange(&L->rng, -10.0, 10.0);
-    scansim_transform(L->s, a, dx, dy);
-}
+#include "scansim_layout.h"
 
 /* ---- hall -------------------------------------------------------------------- */
 
@@ -377,17 +49,20 @@ int scansim_kind_hall(scansim_scene *s)
     rc |= scansim_add_wall(s, outline, 8u, 1);
     if (scansim_rng_uniform(&L.rng) < 0.5) {
         double i = urange(&L.rng, 3.0, 5.0);
-        way(&L, i, i); way(&L, w - i, i); way(&L, w - i, h - i); way(&L, i, h - i);
-        way(&L, i, i + 0.2);
+        layout_way(&L, i, i);
+        layout_way(&L, w - i, i);
+        layout_way(&L, w - i, h - i);
+        layout_way(&L, i, h - i);
+        layout_way(&L, i, i + 0.2);
     } else {
         double m = urange(&L.rng, 2.5, 4.0), lane = urange(&L.rng, 6.0, 9.0), y;
         uint32_t k = 0;
         for (y = m; y <= h - m + 1e-9; y += lane, k++) {
-            way(&L, k % 2u ? w - m : m, y);
-            way(&L, k % 2u ? m : w - m, y);
+            layout_way(&L, k % 2u ? w - m : m, y);
+            layout_way(&L, k % 2u ? m : w - m, y);
         }
     }
-    rc |= lay_path(&L, 800.0);
+    rc |= layout_path(&L, 800.0);
     /* pillars and columns on a grid of 6-9 m, each node jittered by 0.3 m */
     grid = urange(&L.rng, 6.0, 9.0);
     ox = urange(&L.rng, 2.0, 2.0 + grid);
@@ -409,18 +84,14 @@ int scansim_kind_hall(scansim_scene *s)
                     xy[2u * k + 1u] = cy + r * sin(2.0 * PI * (double)k / (double)n);
                 }
             }
-            rc |= try_add(&L, xy, n, 1.0) < 0;
+            rc |= layout_try_add(&L, xy, n, 1.0) < 0;
         }
     {
         static const double case_w[2] = {0.8, 2.5}, case_h[2] = {0.4, 1.2};
-        rc |= scatter_boxes(&L, upick(&L.rng, 4u, 10u), case_w, case_h, -1.0, 1.0, 1.0, w - 1.0,
-                            h - 1.0, 1.0);
+        rc |= layout_scatter_boxes(&L, upick(&L.rng, 4u, 10u), case_w, case_h, -1.0, 1.0, 1.0,
+                                   w - 1.0, h - 1.0, 1.0);
     }
-    rc |= add_people(&L, 3u, 2u);
-    if (rc != 0)
-        return -1;
-    place_anywhere(&L);
-    return 0;
+    return layout_finish(&L, rc, 3u, 2u);
 }
 
 /* ---- shelves ------------------------------------------------------------------- */
@@ -471,27 +142,23 @@ int scansim_kind_shelves(scansim_scene *s)
         rc |= scansim_add_wall(s, xy, 4u, 1);
     }
     for (i = 0; i <= rows; i++) {
-        way(&L, i % 2u ? x_end - cross_e / 2.0 : cross_w / 2.0, aisle_c[i]);
-        way(&L, i % 2u ? cross_w / 2.0 : x_end - cross_e / 2.0, aisle_c[i]);
+        layout_way(&L, i % 2u ? x_end - cross_e / 2.0 : cross_w / 2.0, aisle_c[i]);
+        layout_way(&L, i % 2u ? cross_w / 2.0 : x_end - cross_e / 2.0, aisle_c[i]);
     }
-    rc |= lay_path(&L, 900.0);
+    rc |= layout_path(&L, 900.0);
     {
         uint32_t crates = upick(&L.rng, 1u, 4u), placed = 0, tries;
         L.first_object = s->wall_count;
         for (tries = 0; placed < crates && tries < PLACE_TRIES && rc == 0; tries++) {
             double along = urange(&L.rng, 0.6, 1.2), depth = urange(&L.rng, 0.4, 0.8);
-            int got = against_wall(&L, 0.0, 0.0, x_end, y, along, depth);
+            int got = layout_against_wall(&L, 0.0, 0.0, x_end, y, along, depth);
             if (got < 0)
                 rc = -1;
             else
                 placed += (uint32_t)got;
         }
     }
-    rc |= add_people(&L, 2u, 2u);
-    if (rc != 0)
-        return -1;
-    place_anywhere(&L);
-    return 0;
+    return layout_finish(&L, rc, 2u, 2u);
 }
 
 /* ---- flat ------------------------------------------------------------------- */
@@ -581,20 +248,20 @@ int scansim_kind_flat(scansim_scene *s)
             order[j] = order[j - 1u];
             order[j - 1u] = tmp;
         }
-    way(&L, 0.6, hw / 2.0);
+    layout_way(&L, 0.6, hw / 2.0);
     for (i = 0; i < nr; i++) {
         const flat_room *r = &room[order[i]];
         double inside = r->north ? r->y0 + 0.7 : r->y1 - 0.7;
         double mx = urange(&L.rng, r->x0 + 0.9, r->x1 - 0.9);
         double my = r->y0 + (r->y1 - r->y0) * urange(&L.rng, 0.4, 0.6);
-        way(&L, r->door_c, hw / 2.0);
-        way(&L, r->door_c, inside);
-        way(&L, mx, my);
-        way(&L, r->door_c, inside);
-        way(&L, r->door_c, hw / 2.0);
+        layout_way(&L, r->door_c, hw / 2.0);
+        layout_way(&L, r->door_c, inside);
+        layout_way(&L, mx, my);
+        layout_way(&L, r->door_c, inside);
+        layout_way(&L, r->door_c, hw / 2.0);
     }
-    way(&L, total - 0.6, hw / 2.0);
-    rc |= lay_path(&L, 600.0);
+    layout_way(&L, total - 0.6, hw / 2.0);
+    rc |= layout_path(&L, 600.0);
     /* furniture: a bed or a cupboard against a wall, and a table */
     L.first_object = s->wall_count;
     for (i = 0; i < nr && rc == 0; i++) {
@@ -606,13 +273,13 @@ int scansim_kind_flat(scansim_scene *s)
             if (kind < 0.7) { /* a bed or a cupboard */
                 double along = kind < 0.35 ? urange(&L.rng, 1.9, 2.1) : urange(&L.rng, 0.8, 2.0);
                 double depth = kind < 0.35 ? urange(&L.rng, 0.9, 1.6) : urange(&L.rng, 0.5, 0.65);
-                got = against_wall(&L, r->x0, r->y0, r->x1, r->y1, along, depth);
+                got = layout_against_wall(&L, r->x0, r->y0, r->x1, r->y1, along, depth);
             } else {
                 double xy[8], tx = urange(&L.rng, r->x0 + 0.5, r->x1 - 0.5);
                 double ty = urange(&L.rng, r->y0 + 0.5, r->y1 - 0.5);
                 double tw = urange(&L.rng, 1.0, 1.8), th = urange(&L.rng, 0.7, 0.9);
                 rect_xy(xy, tx, ty, tw, th, urange(&L.rng, -0.3, 0.3));
-                got = try_add(&L, xy, 4u, 0.3); /* table */
+                got = layout_try_add(&L, xy, 4u, 0.3); /* table */
             }
             if (got < 0)
                 rc = -1;
@@ -620,11 +287,7 @@ int scansim_kind_flat(scansim_scene *s)
                 placed += (uint32_t)got;
         }
     }
-    rc |= add_people(&L, 1u, 2u);
-    if (rc != 0)
-        return -1;
-    place_anywhere(&L);
-    return 0;
+    return layout_finish(&L, rc, 1u, 2u);
 }
 
 /* ---- curved --------------------------------------------------------------------- */
@@ -663,15 +326,15 @@ int scansim_kind_curved(scansim_scene *s)
     outline[n++] = h;
     L.outline = s->wall_count;
     rc |= scansim_add_wall(s, outline, n / 2u, 1);
-    way(&L, inset, inset);
-    way(&L, w - inset, inset);
-    way(&L, w - inset, h - inset);
-    way(&L, cx + 0.6, h - inset);
-    way(&L, cx, h - d + r - 1.0);
-    way(&L, cx - 0.6, h - inset);
-    way(&L, inset, h - inset);
-    way(&L, inset, inset + 0.2);
-    rc |= lay_path(&L, 450.0);
+    layout_way(&L, inset, inset);
+    layout_way(&L, w - inset, inset);
+    layout_way(&L, w - inset, h - inset);
+    layout_way(&L, cx + 0.6, h - inset);
+    layout_way(&L, cx, h - d + r - 1.0);
+    layout_way(&L, cx - 0.6, h - inset);
+    layout_way(&L, inset, h - inset);
+    layout_way(&L, inset, inset + 0.2);
+    rc |= layout_path(&L, 450.0);
     L.first_object = s->wall_count;
     {
         static const double fw[2] = {0.6, 1.8}, fh[2] = {0.5, 0.9};
@@ -684,20 +347,16 @@ int scansim_kind_curved(scansim_scene *s)
                 column[2u * k] = ccx + cr * cos(2.0 * PI * (double)k / 40.0);
                 column[2u * k + 1u] = ccy + cr * sin(2.0 * PI * (double)k / 40.0);
             }
-            got = try_add(&L, column, 40u, 0.5);
+            got = layout_try_add(&L, column, 40u, 0.5);
             if (got != 0) {
                 rc |= got < 0;
                 break;
             }
         }
-        rc |= scatter_boxes(&L, upick(&L.rng, 2u, 4u), fw, fh, -1.0, 0.5, 0.5, w - 0.5,
-                            h - 0.5, 0.3);
+        rc |= layout_scatter_boxes(&L, upick(&L.rng, 2u, 4u), fw, fh, -1.0, 0.5, 0.5, w - 0.5,
+                                   h - 0.5, 0.3);
     }
-    rc |= add_people(&L, 1u, 1u);
-    if (rc != 0)
-        return -1;
-    place_anywhere(&L);
-    return 0;
+    return layout_finish(&L, rc, 1u, 1u);
 }
 
 /* ---- thinwalls ------------------------------------------------------------------ */
@@ -760,23 +419,19 @@ int scansim_kind_thinwalls(scansim_scene *s)
             my = 0.5 * (cy[k - 1u] + cy[k]);
         }
         if (k % 2u == 0) {
-            way(&L, bx, 1.1); way(&L, mx, my); way(&L, tx, h - 1.1);
+            layout_way(&L, bx, 1.1); layout_way(&L, mx, my); layout_way(&L, tx, h - 1.1);
         } else {
-            way(&L, tx, h - 1.1); way(&L, mx, my); way(&L, bx, 1.1);
+            layout_way(&L, tx, h - 1.1); layout_way(&L, mx, my); layout_way(&L, bx, 1.1);
         }
     }
-    rc |= lay_path(&L, 600.0);
+    rc |= layout_path(&L, 600.0);
     L.first_object = s->wall_count;
     {
         static const double fw[2] = {0.6, 1.2}, fh[2] = {0.4, 0.8};
-        rc |= scatter_boxes(&L, upick(&L.rng, 0u, 2u), fw, fh, -1.0, 0.5, 0.5, w - 0.5, h - 0.5,
-                            0.3);
+        rc |= layout_scatter_boxes(&L, upick(&L.rng, 0u, 2u), fw, fh, -1.0, 0.5, 0.5, w - 0.5,
+                                   h - 0.5, 0.3);
     }
-    rc |= add_people(&L, 1u, 1u);
-    if (rc != 0)
-        return -1;
-    place_anywhere(&L);
-    return 0;
+    return layout_finish(&L, rc, 1u, 1u);
 }
 
 /* ---- drift and farhall: poses that drift --------------------------------------- */
@@ -880,18 +535,14 @@ int scansim_kind_drift(scansim_scene *s)
     rc |= scansim_add_box(s, o + c, o + c, w - o - c, h - o - c);
     m = o + c / 2.0;
     for (loop = 0; loop < 3u; loop++) {
-        way(&L, m, m);
-        way(&L, w - m, m);
-        way(&L, w - m, h - m);
-        way(&L, m, h - m);
+        layout_way(&L, m, m);
+        layout_way(&L, w - m, m);
+        layout_way(&L, w - m, h - m);
+        layout_way(&L, m, h - m);
     }
-    way(&L, m, m + 0.2);
-    rc |= lay_path(&L, 1000.0);
-    rc |= add_people(&L, 2u, 1u);
-    if (rc != 0)
-        return -1;
-    place_anywhere(&L);
-    return 0;
+    layout_way(&L, m, m + 0.2);
+    rc |= layout_path(&L, 1000.0);
+    return layout_finish(&L, rc, 2u, 1u);
 }
 
 /* The hall (the same layout, path and people for a seed) with drift: its

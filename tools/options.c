@@ -1,0 +1,343 @@
+/* options.c - the polyc tool's command line (cli.h).
+ * Takes: argv. Gives: the options, the command and the input, each value
+ * checked (the configuration by polyc_config_check), or a usage message. */
+#include <ctype.h>
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+#include "outfile.h"
+
+static const struct {
+    const char *name;
+    unsigned bit;
+} option_bits[] = {
+    {"--format", OPT_FORMAT},       {"-o", OPT_OUTPUT},           {"--output", OPT_OUTPUT},
+    {"--trace", OPT_TRACE},         {"--seed", OPT_SEED},         {"--iterations", OPT_ITERATIONS},
+    {"--max-range", OPT_MAX_RANGE}, {"--memory-mb", OPT_MEMORY},  {"--cell", OPT_CELL},
+    {"--threshold", OPT_THRESHOLD}, {"--alpha", OPT_ALPHA},       {"--gamma", OPT_GAMMA},
+    {"--occupied-thresh", OPT_OCCUPIED}, {"--free-thresh", OPT_FREE}, {"--stats", OPT_STATS},
+    {"--no-optimize", OPT_NO_OPTIMIZE}, {"--exact-points", OPT_EXACT},
+    {"--grid-trace", OPT_GRID_TRACE}, {"--points", OPT_POINTS}, {"--grid", OPT_GRID},
+    {"--vertices", OPT_VERTICES},     {"--color-lines", OPT_COLOR_LINES},
+};
+
+static const char usage_text[] =
+    "usage: polyc [options] INPUT       learn a polyline map from a laser log or a ROS map\n"
+    "       polyc convert [-o FILE] [--max-range M] INPUT\n"
+    "                                   write the scans in polyc's plain format\n"
+    "       polyc grid [--cell M] [--max-range M] -o PREFIX LOG\n"
+    "                                   write the log's hit/miss grid as a ROS map:\n"
+    "                                   PREFIX.pgm and PREFIX.yaml, as map_saver does\n"
+    "INPUT is a CARMEN log (FLASER, ROBOTLASER1) or a plain scan file (- is stdin),\n"
+    "or a ROS map_server map YAML (found by its content: key: value lines naming an\n"
+    "image, a PGM). A map's cells are its own: --cell, --threshold, --max-range,\n"
+    "--exact-points, --grid-trace and --points act on scans and are refused for a\n"
+    "map; --occupied-thresh and --free-thresh apply to maps only.\n"
+    "options:\n"
+    "  --format svg|json|txt   output format (default: -o's extension, else svg)\n"
+    "  -o, --output FILE       write FILE instead of stdout (a file is replaced\n"
+    "                          atomically, a device or FIFO written in place)\n"
+    "  --stats                 counts, sizes and times per stage on stderr\n"
+    "  --no-optimize           stop after tracing the initial polylines\n"
+    "  --cell M                grid cell size in metres (default 0.025)\n"
+    "  --threshold T           contour threshold on hits/(hits+misses) (default 0.5)\n"
+    "  --max-range M           FLASER: no-return threshold in metres (default: detected);\n"
+    "                          other formats: lowers their max range to M\n"
+    "  --seed N                PRNG seed of the optimiser\n"
+    "  --iterations N          cap on optimiser iterations\n"
+    "  --alpha A               BIC weight of the error (paper 500)\n"
+    "  --gamma G               weight of the angle prior (0: uniform)\n"
+    "  --exact-points          keep every endpoint as a data point (slower)\n"
+    "  --grid-trace            one scan: trace the grid's contour, not the beam order\n"
+    "  --trace FILE            per iteration: iteration bic best_bic vertices polylines noise_m\n"
+    "  --memory-mb N           fail (exit 3) if the library needs more than N MiB\n"
+    "  --occupied-thresh P     map: a cell of value >= 100 P is occupied (default 0.65)\n"
+    "  --free-thresh P         map: a cell of value 0..100 P is free (default 0.196)\n"
+    "  --quiet                 no progress line on a terminal (shown on stderr for runs\n"
+    "                          over 2 s: stage, iteration, vertices, BIC)\n"
+    "  --points, --grid, --vertices\n"
+    "                          SVG layers: scan endpoints, grid cells, vertex dots\n"
+    "  --color-lines           SVG: a colour per polyline (default: one for the map)\n"
+    "  --help, --version\n"
+    "exit codes: 0 ok, 1 bad input or other failure, 2 usage, 3 memory budget too small\n";
+
+static int parse_double(const char *s, double lo, double hi, double *out)
+{
+    char *end;
+    errno = 0;
+    double v = strtod(s, &end);
+    if (end == s || *end || errno || !(v >= lo && v <= hi))
+        return -1;
+    *out = v;
+    return 0;
+}
+
+static int parse_u64(const char *s, uint64_t max, uint64_t *out)
+{
+    char *end;
+    if (*s < '0' || *s > '9')
+        return -1;
+    errno = 0;
+    unsigned long long v = strtoull(s, &end, 10);
+    if (*end || errno || v > max)
+        return -1;
+    *out = v;
+    return 0;
+}
+
+/* Sets one option that takes a value; returns 0 or an exit code. */
+static int set_value(options *o, const char *name, const char *val)
+{
+    double d;
+    uint64_t u;
+    if (strcmp(name, "--format") == 0) {
+        if (strcmp(val, "svg") == 0)
+            o->format = FORMAT_SVG;
+        else if (strcmp(val, "json") == 0)
+            o->format = FORMAT_JSON;
+        else if (strcmp(val, "txt") == 0)
+            o->format = FORMAT_TXT;
+        else
+            return complain(EXIT_USAGE, "--format must be svg, json or txt, not '%s'", val);
+    } else if (strcmp(name, "-o") == 0 || strcmp(name, "--output") == 0) {
+        o->output = val;
+    } else if (strcmp(name, "--trace") == 0) {
+        o->trace = val;
+    } else if (strcmp(name, "--seed") == 0) {
+        if (parse_u64(val, UINT64_MAX, &u))
+            return complain(EXIT_USAGE, "--seed needs an unsigned integer, not '%s'", val);
+        o->config.seed = u;
+    } else if (strcmp(name, "--iterations") == 0) {
+        if (parse_u64(val, UINT32_MAX, &u))
+            return complain(EXIT_USAGE, "--iterations needs 0..%u, not '%s'", UINT32_MAX, val);
+        o->config.max_iterations = (uint32_t)u;
+    } else if (strcmp(name, "--max-range") == 0) {
+        if (parse_double(val, 0.05, 1e6, &d))
+            return complain(EXIT_USAGE, "--max-range needs metres in [0.05, 1e6], not '%s'", val);
+        o->max_range_m = d;
+    } else if (strcmp(name, "--memory-mb") == 0) {
+        if (parse_double(val, 1e-6, 1e9, &d))
+            return complain(EXIT_USAGE, "--memory-mb needs MiB from 0.000001 to 1000000000,"
+                                        " not '%s'", val);
+        o->memory_mb = d;
+    } else {
+        /* float config fields; polyc_config_check judges the values */
+        float *field = strcmp(name, "--cell") == 0        ? &o->config.cell_m
+                       : strcmp(name, "--threshold") == 0 ? &o->config.contour_threshold
+                       : strcmp(name, "--alpha") == 0     ? &o->config.alpha
+                       : strcmp(name, "--gamma") == 0     ? &o->config.gamma
+                       : strcmp(name, "--occupied-thresh") == 0 ? &o->config.occupied_thresh
+                       : strcmp(name, "--free-thresh") == 0     ? &o->config.free_thresh
+                                                                : NULL;
+        if (!field)
+            return complain(EXIT_USAGE, "unknown option '%s'", name);
+        if (parse_double(val, -1e30, 1e30, &d))
+            return complain(EXIT_USAGE, "%s needs a number, not '%s'", name, val);
+        *field = (float)d;
+    }
+    return 0;
+}
+
+static unsigned option_bit(const char *name)
+{
+    for (size_t i = 0; i < sizeof option_bits / sizeof option_bits[0]; i++)
+        if (strcmp(name, option_bits[i].name) == 0)
+            return option_bits[i].bit;
+    return 0;
+}
+
+static int set_flag(options *o, const char *name)
+{
+    if (strcmp(name, "--quiet") == 0)
+        o->quiet = 1;
+    else if (strcmp(name, "--stats") == 0)
+        o->stats = 1;
+    else if (strcmp(name, "--no-optimize") == 0)
+        o->no_optimize = 1;
+    else if (strcmp(name, "--exact-points") == 0)
+        o->config.flags |= POLYC_FLAG_EXACT_POINTS;
+    else if (strcmp(name, "--grid-trace") == 0)
+        o->config.flags |= POLYC_FLAG_GRID_TRACE;
+    else if (strcmp(name, "--points") == 0)
+        o->points = 1;
+    else if (strcmp(name, "--grid") == 0)
+        o->grid = 1;
+    else if (strcmp(name, "--vertices") == 0)
+        o->vertices = 1;
+    else if (strcmp(name, "--color-lines") == 0)
+        o->color_lines = 1;
+    else
+        return -1;
+    return 0;
+}
+
+static int takes_value(const char *name)
+{
+    static const char *const names[] = {"--format", "-o",          "--output",    "--trace",
+                                        "--seed",   "--iterations", "--max-range", "--memory-mb",
+                                        "--cell",   "--threshold", "--alpha",     "--gamma",
+                                        "--occupied-thresh", "--free-thresh"};
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
+        if (strcmp(name, names[i]) == 0)
+            return 1;
+    return 0;
+}
+
+/* The format -o's extension names (.svg, .json, .txt), or -1. */
+static int format_of_name(const char *path)
+{
+    static const char *const ext[] = {".svg", ".json", ".txt"};
+    const char *slash = strrchr(path, '/');
+    const char *dot = strrchr(slash ? slash + 1 : path, '.');
+    for (int f = 0; dot && f < 3; f++) {
+        size_t i = 0;
+        while (dot[i] && ext[f][i] && tolower((unsigned char)dot[i]) == ext[f][i])
+            i++;
+        if (!dot[i] && !ext[f][i])
+            return f;
+    }
+    return -1;
+}
+
+/* Refuses (usage) outputs that cannot be written as asked, before any work:
+ * an empty or directory name, -o and --trace naming the same file, a
+ * --format that -o's extension contradicts; else takes the format from it. */
+static int check_outputs(options *o)
+{
+    const char *why;
+    if (o->command == CMD_GRID) {
+        size_t n = strlen(o->output);
+        char *p = malloc(n + 6);
+        if (!p)
+            return complain(EXIT_INPUT, "out of memory");
+        why = outfile_check(o->output);
+        for (int i = 0; i < 2 && !why; i++) {
+            snprintf(p, n + 6, "%s%s", o->output, i ? ".yaml" : ".pgm");
+            why = outfile_check(p);
+        }
+        free(p);
+        return why ? complain(EXIT_USAGE, "-o PREFIX '%s' %s (polyc grid writes PREFIX.pgm and"
+                                          " PREFIX.yaml)", o->output, why)
+                   : 0;
+    }
+    if ((why = outfile_check(o->output)))
+        return complain(EXIT_USAGE, "-o '%s' %s: give a file name", o->output, why);
+    if ((why = outfile_check(o->trace)))
+        return complain(EXIT_USAGE, "--trace '%s' %s: give a file name", o->trace, why);
+    if (o->trace && outfile_same(o->output, o->trace))
+        return complain(EXIT_USAGE, "-o and --trace name the same file ('%s', '%s')",
+                        o->output ? o->output : "-", o->trace);
+    int f = o->output && o->command == CMD_MAP ? format_of_name(o->output) : -1;
+    static const char *const names[] = {"svg", "json", "txt"};
+    if (f >= 0 && (o->given & OPT_FORMAT) && (int)o->format != f)
+        return complain(EXIT_USAGE, "--format %s contradicts -o %s (a .%s name)",
+                        names[o->format], o->output, names[f]);
+    if (f >= 0)
+        o->format = (enum format)f;
+    return 0;
+}
+
+/* polyc_config_check's message, in the options' names: "cell_m must be in
+ * [0.001, 10]" is "--cell must be in [0.001, 10]". */
+static int config_fail(const char *why)
+{
+    static const char *const names[][2] = {
+        {"cell_m", "--cell"}, {"contour_threshold", "--threshold"}, {"alpha", "--alpha"},
+        {"gamma", "--gamma"}, {"occupied_thresh", "--occupied-thresh"},
+        {"free_thresh", "--free-thresh"}};
+    char msg[200];
+    size_t n = 0;
+    while (*why && n + 40 < sizeof msg) {
+        size_t k = 0, len = 0;
+        for (; k < sizeof names / sizeof names[0]; k++) {
+            len = strlen(names[k][0]);
+            if (strncmp(why, names[k][0], len) == 0 && why[len] != '_' &&
+                !isalnum((unsigned char)why[len]))   /* a whole name */
+                break;
+        }
+        if (k < sizeof names / sizeof names[0]) {
+            n += (size_t)sprintf(msg + n, "%s", names[k][1]);
+            why += len;
+        } else {
+            msg[n++] = *why++;
+        }
+    }
+    msg[n] = '\0';
+    return complain(EXIT_USAGE, "bad option value: %s", msg);
+}
+
+int parse_args(int argc, char **argv, options *o)
+{
+    const char *positional[2];
+    int npos = 0, only_files = 0;
+    memset(o, 0, sizeof *o);
+    polyc_config_default(&o->config);
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        if (only_files || a[0] != '-' || strcmp(a, "-") == 0) {
+            if (npos == 2)
+                return complain(EXIT_USAGE, "too many arguments ('%s')", a);
+            positional[npos++] = a;
+            continue;
+        }
+        if (strcmp(a, "--") == 0) {
+            only_files = 1;
+        } else if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+            fputs(usage_text, stdout);
+            return -1;
+        } else if (strcmp(a, "--version") == 0) {
+            printf("polyc %d.%d.%d\n", POLYC_VERSION_MAJOR, POLYC_VERSION_MINOR,
+                   POLYC_VERSION_PATCH);   /* the tool is libpolyc's, one version */
+            return -1;
+        } else if (set_flag(o, a) == 0) {
+            o->given |= option_bit(a);
+            continue;
+        } else {
+            char name[32];
+            const char *eq = strchr(a, '=');
+            size_t n = eq && a[1] == '-' ? (size_t)(eq - a) : strlen(a);   /* --name=value */
+            if (n >= sizeof name)
+                return complain(EXIT_USAGE, "unknown option '%s'", a);
+            memcpy(name, a, n);
+            name[n] = '\0';
+            if (!takes_value(name))
+                return complain(EXIT_USAGE, "unknown option '%s'", a);
+            if (!eq && i + 1 >= argc)
+                return complain(EXIT_USAGE, "%s needs a value", a);
+            int rc = set_value(o, name, eq && a[1] == '-' ? eq + 1 : argv[++i]);
+            if (rc)
+                return rc;
+            o->given |= option_bit(name);
+        }
+    }
+    if (npos >= 1 && (strcmp(positional[0], "convert") == 0 || strcmp(positional[0], "grid") == 0)) {
+        o->command = positional[0][0] == 'c' ? CMD_CONVERT : CMD_GRID;
+        positional[0] = npos == 2 ? positional[1] : NULL;
+        npos--;
+    }
+    if (npos != 1 || !positional[0])
+        return complain(EXIT_USAGE, npos == 0 ? "no input file" : "too many arguments");
+    o->input = positional[0];
+    if (o->command == CMD_GRID && (!o->output || strcmp(o->output, "-") == 0))
+        return complain(EXIT_USAGE, "polyc grid needs -o PREFIX (it writes PREFIX.pgm and"
+                                    " PREFIX.yaml)");
+    int rc = check_outputs(o);
+    if (rc)
+        return rc;
+    const char *why = NULL;
+    if (polyc_config_check(&o->config, &why) != POLYC_OK)
+        return config_fail(why ? why : "?");
+    return 0;
+}
+
+int refuse_options(const options *o, unsigned allowed, const char *why)
+{
+    unsigned bad = o->given & ~allowed;
+    for (size_t i = 0; bad && i < sizeof option_bits / sizeof option_bits[0]; i++)
+        if (bad & option_bits[i].bit)
+            return complain(EXIT_USAGE, "%s does not apply to %s", option_bits[i].name, why);
+    return 0;
+}
