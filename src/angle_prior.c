@@ -94,14 +94,51 @@ static uint32_t cache_beams(const polyc_limits *lim)
     return lim->max_beams < CACHE_BEAMS ? lim->max_beams : CACHE_BEAMS;
 }
 
-size_t polyc__prior_bytes(const polyc_limits *lim)
+/* The allocations of polyc__prior_build, in its order: per cell its row;
+ * the rows (a budget of one a cell, the unused ones given back after
+ * learning); the endpoint cache; per row its total. */
+static uint32_t *row_index(polyc__arena *a, size_t cells)
+{
+    return polyc__alloc_zero(a, cells, sizeof(uint32_t));
+}
+static uint16_t *row_counts(polyc__arena *a, size_t rows)
+{
+    return polyc__alloc(a, rows, BINS * sizeof(uint16_t));
+}
+static float *endpoint_cache(polyc__arena *a, size_t beams)
+{
+    return polyc__alloc(a, beams, 3 * sizeof(float));
+}
+static uint32_t *row_totals(polyc__arena *a, size_t rows)
+{
+    return polyc__alloc(a, rows, sizeof(uint32_t));
+}
+
+void polyc__prior_reserve(polyc__arena *a, const polyc_limits *lim)
 {
     size_t cells = cell_cap(lim);
-    size_t n = polyc__add(polyc__bytes(cells, sizeof(uint32_t)),           /* row_of */
-                          polyc__bytes(cells, BINS * sizeof(uint16_t)));   /* rows */
-    n = polyc__add(n, polyc__bytes(cells, sizeof(uint32_t)));              /* totals */
-    n = polyc__add(n, polyc__accuracy_bytes(lim, cells));
-    return polyc__add(n, polyc__bytes(cache_beams(lim), 3 * sizeof(float)));
+    polyc__prior p;
+    polyc__acc_learn acc;
+    memset(&p, 0, sizeof p);
+    p.w = (int32_t)cells;
+    p.h = 1;
+    row_index(a, cells);
+    polyc__accuracy_begin(&acc, &p, a, lim);
+    size_t rows_at = a->used;
+    row_counts(a, cells);
+    endpoint_cache(a, cache_beams(lim));
+    polyc__accuracy_scratch(&acc, a, lim);
+    polyc__accuracy_reserve_finish(&acc, a);
+    a->used = rows_at + polyc__bytes(cells, BINS * sizeof(uint16_t));
+    row_totals(a, cells);
+}
+
+size_t polyc__prior_bytes(const polyc_limits *lim)
+{
+    polyc__arena a;
+    polyc__arena_counting(&a);
+    polyc__prior_reserve(&a, lim);
+    return a.peak;
 }
 
 /* ---- learning ---- */
@@ -500,14 +537,14 @@ polyc_status polyc__prior_build(polyc_ctx *ctx, polyc__prior *p, size_t spare)
     p->origin_x = g->origin_x_m - ctx->frame_x;
     p->origin_y = g->origin_y_m - ctx->frame_y;
     size_t cells = (size_t)p->w * (size_t)p->h;
-    p->row_of = polyc__alloc_zero(&ctx->arena, cells, sizeof(uint32_t));
+    p->row_of = row_index(&ctx->arena, cells);
     polyc__acc_learn acc;
     if (!p->row_of || !polyc__accuracy_begin(&acc, p, &ctx->arena, &ctx->lim)) {
         memset(p, 0, sizeof *p);
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the angle prior");
     }
     size_t rows_at = ctx->arena.used;
-    p->hist = p->row_of ? polyc__alloc(&ctx->arena, cells, BINS * sizeof(uint16_t)) : NULL;
+    p->hist = p->row_of ? row_counts(&ctx->arena, cells) : NULL;
     if (!p->hist) {
         memset(p, 0, sizeof *p);
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the angle prior");
@@ -520,7 +557,7 @@ polyc_status polyc__prior_build(polyc_ctx *ctx, polyc__prior *p, size_t spare)
     q.ox = (float)p->origin_x;
     q.oy = (float)p->origin_y;
     q.cache_cap = cache_beams(&ctx->lim);
-    q.cache = polyc__alloc(&ctx->arena, q.cache_cap, 3 * sizeof(float));
+    q.cache = endpoint_cache(&ctx->arena, q.cache_cap);
     q.acc = polyc__accuracy_scratch(&acc, &ctx->arena, &ctx->lim) && acc.p ? &acc : NULL;
     for (uint32_t si = 0; si < ctx->scan_count; si++) {
         q.s = &ctx->scans[si];
@@ -531,7 +568,7 @@ polyc_status polyc__prior_build(polyc_ctx *ctx, polyc__prior *p, size_t spare)
         polyc__accuracy_finish(&acc, &ctx->arena, ctx->cfg.alpha);
     /* the rows not handed out go back to the block (the cache is gone too) */
     ctx->arena.used = rows_at + polyc__bytes(p->rows, BINS * sizeof(uint16_t));
-    p->total = polyc__alloc(&ctx->arena, p->rows, sizeof(uint32_t));
+    p->total = row_totals(&ctx->arena, p->rows);
     if (!p->total && p->rows > 0) { /* cannot happen: the rows' budget held them */
         memset(p, 0, sizeof *p);
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the angle prior");

@@ -203,29 +203,37 @@ polyc_status polyc_limits_for_scans(const polyc_config *config, const polyc_scan
 
 /* ---- sizing and context ---- */
 
-static size_t scans_bytes(const polyc_limits *lim)
+/* the scans' poses and their ranges */
+static int scans_carve(polyc__arena *a, const polyc_limits *lim, polyc__scan **scans, float **ranges)
 {
-    return polyc__add(polyc__bytes(lim->max_scans, sizeof(polyc__scan)),
-                      polyc__bytes(lim->max_beams, sizeof(float)));
+    *scans = polyc__alloc(a, lim->max_scans, sizeof(polyc__scan));
+    *ranges = polyc__alloc(a, lim->max_beams, sizeof(float));
+    return (*scans || !lim->max_scans) && (*ranges || !lim->max_beams);
 }
 
+/* The size is the peak of a counting arena on which every stage carves what
+ * it would carve under the limits, in the order of the block's layout. */
 size_t polyc_memory_size(const polyc_config *config, const polyc_limits *limits)
 {
     if (!config || !limits || polyc_config_check(config, NULL) != POLYC_OK)
         return 0;
-    size_t n = polyc__bytes(1, sizeof(polyc_ctx)) + 16; /* + alignment of the block */
-    n = polyc__add(n, scans_bytes(limits));
-    n = polyc__add(n, polyc__grid_budget_bytes(limits));
-    n = polyc__add(n, polyc__store_bytes(limits));
-    /* the contour's cells and the walk that traces them, or a single scan's
-     * chains, which start where the contour would (need_stage) */
-    size_t contour = polyc__add(polyc__contour_bytes(limits), polyc__contour_bytes(limits));
-    size_t chains = polyc__chains_bytes(limits);
-    n = polyc__add(n, contour > chains ? contour : chains);
-    n = polyc__add(n, polyc__flat_bytes(limits));
-    n = polyc__add(n, polyc__prior_bytes(limits));
-    n = polyc__add(n, 2 * polyc__spacing_bytes(limits)); /* trace and optimiser */
-    n = polyc__add(n, polyc__optimizer_bytes(config, limits));
+    polyc__arena a;
+    polyc__scan *scans;
+    float *ranges;
+    polyc__arena_counting(&a);
+    scans_carve(&a, limits, &scans, &ranges);
+    polyc__grid_reserve(&a, limits);
+    /* a single scan's chains start where the contour would (need_stage) */
+    size_t grid_mark = a.used;
+    polyc__chains_reserve(&a, limits);
+    a.used = grid_mark;
+    polyc__contour_reserve(&a, limits);
+    polyc__trace_reserve(&a, limits);
+    polyc__flat_reserve(&a, polyc__max_vertices(limits)); /* the result */
+    polyc__prior_reserve(&a, limits);
+    polyc__optimizer_reserve(&a, config, limits);
+    size_t head = polyc__bytes(1, sizeof(polyc_ctx)) + 16; /* + alignment of the block */
+    size_t n = polyc__add(head, a.peak);
     return n == SIZE_MAX ? 0 : n;
 }
 
@@ -275,9 +283,7 @@ polyc_status polyc_init(void *block, size_t size, const polyc_config *config,
     size_t head = polyc__bytes(1, sizeof(polyc_ctx));
     ctx->arena.base = (unsigned char *)p + head;
     ctx->arena.size = size - skew - head;
-    ctx->scans = polyc__alloc(&ctx->arena, limits->max_scans, sizeof(polyc__scan));
-    ctx->ranges = polyc__alloc(&ctx->arena, limits->max_beams, sizeof(float));
-    if ((!ctx->scans && limits->max_scans) || (!ctx->ranges && limits->max_beams))
+    if (!scans_carve(&ctx->arena, limits, &ctx->scans, &ctx->ranges))
         return POLYC_ERR_NOMEM;
     ctx->scans_mark = ctx->base_mark = ctx->arena.used;
     ctx->frame_cos = 1.0;
@@ -455,7 +461,7 @@ static polyc_status stage_trace(polyc_ctx *ctx)
     if (st != POLYC_OK)
         return st;
     int32_t vcap = ctx->store.v_cap;
-    st = polyc__flat_init(ctx, &ctx->flat, (uint32_t)(vcap / 2 + 16), (uint32_t)vcap);
+    st = polyc__flat_init(ctx, &ctx->flat, (uint32_t)polyc__line_cap(vcap), (uint32_t)vcap);
     if (st != POLYC_OK)
         return st;
     export_result(ctx);

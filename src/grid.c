@@ -40,6 +40,13 @@ size_t polyc__grid_budget_bytes(const polyc_limits *lim)
     return polyc__add(polyc__bytes(tiles + 1, sizeof(polyc__tile)), dir);
 }
 
+/* The grid hands out its tiles by data, within its budget (the directory,
+ * its bits, the spill tile and the tiles): that budget is its reservation. */
+void polyc__grid_reserve(polyc__arena *a, const polyc_limits *lim)
+{
+    polyc__alloc(a, polyc__grid_budget_bytes(lim), 1);
+}
+
 int polyc__cell_occupied(const polyc__tile *t, int idx, float threshold)
 {
     unsigned h = t->hits[idx];

@@ -33,6 +33,8 @@ typedef struct polyc__arena {
 } polyc__arena;
 
 void *polyc__alloc(polyc__arena *a, size_t count, size_t elem_size);
+/* an arena that only counts (no block): what polyc_memory_size carves on */
+void polyc__arena_counting(polyc__arena *a);
 void *polyc__alloc_zero(polyc__arena *a, size_t count, size_t elem_size);
 /* size of count * elem_size rounded up to the arena alignment; 0 on overflow */
 size_t polyc__bytes(size_t count, size_t elem_size);
@@ -171,8 +173,6 @@ typedef struct polyc__acc_learn {
     void *samples, *cells;         /* scratch */
     uint32_t n, cap;
 } polyc__acc_learn;
-/* bytes for a prior of `cells` cells: the weights and the scratch */
-size_t polyc__accuracy_bytes(const polyc_limits *lim, size_t cells);
 /* the weights (all 1), after the prior's cells are laid out; 0: no room */
 int polyc__accuracy_begin(polyc__acc_learn *L, polyc__prior *p, polyc__arena *a,
                           const polyc_limits *lim);
@@ -185,9 +185,14 @@ void polyc__accuracy_sample(polyc__acc_learn *L, float x, float y, float nx, flo
                             uint32_t scan, float res2, float density);
 /* pairs the samples up and sets the weights (alpha: the error term's) */
 void polyc__accuracy_finish(polyc__acc_learn *L, polyc__arena *a, float alpha);
+/* what polyc__accuracy_finish allocates at most (L->cap samples), on a
+ * counting arena */
+void polyc__accuracy_reserve_finish(polyc__acc_learn *L, polyc__arena *a);
 /* the weight at (x, y), frame metres; 1 outside the prior or without one */
 float polyc__accuracy_weight(const polyc__prior *p, float x, float y);
 
+/* the prior's allocations under the limits, on a counting arena; and their peak */
+void polyc__prior_reserve(polyc__arena *a, const polyc_limits *lim);
 size_t polyc__prior_bytes(const polyc_limits *lim);
 /* Learns the prior from the stored scans (needs the grid for its extent);
  * with `spare` bytes or more of the block free beyond what the later stages
@@ -216,7 +221,8 @@ typedef struct polyc__spacing {
     uint32_t pose_count;
 } polyc__spacing;
 
-size_t polyc__spacing_bytes(const polyc_limits *lim);
+/* the table's allocation under the limits, on a counting arena */
+void polyc__spacing_reserve(polyc__arena *a, const polyc_limits *lim);
 polyc_status polyc__spacing_build(polyc_ctx *ctx, polyc__spacing *sp);
 /* metres between neighbouring endpoints near (x, y), frame-relative; a lower
  * bound, since the nearest pose is taken (0 without poses) */
@@ -282,6 +288,8 @@ polyc_status polyc__fail(polyc_ctx *ctx, polyc_status st, const char *msg);
 
 /* grid.c */
 size_t polyc__grid_budget_bytes(const polyc_limits *lim);
+/* the budget, on a counting arena */
+void polyc__grid_reserve(polyc__arena *a, const polyc_limits *lim);
 polyc_status polyc__grid_build(polyc_ctx *ctx);
 polyc__tile *polyc__grid_tile(const polyc__grid *g, int32_t ix, int32_t iy);
 /* NULL for cells outside the grid or in tiles not stored (no beam ends in a
@@ -354,11 +362,18 @@ int polyc__occ_free_at(const polyc_ctx *ctx, float x, float y);
 /* contour.c */
 /* entries the grid's tile directory may have under the limits */
 size_t polyc__grid_dir_cap(const polyc_limits *lim);
+/* the contour list (limits.max_beams + 1 cells) */
+int32_t *polyc__contour_list(polyc__arena *a, const polyc_limits *lim);
+/* the stage's allocations under the limits, on a counting arena; and their peak */
+void polyc__contour_reserve(polyc__arena *a, const polyc_limits *lim);
 size_t polyc__contour_bytes(const polyc_limits *lim);
 polyc_status polyc__contour_build(polyc_ctx *ctx);
 
 /* polyline.c */
-size_t polyc__store_bytes(const polyc_limits *lim);
+/* lines a store (and its flat form) of v_cap vertices holds */
+int32_t polyc__line_cap(int32_t v_cap);
+/* the store's allocations under the limits, on a counting arena */
+void polyc__store_reserve(polyc__arena *a, const polyc_limits *lim);
 polyc_status polyc__store_init(polyc_ctx *ctx, polyc__store *s, int32_t v_cap);
 void polyc__store_clear(polyc__store *s);
 int32_t polyc__line_new(polyc__store *s);
@@ -370,23 +385,22 @@ void polyc__line_close(polyc__store *s, int32_t line);
 void polyc__line_reverse(polyc__store *s, int32_t line);
 int32_t polyc__line_cut(polyc__store *s, int32_t u, int *ok);
 void polyc__line_join(polyc__store *s, int32_t tail, int32_t head);
-size_t polyc__flat_bytes(const polyc_limits *lim);
+/* a flat form of v_cap vertices' allocations, on a counting arena */
+void polyc__flat_reserve(polyc__arena *a, int32_t v_cap);
 polyc_status polyc__flat_init(polyc_ctx *ctx, polyc__flat *f, uint32_t cap_lines, uint32_t cap_points);
 void polyc__flat_from_store(polyc__flat *f, const polyc__store *s);
 polyc_status polyc__store_from_flat(polyc__store *s, const polyc__flat *f);
 
 /* trace.c */
 polyc_status polyc__trace_build(polyc_ctx *ctx);
+void polyc__trace_reserve(polyc__arena *a, const polyc_limits *lim);
 /* scan_chains.c: a single scan's initial polylines from its beam order */
-size_t polyc__chains_bytes(const polyc_limits *lim);
+void polyc__chains_reserve(polyc__arena *a, const polyc_limits *lim);
 polyc_status polyc__chains_build(polyc_ctx *ctx);
 
-/* points.c */
-size_t polyc__points_bytes(const polyc_limits *lim);
-polyc_status polyc__points_build(polyc_ctx *ctx);
-
 /* optimize.c */
-size_t polyc__optimizer_bytes(const polyc_config *cfg, const polyc_limits *lim);
+/* what the optimiser carves after the prior, on a counting arena */
+void polyc__optimizer_reserve(polyc__arena *a, const polyc_config *cfg, const polyc_limits *lim);
 polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *user);
 polyc_status polyc__score(polyc_ctx *ctx, double *bic, double *err);
 

@@ -257,7 +257,7 @@ static polyc_status fill(polyc_ctx *ctx, const polyc_occupancy_grid *grid, const
     /* the contour list after the tiles: each occupied cell labels itself at
      * most once, so limits.max_beams (the occupied cells) bounds it */
     ctx->contour_count = 0;
-    ctx->contour_xy = polyc__alloc(&ctx->arena, (size_t)ctx->lim.max_beams * 2 + 2, sizeof(int32_t));
+    ctx->contour_xy = polyc__contour_list(&ctx->arena, &ctx->lim);
     if (!ctx->contour_xy)
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the contour");
     /* a miss in each free cell of a stored tile (polyc_grid_cell reads it);

@@ -22,42 +22,80 @@ static int32_t loc_soa_cap(const polyc_limits *lim)
     return lim->max_scans != 1 ? POLYC__LOC_SOA : 0;
 }
 
-size_t polyc__optimizer_bytes(const polyc_config *cfg, const polyc_limits *lim)
+/* The optimiser's own arrays for P points and V vertices (the points, the
+ * spatial hash and the best model are carved by their files). */
+#define CARVE(ptr, count) (ok &= ((ptr) = polyc__alloc(a, (size_t)(count), sizeof *(ptr))) != NULL)
+static int opt_carve(polyc__arena *a, polyc__opt *o, int32_t P, int32_t V, int viewed, int32_t lsoa_cap)
 {
-    size_t P = (size_t)polyc__points_bound(cfg, lim);
-    size_t V = (size_t)polyc__max_vertices(lim);
-    size_t NB = (size_t)polyc__hash_bucket_cap(lim);
-    size_t NE = (size_t)polyc__hash_entry_cap(lim);
-    size_t n = 0;
-    n = polyc__add(n, polyc__bytes(P * 2, sizeof(polyc__point))); /* sorted + unsorted */
-    if (lim->max_scans > 1) {
-        n = polyc__add(n, polyc__bytes(P * 2, 2 * sizeof(float))); /* pt_view, sorted + unsorted */
-        n = polyc__add(n, polyc__bytes(V, sizeof(float)));         /* seg_side */
+    int ok = 1;
+    CARVE(o->pt_seg, P);
+    CARVE(o->pt_cost, P);
+    CARVE(o->loc_pt, P);
+    CARVE(o->loc_base, P);
+    CARVE(o->loc_seg, P);
+    CARVE(o->agg_pt, P);
+    CARVE(o->cand_seg, POLYC__CAND_MAX);
+    CARVE(o->cand_box, 4 * POLYC__CAND_MAX);
+    o->lsoa_cap = lsoa_cap;
+    if (o->lsoa_cap > 0) {
+        CARVE(o->lsoa_x, o->lsoa_cap);
+        CARVE(o->lsoa_y, o->lsoa_cap);
+        CARVE(o->lsoa_w, o->lsoa_cap);
+        CARVE(o->lsoa_cxx, o->lsoa_cap);
+        CARVE(o->lsoa_cxy, o->lsoa_cap);
+        CARVE(o->lsoa_cyy, o->lsoa_cap);
+        CARVE(o->lsoa_c, o->lsoa_cap);
     }
-    n = polyc__add(n, polyc__bytes(P, sizeof(int32_t)));          /* pt_seg */
-    n = polyc__add(n, polyc__bytes(P, sizeof(double)));           /* pt_cost */
-    n = polyc__add(n, polyc__bytes(P, sizeof(int32_t)));          /* loc_pt */
-    n = polyc__add(n, polyc__bytes(P, sizeof(double)));           /* loc_base */
-    n = polyc__add(n, polyc__bytes(P, sizeof(int32_t)));          /* loc_seg */
-    n = polyc__add(n, polyc__bytes(P, sizeof(int32_t)));          /* agg_pt */
-    n = polyc__add(n, polyc__bytes(POLYC__CAND_MAX, sizeof(int32_t) + 4 * sizeof(float))); /* cand */
-    n = polyc__add(n, polyc__bytes((size_t)loc_soa_cap(lim), 7 * sizeof(double))); /* lsoa */
-    n = polyc__add(n, polyc__bytes(P + V, sizeof(float)));        /* split_t */
-    n = polyc__add(n, polyc__bytes(V, 3 * sizeof(float)));        /* trim_head, gap_head, gap_tail */
-    n = polyc__add(n, polyc__bytes(V + 1, sizeof(int32_t)));      /* split_off */
-    n = polyc__add(n, polyc__bytes(V / 4 + 64, 2 * sizeof(float) + 2 * sizeof(int32_t))); /* cuts */
-    n = polyc__add(n, polyc__bytes(V, sizeof(double) + 3 * sizeof(float))); /* acost, seg stats */
-    n = polyc__add(n, polyc__bytes(V, 6 * sizeof(int32_t) + 2));  /* marks, lists, seg_in, split_due */
-    n = polyc__add(n, polyc__bytes(V + 1024, sizeof(polyc__heap_entry)));
-    n = polyc__add(n, polyc__bytes(ADDED_CAP, sizeof(int32_t)));
-    n = polyc__add(n, polyc__bytes(NB, 4 * sizeof(int32_t)));     /* heads, starts, marks, list */
-    n = polyc__add(n, polyc__bytes(NE, sizeof(polyc__hash_entry)));
-    n = polyc__add(n, polyc__flat_bytes(lim));                    /* best model */
-    return polyc__add(n, 44 * 16);                                /* alignment slack */
+    o->agg_cap = P;
+    CARVE(o->split_t, P > V ? P : V);
+    CARVE(o->trim_head, V);
+    CARVE(o->gap_head, V);
+    CARVE(o->gap_tail, V);
+    CARVE(o->split_off, V + 1);
+    /* cuts per pass (more wait for the next pass) */
+    o->cut_cap = V / 4 + 64;
+    CARVE(o->cut_seg, o->cut_cap);
+    CARVE(o->cut_next, o->cut_cap);
+    CARVE(o->cut_t0, o->cut_cap);
+    CARVE(o->cut_t1, o->cut_cap);
+    CARVE(o->acost, V);
+    o->seg_side = NULL;
+    if (viewed)
+        CARVE(o->seg_side, V);
+    CARVE(o->seg_sum, V);
+    CARVE(o->seg_w, V);
+    CARVE(o->seg_far_d, V);
+    CARVE(o->seg_far, V);
+    CARVE(o->seg_dead, V);
+    CARVE(o->v_dirty, V);
+    CARVE(o->dirty_list, V);
+    CARVE(o->seg_in, V);
+    CARVE(o->split_due, V);
+    CARVE(o->v_work, V);
+    CARVE(o->v_touch, V);
+    o->heap_cap = V + 1024; /* a candidate that finds it full is not retried */
+    CARVE(o->heap, o->heap_cap);
+    o->added_cap = ADDED_CAP;
+    CARVE(o->added, ADDED_CAP);
+    o->dirty_cap = V;
+    return ok;
 }
+#undef CARVE
 
-#define ALLOC(ptr, count) \
-    do { if (!((ptr) = polyc__alloc(&ctx->arena, (size_t)(count), sizeof *(ptr)))) goto nomem; } while (0)
+/* What the optimiser takes from the block after the prior: the spacing
+ * table, the spatial hash, the points, its own arrays and the best model,
+ * each carved by the code that carves them in polyc__opt_setup. */
+void polyc__optimizer_reserve(polyc__arena *a, const polyc_config *cfg, const polyc_limits *lim)
+{
+    polyc__opt o;
+    memset(&o, 0, sizeof o);
+    int32_t V = polyc__max_vertices(lim), P = polyc__points_bound(cfg, lim);
+    polyc__spacing_reserve(a, lim);
+    polyc__hash_reserve(a, &o, lim);
+    polyc__points_reserve(a, cfg, lim);
+    opt_carve(a, &o, P > 0 ? P : 1, V, lim->max_scans > 1, loc_soa_cap(lim));
+    polyc__flat_reserve(a, V);
+}
 
 /* An occupancy grid's data are cell centres, not noisy endpoints
  * (docs/algorithm.md, "From an occupancy grid"): its squared distances are
@@ -106,9 +144,10 @@ polyc_status polyc__opt_setup(polyc_ctx *ctx, polyc__opt *o)
     int32_t V = o->s->v_cap;
     polyc__rays_init(&o->rays, ctx);
     /* what the optimiser will still take from the block after the prior */
-    size_t later = polyc__add(polyc__spacing_bytes(&ctx->lim),
-                              polyc__optimizer_bytes(&ctx->cfg, &ctx->lim));
-    polyc_status st = polyc__prior_build(ctx, &o->prior, later);
+    polyc__arena later;
+    polyc__arena_counting(&later);
+    polyc__optimizer_reserve(&later, &ctx->cfg, &ctx->lim);
+    polyc_status st = polyc__prior_build(ctx, &o->prior, later.peak);
     if (st != POLYC_OK)
         return st;
     if ((st = polyc__spacing_build(ctx, &o->spacing)) != POLYC_OK)
@@ -119,71 +158,20 @@ polyc_status polyc__opt_setup(polyc_ctx *ctx, polyc__opt *o)
         return st;
     o->log_n = log(o->n > 1.0 ? o->n : 1.0);
     int32_t P = o->np > 0 ? o->np : 1;
-    ALLOC(o->pt_seg, P);
-    ALLOC(o->pt_cost, P);
-    ALLOC(o->loc_pt, P);
-    ALLOC(o->loc_base, P);
-    ALLOC(o->loc_seg, P);
-    ALLOC(o->agg_pt, P);
-    ALLOC(o->cand_seg, POLYC__CAND_MAX);
-    ALLOC(o->cand_box, 4 * POLYC__CAND_MAX);
-    o->lsoa_cap = loc_soa_cap(&ctx->lim);
+    if (!opt_carve(&ctx->arena, o, P, V, o->pt_view != NULL, loc_soa_cap(&ctx->lim)))
+        return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the optimiser");
     o->lsoa_n = -1;
-    if (o->lsoa_cap > 0) {
-        ALLOC(o->lsoa_x, o->lsoa_cap);
-        ALLOC(o->lsoa_y, o->lsoa_cap);
-        ALLOC(o->lsoa_w, o->lsoa_cap);
-        ALLOC(o->lsoa_cxx, o->lsoa_cap);
-        ALLOC(o->lsoa_cxy, o->lsoa_cap);
-        ALLOC(o->lsoa_cyy, o->lsoa_cap);
-        ALLOC(o->lsoa_c, o->lsoa_cap);
-    }
-    o->agg_cap = P;
-    ALLOC(o->split_t, P > V ? P : V);
-    ALLOC(o->trim_head, V);
-    ALLOC(o->gap_head, V);
-    ALLOC(o->gap_tail, V);
     memset(o->gap_head, 0, (size_t)V * sizeof(float));
     memset(o->gap_tail, 0, (size_t)V * sizeof(float));
-    ALLOC(o->split_off, V + 1);
-    /* cuts per pass (more wait for the next pass) */
-    ALLOC(o->cut_seg, V / 4 + 64);
-    ALLOC(o->cut_next, V / 4 + 64);
-    ALLOC(o->cut_t0, V / 4 + 64);
-    ALLOC(o->cut_t1, V / 4 + 64);
-    o->cut_cap = V / 4 + 64;
-    ALLOC(o->acost, V);
-    o->seg_side = NULL;
-    if (o->pt_view)
-        ALLOC(o->seg_side, V);
-    ALLOC(o->seg_sum, V);
-    ALLOC(o->seg_w, V);
-    ALLOC(o->seg_far_d, V);
-    ALLOC(o->seg_far, V);
-    ALLOC(o->seg_dead, V);
-    ALLOC(o->v_dirty, V);
-    ALLOC(o->dirty_list, V);
-    ALLOC(o->seg_in, V);
-    ALLOC(o->split_due, V);
-    ALLOC(o->v_work, V);
     memset(o->v_work, 0, (size_t)V * sizeof(uint32_t));
-    ALLOC(o->v_touch, V);
     memset(o->v_touch, 0, (size_t)V * sizeof(uint32_t));
-    ALLOC(o->heap, V + 1024); /* a candidate that finds it full is not retried */
-    o->heap_cap = V + 1024;
-    ALLOC(o->added, ADDED_CAP);
-    o->added_cap = ADDED_CAP;
-    o->dirty_cap = V;
     memset(o->seg_dead, 0, (size_t)V * sizeof(uint32_t));
     memset(o->v_dirty, 0, (size_t)V * sizeof(uint32_t));
     memset(o->seg_in, 0, (size_t)V);
     memset(o->split_due, 0, (size_t)V);
-    int32_t vcap = V;
-    if ((st = polyc__flat_init(ctx, &o->best, (uint32_t)(vcap / 2 + 16), (uint32_t)vcap)) != POLYC_OK)
+    if ((st = polyc__flat_init(ctx, &o->best, (uint32_t)polyc__line_cap(V), (uint32_t)V)) != POLYC_OK)
         return st;
     return polyc__rebuild(o);
-nomem:
-    return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the optimiser");
 }
 
 static void fill_stats(polyc__opt *o)

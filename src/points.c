@@ -274,19 +274,38 @@ int32_t polyc__points_bound(const polyc_config *cfg, const polyc_limits *lim)
     return b > 0x3fffffffu ? 0x3fffffff : (int32_t)b;
 }
 
+/* The points and, with `viewed`, where they were seen from: a pair of
+ * arrays of cap entries (the sorted ones first, the unsorted after them). */
+static int points_carve(polyc__arena *a, int32_t cap, int viewed, polyc__point **pts, float **view)
+{
+    *pts = polyc__alloc(a, (size_t)cap, sizeof(polyc__point));
+    *view = viewed ? polyc__alloc(a, (size_t)cap, 2 * sizeof(float)) : NULL;
+    return *pts && (!viewed || *view);
+}
+
+void polyc__points_reserve(polyc__arena *a, const polyc_config *cfg, const polyc_limits *lim)
+{
+    polyc__point *pts;
+    float *view;
+    int32_t cap = polyc__points_bound(cfg, lim);
+    points_carve(a, cap, lim->max_scans > 1, &pts, &view);
+    size_t mark = a->used;
+    points_carve(a, cap, lim->max_scans > 1, &pts, &view);
+    a->used = mark;
+}
+
 polyc_status polyc__points_collect(polyc__opt *o)
 {
     polyc_ctx *ctx = o->ctx;
     int32_t cap = polyc__points_bound(o->cfg, &ctx->lim);
-    /* final array first, the unsorted one after it (released at the end) */
-    o->pts = polyc__alloc(&ctx->arena, (size_t)cap, sizeof(polyc__point));
-    /* where the endpoints were seen from: scans (more than one) only */
+    /* final array first, the unsorted one after it (released at the end);
+     * where the endpoints were seen from: scans (more than one) only */
     int viewed = polyc__points_viewed(ctx);
-    o->pt_view = viewed ? polyc__alloc(&ctx->arena, (size_t)cap, 2 * sizeof(float)) : NULL;
+    int ok = points_carve(&ctx->arena, cap, viewed, &o->pts, &o->pt_view);
     size_t mark = ctx->arena.used;
-    polyc__point *tmp = polyc__alloc(&ctx->arena, (size_t)cap, sizeof(polyc__point));
-    float *tmp_view = viewed ? polyc__alloc(&ctx->arena, (size_t)cap, 2 * sizeof(float)) : NULL;
-    if (!o->pts || !tmp || (viewed && (!o->pt_view || !tmp_view)))
+    polyc__point *tmp;
+    float *tmp_view;
+    if (!ok || !points_carve(&ctx->arena, cap, viewed, &tmp, &tmp_view))
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the data points");
     int32_t n = 0;
     /* one scan: a point per return, whose beam the ends are set by (a

@@ -39,11 +39,23 @@ typedef struct chains {
     float alpha, log_n;        /* the BIC's weight of the error; log of the returns */
 } chains;
 
-size_t polyc__chains_bytes(const polyc_limits *lim)
+/* the scratch for a scan of n beams */
+static int chains_carve(polyc__arena *a, chains *c, int32_t n)
 {
-    size_t n = polyc__add(polyc__bytes((size_t)lim->max_beams + 1, 3 * sizeof(float)),
-                          polyc__bytes((size_t)lim->max_beams + 1, 1));
-    return polyc__add(n, polyc__bytes((size_t)lim->max_beams + 1, 1));
+    c->xy = polyc__alloc(a, (size_t)n + 1, 2 * sizeof(float));
+    c->keep = polyc__alloc(a, (size_t)n + 1, 1);
+    c->cost = polyc__alloc(a, (size_t)n + 1, sizeof(float));
+    c->chain_of = polyc__alloc(a, (size_t)n + 1, 1);
+    return c->xy && c->keep && c->cost && c->chain_of;
+}
+
+void polyc__chains_reserve(polyc__arena *a, const polyc_limits *lim)
+{
+    chains c;
+    polyc__store_reserve(a, lim);
+    size_t after_store = a->used;
+    chains_carve(a, &c, (int32_t)lim->max_beams);
+    a->used = after_store;
 }
 
 static int is_hit(const polyc__scan *s, float r)
@@ -523,11 +535,7 @@ polyc_status polyc__chains_build(polyc_ctx *ctx)
     int32_t n = (int32_t)s->count;
     chains c;
     c.ctx = ctx;
-    c.xy = polyc__alloc(&ctx->arena, (size_t)n + 1, 2 * sizeof(float));
-    c.keep = polyc__alloc(&ctx->arena, (size_t)n + 1, 1);
-    c.cost = polyc__alloc(&ctx->arena, (size_t)n + 1, sizeof(float));
-    c.chain_of = polyc__alloc(&ctx->arena, (size_t)n + 1, 1);
-    if (!c.xy || !c.keep || !c.cost || !c.chain_of)
+    if (!chains_carve(&ctx->arena, &c, n))
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the scan's chains");
     c.ox = s->x_m;
     c.oy = s->y_m;

@@ -34,6 +34,24 @@ int32_t polyc__hash_entry_cap(const polyc_limits *lim)
     return cap > 0x3fffffff ? 0x3fffffff : (int32_t)cap;
 }
 
+/* nb buckets' lists, marks and point ranges, and the entries */
+static int hash_carve(polyc__arena *a, polyc__opt *o, size_t nb, int32_t entry_cap)
+{
+    polyc__hash *h = &o->h;
+    h->seg_head = polyc__alloc(a, nb, sizeof(int32_t));
+    h->pt_start = polyc__alloc(a, nb + 1, sizeof(uint32_t));
+    h->entry_cap = entry_cap;
+    h->entries = polyc__alloc(a, (size_t)h->entry_cap, sizeof(polyc__hash_entry));
+    o->bucket_mark = polyc__alloc_zero(a, nb, sizeof(uint32_t));
+    o->bucket_list = polyc__alloc(a, nb, sizeof(int32_t));
+    return h->seg_head && h->pt_start && h->entries && o->bucket_mark && o->bucket_list;
+}
+
+void polyc__hash_reserve(polyc__arena *a, polyc__opt *o, const polyc_limits *lim)
+{
+    hash_carve(a, o, (size_t)polyc__hash_bucket_cap(lim), polyc__hash_entry_cap(lim));
+}
+
 polyc_status polyc__hash_init(polyc__opt *o)
 {
     polyc_ctx *ctx = o->ctx;
@@ -54,13 +72,7 @@ polyc_status polyc__hash_init(polyc__opt *o)
     h->origin_x = (float)(g->origin_x_m - ctx->frame_x) - HASH_MARGIN_M;
     h->origin_y = (float)(g->origin_y_m - ctx->frame_y) - HASH_MARGIN_M;
     size_t nb = (size_t)h->bx * (size_t)h->by;
-    h->seg_head = polyc__alloc(&ctx->arena, nb, sizeof(int32_t));
-    h->pt_start = polyc__alloc(&ctx->arena, nb + 1, sizeof(uint32_t));
-    h->entry_cap = polyc__hash_entry_cap(&ctx->lim);
-    h->entries = polyc__alloc(&ctx->arena, (size_t)h->entry_cap, sizeof(polyc__hash_entry));
-    o->bucket_mark = polyc__alloc_zero(&ctx->arena, nb, sizeof(uint32_t));
-    o->bucket_list = polyc__alloc(&ctx->arena, nb, sizeof(int32_t));
-    if (!h->seg_head || !h->pt_start || !h->entries || !o->bucket_mark || !o->bucket_list)
+    if (!hash_carve(&ctx->arena, o, nb, polyc__hash_entry_cap(&ctx->lim)))
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the spatial hash");
     polyc__hash_clear(o);
     return POLYC_OK;

@@ -294,6 +294,21 @@ static int adjacent(const int32_t *a, const int32_t *b, int32_t link)
     return dx * dx + dy * dy <= (link > 1 ? link * link : 2);
 }
 
+/* the walk's cells: the contour's and one more */
+static int32_t *walk_cells(polyc__arena *a, uint32_t cap)
+{
+    return polyc__alloc(a, (size_t)cap * 2, sizeof(int32_t));
+}
+
+void polyc__trace_reserve(polyc__arena *a, const polyc_limits *lim)
+{
+    polyc__store_reserve(a, lim);
+    size_t after_store = a->used;
+    walk_cells(a, lim->max_beams + 2); /* the contour list holds max_beams + 1 */
+    polyc__spacing_reserve(a, lim);
+    a->used = after_store;
+}
+
 polyc_status polyc__trace_build(polyc_ctx *ctx)
 {
     const polyc__grid *g = &ctx->grid;
@@ -304,7 +319,7 @@ polyc_status polyc__trace_build(polyc_ctx *ctx)
     walk w;
     w.cap = ctx->contour_count + 1;
     w.n = 0;
-    w.xy = polyc__alloc(&ctx->arena, (size_t)w.cap * 2, sizeof(int32_t));
+    w.xy = walk_cells(&ctx->arena, w.cap);
     if (!w.xy)
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for tracing");
     for (uint32_t k = 0; k < g->tile_count; k++)
