@@ -274,9 +274,6 @@ struct polyc_ctx {
     int opt_result_valid;          /* the store holds a map to publish */
     size_t trace_mark;             /* arena use after the initial polylines */
 
-    polyc__point *points;
-    uint32_t point_count;
-    double point_weight;           /* n of the BIC: every endpoint counts */
 
     polyc_stats stats;
 };

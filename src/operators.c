@@ -196,21 +196,18 @@ static float other_dist2(const polyc__opt *o, float x, float y, int32_t v)
 {
     const polyc__hash *h = &o->h;
     float best = 1e30f;
-    int32_t b = polyc__bucket_of(h, x, y);
-    int32_t bx = b % h->bx, by = b / h->bx;
-    for (int32_t yy = by - 1; yy <= by + 1; yy++)
-        for (int32_t xx = bx - 1; xx <= bx + 1; xx++) {
-            if (xx < 0 || yy < 0 || xx >= h->bx || yy >= h->by)
+    int32_t bx, by, around[9];
+    polyc__bucket_xy(h, x, y, &bx, &by);
+    int n = polyc__buckets_around(h, bx, by, around);
+    for (int i = 0; i < n; i++)
+        for (int32_t e = h->seg_head[around[i]]; e != POLYC__NONE; e = h->entries[e].next) {
+            int32_t sg = h->entries[e].seg;
+            if (near_on_line(o, v, sg, 3))
                 continue;
-            for (int32_t e = h->seg_head[yy * h->bx + xx]; e != POLYC__NONE; e = h->entries[e].next) {
-                int32_t sg = h->entries[e].seg;
-                if (near_on_line(o, v, sg, 3))
-                    continue;
-                const polyc__vertex *a = &o->s->v[sg], *c = &o->s->v[a->next];
-                float d = polyc__seg_dist2(x, y, a->x, a->y, c->x, c->y);
-                if (d < best)
-                    best = d;
-            }
+            const polyc__vertex *a = &o->s->v[sg], *c = &o->s->v[a->next];
+            float d = polyc__seg_dist2(x, y, a->x, a->y, c->x, c->y);
+            if (d < best)
+                best = d;
         }
     return best;
 }
@@ -282,27 +279,24 @@ static int32_t nearest_end(const polyc__opt *o, int32_t e, float lim2)
     int32_t best_v = POLYC__NONE;
     float best = lim2;
     float x = s->v[e].x, y = s->v[e].y;
-    int32_t b = polyc__bucket_of(h, x, y);
-    int32_t bx = b % h->bx, by = b / h->bx;
-    for (int32_t yy = by - 1; yy <= by + 1; yy++)
-        for (int32_t xx = bx - 1; xx <= bx + 1; xx++) {
-            if (xx < 0 || yy < 0 || xx >= h->bx || yy >= h->by)
-                continue;
-            for (int32_t en = h->seg_head[yy * h->bx + xx]; en != POLYC__NONE; en = h->entries[en].next) {
-                int32_t sg = h->entries[en].seg;
-                int32_t cand[2] = {sg, s->v[sg].next};
-                for (int k = 0; k < 2; k++) {
-                    int32_t f = cand[k];
-                    const polyc__vertex *fv = &s->v[f];
-                    if (f == e || (fv->prev != POLYC__NONE && fv->next != POLYC__NONE))
-                        continue; /* not an open end */
-                    if (fv->line == s->v[e].line && s->l[fv->line].count < 3)
-                        continue;
-                    float dx = fv->x - x, dy = fv->y - y, d = dx * dx + dy * dy;
-                    if (d < best) {
-                        best = d;
-                        best_v = f;
-                    }
+    int32_t bx, by, around[9];
+    polyc__bucket_xy(h, x, y, &bx, &by);
+    int n = polyc__buckets_around(h, bx, by, around);
+    for (int i = 0; i < n; i++)
+        for (int32_t en = h->seg_head[around[i]]; en != POLYC__NONE; en = h->entries[en].next) {
+            int32_t sg = h->entries[en].seg;
+            int32_t cand[2] = {sg, s->v[sg].next};
+            for (int k = 0; k < 2; k++) {
+                int32_t f = cand[k];
+                const polyc__vertex *fv = &s->v[f];
+                if (f == e || (fv->prev != POLYC__NONE && fv->next != POLYC__NONE))
+                    continue; /* not an open end */
+                if (fv->line == s->v[e].line && s->l[fv->line].count < 3)
+                    continue;
+                float dx = fv->x - x, dy = fv->y - y, d = dx * dx + dy * dy;
+                if (d < best) {
+                    best = d;
+                    best_v = f;
                 }
             }
         }

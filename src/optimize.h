@@ -54,7 +54,6 @@ typedef struct polyc__opt {
     uint8_t *seg_in;               /* per vertex: its segment is in the hash */
     uint8_t *split_due;            /* per vertex: its segment or its points changed
                                     * since op_split last looked at it */
-    int32_t cur_seg;               /* segment being entered or removed */
 
     /* one change (a batch of edits) being recorded */
     uint32_t epoch;
@@ -120,7 +119,6 @@ typedef struct polyc__opt {
                                     * edited since is looked at again */
     polyc__rng rng;
     polyc__flat best;
-    double noise_m;
 } polyc__opt;
 
 #define POLYC__CAND_MAX 48
@@ -161,10 +159,22 @@ static inline void polyc__bucket_xy(const polyc__hash *h, float x, float y, int3
     *ix = fx < 0.0f ? 0 : (fx >= (float)h->bx ? h->bx - 1 : (int32_t)fx);
     *iy = fy < 0.0f ? 0 : (fy >= (float)h->by ? h->by - 1 : (int32_t)fy);
 }
-/* calls fn for every bucket the segment a-b crosses */
-typedef void (*polyc__bucket_fn)(polyc__opt *o, int32_t bucket);
+/* The 3 x 3 buckets around bucket (bx, by) that lie in the hash, row by
+ * row, into out; returns their count (the one bucket walk of the library). */
+static inline int polyc__buckets_around(const polyc__hash *h, int32_t bx, int32_t by, int32_t out[9])
+{
+    int32_t x0 = bx > 0 ? bx - 1 : 0, x1 = bx + 1 < h->bx ? bx + 1 : h->bx - 1;
+    int32_t y0 = by > 0 ? by - 1 : 0, y1 = by + 1 < h->by ? by + 1 : h->by - 1;
+    int n = 0;
+    for (int32_t y = y0; y <= y1; y++)
+        for (int32_t x = x0; x <= x1; x++)
+            out[n++] = y * h->bx + x;
+    return n;
+}
+/* calls fn(o, user, bucket) for every bucket the segment a-b crosses */
+typedef void (*polyc__bucket_fn)(polyc__opt *o, void *user, int32_t bucket);
 void polyc__segment_buckets(polyc__opt *o, float ax, float ay, float bx, float by,
-                            polyc__bucket_fn fn);
+                            polyc__bucket_fn fn, void *user);
 /* lists in o->bucket_list, once per epoch (o->bucket_mark), every bucket
  * within one bucket of the segment a-b: those whose points it can reach */
 void polyc__segment_region(polyc__opt *o, float ax, float ay, float bx, float by);

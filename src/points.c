@@ -357,7 +357,6 @@ polyc_status polyc__points_collect(polyc__opt *o)
                       : exact        ? 0.0f
                                      : ctx->grid.cell_m * (float)BLOCK_SIDE;
     o->support_m = polyc__maxf(POLYC__SUPPORT_M, o->point_span_m);
-    ctx->point_weight = total;
     ctx->stats.data_points = (uint64_t)total;
     ctx->stats.weighted_points = (uint32_t)n;
     return POLYC_OK;

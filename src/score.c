@@ -356,33 +356,31 @@ static void gather_around(polyc__opt *o, int32_t b)
     if (b == o->cand_src)
         return; /* the points come bucket by bucket */
     o->cand_src = b;
-    int32_t bx = b % h->bx, by = b / h->bx;
-    int32_t x0 = bx > 0 ? bx - 1 : 0, x1 = bx + 1 < h->bx ? bx + 1 : h->bx - 1;
-    int32_t y0 = by > 0 ? by - 1 : 0, y1 = by + 1 < h->by ? by + 1 : h->by - 1;
-    for (int32_t y = y0; y <= y1; y++)
-        for (int32_t x = x0; x <= x1; x++) {
-            int32_t nb = y * h->bx + x;
-            if (o->bucket_mark[nb] == stamp)
+    int32_t around[9];
+    int n = polyc__buckets_around(h, b % h->bx, b / h->bx, around);
+    for (int i = 0; i < n; i++) {
+        int32_t nb = around[i];
+        if (o->bucket_mark[nb] == stamp)
+            continue;
+        o->bucket_mark[nb] = stamp;
+        for (int32_t e = h->seg_head[nb]; e != POLYC__NONE; e = h->entries[e].next) {
+            int32_t sg = h->entries[e].seg;
+            if (o->seg_dead[sg] == stamp)
                 continue;
-            o->bucket_mark[nb] = stamp;
-            for (int32_t e = h->seg_head[nb]; e != POLYC__NONE; e = h->entries[e].next) {
-                int32_t sg = h->entries[e].seg;
-                if (o->seg_dead[sg] == stamp)
-                    continue;
-                o->seg_dead[sg] = stamp;
-                if (o->cand_n == POLYC__CAND_MAX) {
-                    o->cand_n = POLYC__CAND_MAX + 1; /* too many: the hash is queried */
-                    return;
-                }
-                const polyc__vertex *a = &o->s->v[sg], *c = &o->s->v[a->next];
-                float *box = o->cand_box + 4 * o->cand_n;
-                box[0] = polyc__minf(a->x, c->x);
-                box[1] = polyc__minf(a->y, c->y);
-                box[2] = polyc__maxf(a->x, c->x);
-                box[3] = polyc__maxf(a->y, c->y);
-                o->cand_seg[o->cand_n++] = sg;
+            o->seg_dead[sg] = stamp;
+            if (o->cand_n == POLYC__CAND_MAX) {
+                o->cand_n = POLYC__CAND_MAX + 1; /* too many: the hash is queried */
+                return;
             }
+            const polyc__vertex *a = &o->s->v[sg], *c = &o->s->v[a->next];
+            float *box = o->cand_box + 4 * o->cand_n;
+            box[0] = polyc__minf(a->x, c->x);
+            box[1] = polyc__minf(a->y, c->y);
+            box[2] = polyc__maxf(a->x, c->x);
+            box[3] = polyc__maxf(a->y, c->y);
+            o->cand_seg[o->cand_n++] = sg;
         }
+    }
 }
 
 /* nearest_below over the gathered candidates: the same segments it would

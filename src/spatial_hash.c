@@ -177,7 +177,7 @@ static int path_next(path_walk *p, int32_t *ix, int32_t *iy)
 }
 
 void polyc__segment_buckets(polyc__opt *o, float ax, float ay, float bx, float by,
-                            polyc__bucket_fn fn)
+                            polyc__bucket_fn fn, void *user)
 {
     const polyc__hash *h = &o->h;
     path_walk p;
@@ -185,7 +185,7 @@ void polyc__segment_buckets(polyc__opt *o, float ax, float ay, float bx, float b
     if (!path_begin(h, ax, ay, bx, by, &p))
         return;
     while (path_next(&p, &ix, &iy))
-        fn(o, clampi(iy, h->by - 1) * h->bx + clampi(ix, h->bx - 1));
+        fn(o, user, clampi(iy, h->by - 1) * h->bx + clampi(ix, h->bx - 1));
 }
 
 void polyc__segment_region(polyc__opt *o, float ax, float ay, float bx, float by)
@@ -193,25 +193,23 @@ void polyc__segment_region(polyc__opt *o, float ax, float ay, float bx, float by
     const polyc__hash *h = &o->h;
     const uint32_t epoch = o->epoch;
     path_walk p;
-    int32_t ix, iy;
+    int32_t ix, iy, around[9];
     if (!path_begin(h, ax, ay, bx, by, &p))
         return;
-    while (path_next(&p, &ix, &iy))
-        for (int32_t y = iy - 1; y <= iy + 1; y++) {
-            if (y < 0 || y >= h->by)
+    while (path_next(&p, &ix, &iy)) {
+        int n = polyc__buckets_around(h, ix, iy, around);
+        for (int i = 0; i < n; i++) {
+            int32_t k = around[i];
+            if (o->bucket_mark[k] == epoch)
                 continue;
-            for (int32_t x = ix - 1; x <= ix + 1; x++) {
-                int32_t k = y * h->bx + x;
-                if (x < 0 || x >= h->bx || o->bucket_mark[k] == epoch)
-                    continue;
-                o->bucket_mark[k] = epoch;
-                o->bucket_list[o->bucket_n++] = k;
-            }
+            o->bucket_mark[k] = epoch;
+            o->bucket_list[o->bucket_n++] = k;
         }
+    }
 }
 
-/* The bucket callbacks get the segment id through o->cur_seg. */
-static void insert_in_bucket(polyc__opt *o, int32_t bucket)
+/* The bucket callbacks get the segment id as their user pointer. */
+static void insert_in_bucket(polyc__opt *o, void *user, int32_t bucket)
 {
     polyc__hash *h = &o->h;
     int32_t e = h->entry_free;
@@ -223,19 +221,20 @@ static void insert_in_bucket(polyc__opt *o, int32_t bucket)
         h->out_of_entries = 1;
         return;
     }
-    h->entries[e].seg = o->cur_seg;
+    h->entries[e].seg = *(const int32_t *)user;
     h->entries[e].next = h->seg_head[bucket];
     h->seg_head[bucket] = e;
     h->entry_live++;
 }
 
-static void remove_from_bucket(polyc__opt *o, int32_t bucket)
+static void remove_from_bucket(polyc__opt *o, void *user, int32_t bucket)
 {
     polyc__hash *h = &o->h;
+    const int32_t seg = *(const int32_t *)user;
     int32_t *link = &h->seg_head[bucket];
     while (*link != POLYC__NONE) {
         int32_t e = *link;
-        if (h->entries[e].seg == o->cur_seg) {
+        if (h->entries[e].seg == seg) {
             *link = h->entries[e].next;
             h->entries[e].next = h->entry_free;
             h->entry_free = e;
@@ -250,8 +249,7 @@ int polyc__hash_insert(polyc__opt *o, int32_t seg)
 {
     const polyc__vertex *a = &o->s->v[seg];
     const polyc__vertex *b = &o->s->v[a->next];
-    o->cur_seg = seg;
-    polyc__segment_buckets(o, a->x, a->y, b->x, b->y, insert_in_bucket);
+    polyc__segment_buckets(o, a->x, a->y, b->x, b->y, insert_in_bucket, &seg);
     o->seg_in[seg] = 1;
     o->split_due[seg] = 1; /* every new or moved segment comes in here */
     return !o->h.out_of_entries;
@@ -261,7 +259,6 @@ void polyc__hash_remove(polyc__opt *o, int32_t seg)
 {
     const polyc__vertex *a = &o->s->v[seg];
     const polyc__vertex *b = &o->s->v[a->next];
-    o->cur_seg = seg;
-    polyc__segment_buckets(o, a->x, a->y, b->x, b->y, remove_from_bucket);
+    polyc__segment_buckets(o, a->x, a->y, b->x, b->y, remove_from_bucket, &seg);
     o->seg_in[seg] = 0;
 }

@@ -249,23 +249,20 @@ static int32_t nearest_other(const polyc__opt *o, float x, float y, int32_t a, i
 {
     const polyc__hash *h = &o->h;
     const polyc__store *s = o->s;
-    int32_t bx, by, best = POLYC__NONE;
+    int32_t bx, by, best = POLYC__NONE, around[9];
     *d2 = 1e30f;
     polyc__bucket_xy(h, x, y, &bx, &by);
-    for (int32_t yy = by - 1; yy <= by + 1; yy++)
-        for (int32_t xx = bx - 1; xx <= bx + 1; xx++) {
-            if (xx < 0 || yy < 0 || xx >= h->bx || yy >= h->by)
+    int n = polyc__buckets_around(h, bx, by, around);
+    for (int i = 0; i < n; i++)
+        for (int32_t e = h->seg_head[around[i]]; e != POLYC__NONE; e = h->entries[e].next) {
+            int32_t sg = h->entries[e].seg;
+            if (touches(s, sg, a, b))
                 continue;
-            for (int32_t e = h->seg_head[yy * h->bx + xx]; e != POLYC__NONE; e = h->entries[e].next) {
-                int32_t sg = h->entries[e].seg;
-                if (touches(s, sg, a, b))
-                    continue;
-                const polyc__vertex *c = &s->v[sg], *d = &s->v[c->next];
-                float dd = polyc__seg_dist2(x, y, c->x, c->y, d->x, d->y);
-                if (dd < *d2) {
-                    *d2 = dd;
-                    best = sg;
-                }
+            const polyc__vertex *c = &s->v[sg], *d = &s->v[c->next];
+            float dd = polyc__seg_dist2(x, y, c->x, c->y, d->x, d->y);
+            if (dd < *d2) {
+                *d2 = dd;
+                best = sg;
             }
         }
     return best;

@@ -372,9 +372,10 @@ static void check_store(const polyc__opt *o, const char *where)
 #define MAX_WALK 4096
 static int32_t g_walk[MAX_WALK];
 static int g_walk_n;
-static void collect_bucket(polyc__opt *o, int32_t bucket)
+static void collect_bucket(polyc__opt *o, void *user, int32_t bucket)
 {
     (void)o;
+    (void)user;
     assert_true(g_walk_n < MAX_WALK);
     g_walk[g_walk_n++] = bucket;
 }
@@ -415,7 +416,7 @@ static void check_hash(polyc__opt *o, const char *where)
             fail_msg("%s: live segment %d not marked in the hash", where, v);
         const polyc__vertex *a = &o->s->v[v], *c = &o->s->v[a->next];
         g_walk_n = 0;
-        polyc__segment_buckets(o, a->x, a->y, c->x, c->y, collect_bucket);
+        polyc__segment_buckets(o, a->x, a->y, c->x, c->y, collect_bucket, NULL);
         expect += g_walk_n;
         for (int k = 0; k < g_walk_n; k++) {
             int visits = 0;
