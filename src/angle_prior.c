@@ -56,7 +56,7 @@
  * more cells than polyc__prior_bytes allows for (a long diagonal extent
  * under a tight limits.max_grid_cells), prior cells are made K x K tiles for
  * the smallest K that fits. */
-#include "internal.h"
+#include "context.h"
 
 #include <math.h>
 #include <string.h>

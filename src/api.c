@@ -1,7 +1,7 @@
 /* api.c - the public entry points: configuration, sizing, context, scans,
  * stage order and results. Takes: the caller's block and scans. Gives: the
  * pipeline run stage by stage, each stage restartable from its arena mark. */
-#include "internal.h"
+#include "context.h"
 
 #include <math.h>
 #include <string.h>
@@ -237,13 +237,6 @@ size_t polyc_memory_size(const polyc_config *config, const polyc_limits *limits)
     return n == SIZE_MAX ? 0 : n;
 }
 
-polyc_status polyc__fail(polyc_ctx *ctx, polyc_status st, const char *msg)
-{
-    if (ctx && !ctx->error)
-        ctx->error = msg;
-    return st;
-}
-
 /* While the progress callback runs, the context is lent to the optimiser:
  * its magic reads POLYC__MAGIC_BUSY and every entry point refuses it with
  * POLYC_ERR_BUSY (guarded_progress). */
@@ -461,9 +454,8 @@ static polyc_status stage_trace(polyc_ctx *ctx)
     if (st != POLYC_OK)
         return st;
     int32_t vcap = ctx->store.v_cap;
-    st = polyc__flat_init(ctx, &ctx->flat, (uint32_t)polyc__line_cap(vcap), (uint32_t)vcap);
-    if (st != POLYC_OK)
-        return st;
+    if (!polyc__flat_init(&ctx->arena, &ctx->flat, (uint32_t)polyc__line_cap(vcap), (uint32_t)vcap))
+        return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the result polylines");
     export_result(ctx);
     ctx->stats.initial_polylines = ctx->stats.polylines;
     ctx->stats.initial_vertices = ctx->stats.vertices;

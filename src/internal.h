@@ -228,62 +228,10 @@ polyc_status polyc__spacing_build(polyc_ctx *ctx, polyc__spacing *sp);
  * bound, since the nearest pose is taken (0 without poses) */
 float polyc__spacing_at(const polyc__spacing *sp, float x, float y);
 
-typedef enum polyc__stage {
-    POLYC__STAGE_SCANS = 0,
-    POLYC__STAGE_GRID,
-    POLYC__STAGE_CONTOUR,
-    POLYC__STAGE_TRACE,
-    POLYC__STAGE_OPTIMIZED
-} polyc__stage;
-
-struct polyc_ctx {
-    uint32_t magic;
-    polyc_config cfg;
-    polyc_limits lim;
-    polyc__arena arena;
-    size_t scans_mark;             /* arena use after the fixed scan storage */
-    polyc__stage stage;
-    const char *error;
-    int32_t error_scan;
-
-    double frame_x, frame_y;       /* first pose: stored floats are relative to it */
-    int have_frame;
-    /* an occupancy grid (occupancy.c) instead of scans: stored floats are in
-     * its frame, whose corner is frame_x, frame_y and whose x axis points
-     * along (frame_cos, frame_sin); its grid and contour are input, kept
-     * below scans_mark */
-    int from_grid;
-    double frame_cos, frame_sin;
-    size_t base_mark;              /* arena use after polyc_init's scan storage */
-    polyc_config grid_cfg;         /* the optimiser's weights for it (optimize.c);
-                                      here, not on the optimiser's stack */
-    polyc__scan *scans;
-    float *ranges;
-    uint32_t scan_count, range_count;
-    double ext_min_x, ext_min_y, ext_max_x, ext_max_y; /* frame-relative extent */
-    int have_extent;
-
-    polyc__grid grid;
-    int32_t *contour_xy;           /* 2 per contour cell */
-    uint32_t contour_count;
-    size_t grid_mark;              /* arena use after the grid */
-    size_t contour_mark;           /* arena use after the contour */
-
-    polyc__store store;
-    polyc__flat flat;
-    int opt_result_valid;          /* the store holds a map to publish */
-    size_t trace_mark;             /* arena use after the initial polylines */
-
-
-    polyc_stats stats;
-};
-
-#define POLYC__MAGIC 0x706f6c79u   /* "poly" */
-
-/* errors: keep the first message of an operation */
-polyc_status polyc__fail(polyc_ctx *ctx, polyc_status st, const char *msg);
 
 /* grid.c */
+/* entries the grid's tile directory may have under the limits */
+size_t polyc__grid_dir_cap(const polyc_limits *lim);
 size_t polyc__grid_budget_bytes(const polyc_limits *lim);
 /* the budget, on a counting arena */
 void polyc__grid_reserve(polyc__arena *a, const polyc_limits *lim);
@@ -357,8 +305,6 @@ int polyc__occ_free_at(const polyc_ctx *ctx, float x, float y);
 #define POLYC__FACE_CELLS 4
 
 /* contour.c */
-/* entries the grid's tile directory may have under the limits */
-size_t polyc__grid_dir_cap(const polyc_limits *lim);
 /* the contour list (limits.max_beams + 1 cells) */
 int32_t *polyc__contour_list(polyc__arena *a, const polyc_limits *lim);
 /* the stage's allocations under the limits, on a counting arena; and their peak */
@@ -367,11 +313,14 @@ size_t polyc__contour_bytes(const polyc_limits *lim);
 polyc_status polyc__contour_build(polyc_ctx *ctx);
 
 /* polyline.c */
+/* the store's vertex capacity: limits.max_vertices, or max_beams + 1024 */
+int32_t polyc__max_vertices(const polyc_limits *lim);
 /* lines a store (and its flat form) of v_cap vertices holds */
 int32_t polyc__line_cap(int32_t v_cap);
 /* the store's allocations under the limits, on a counting arena */
 void polyc__store_reserve(polyc__arena *a, const polyc_limits *lim);
-polyc_status polyc__store_init(polyc_ctx *ctx, polyc__store *s, int32_t v_cap);
+/* 0: no room */
+int polyc__store_init(polyc__arena *a, polyc__store *s, int32_t v_cap);
 void polyc__store_clear(polyc__store *s);
 int32_t polyc__line_new(polyc__store *s);
 void polyc__line_free(polyc__store *s, int32_t line);
@@ -384,7 +333,8 @@ int32_t polyc__line_cut(polyc__store *s, int32_t u, int *ok);
 void polyc__line_join(polyc__store *s, int32_t tail, int32_t head);
 /* a flat form of v_cap vertices' allocations, on a counting arena */
 void polyc__flat_reserve(polyc__arena *a, int32_t v_cap);
-polyc_status polyc__flat_init(polyc_ctx *ctx, polyc__flat *f, uint32_t cap_lines, uint32_t cap_points);
+/* 0: no room */
+int polyc__flat_init(polyc__arena *a, polyc__flat *f, uint32_t cap_lines, uint32_t cap_points);
 void polyc__flat_from_store(polyc__flat *f, const polyc__store *s);
 polyc_status polyc__store_from_flat(polyc__store *s, const polyc__flat *f);
 
@@ -400,7 +350,5 @@ polyc_status polyc__chains_build(polyc_ctx *ctx);
 void polyc__optimizer_reserve(polyc__arena *a, const polyc_config *cfg, const polyc_limits *lim);
 polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *user);
 polyc_status polyc__score(polyc_ctx *ctx, double *bic, double *err);
-
-int32_t polyc__max_vertices(const polyc_limits *lim);
 
 #endif

@@ -6,7 +6,7 @@
  * and the contour is every occupied cell that faces free space (faces_free;
  * docs/algorithm.md, "From an occupancy grid"). The caller's cells
  * are read during the call only. */
-#include "internal.h"
+#include "context.h"
 
 #include <math.h>
 #include <string.h>

@@ -169,8 +169,8 @@ polyc_status polyc__opt_setup(polyc_ctx *ctx, polyc__opt *o)
     memset(o->v_dirty, 0, (size_t)V * sizeof(uint32_t));
     memset(o->seg_in, 0, (size_t)V);
     memset(o->split_due, 0, (size_t)V);
-    if ((st = polyc__flat_init(ctx, &o->best, (uint32_t)polyc__line_cap(V), (uint32_t)V)) != POLYC_OK)
-        return st;
+    if (!polyc__flat_init(&ctx->arena, &o->best, (uint32_t)polyc__line_cap(V), (uint32_t)V))
+        return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the result polylines");
     return polyc__rebuild(o);
 }
 

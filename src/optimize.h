@@ -3,7 +3,7 @@
 #ifndef POLYC_OPTIMIZE_H
 #define POLYC_OPTIMIZE_H
 
-#include "internal.h"
+#include "context.h"
 
 typedef struct polyc__heap_entry {
     double delta;                  /* change of the BIC if the vertex goes */

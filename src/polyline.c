@@ -35,13 +35,13 @@ void polyc__store_reserve(polyc__arena *a, const polyc_limits *lim)
     store_carve(a, &s, polyc__max_vertices(lim));
 }
 
-polyc_status polyc__store_init(polyc_ctx *ctx, polyc__store *s, int32_t v_cap)
+int polyc__store_init(polyc__arena *a, polyc__store *s, int32_t v_cap)
 {
-    if (!store_carve(&ctx->arena, s, v_cap))
-        return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the polylines");
+    if (!store_carve(a, s, v_cap))
+        return 0;
     s->v_free = POLYC__NONE;
     s->l_free = POLYC__NONE;
-    return POLYC_OK;
+    return 1;
 }
 
 void polyc__store_clear(polyc__store *s)
@@ -221,14 +221,14 @@ void polyc__flat_reserve(polyc__arena *a, int32_t v_cap)
     flat_carve(a, &f, (uint32_t)polyc__line_cap(v_cap), (uint32_t)v_cap);
 }
 
-polyc_status polyc__flat_init(polyc_ctx *ctx, polyc__flat *f, uint32_t cap_lines, uint32_t cap_points)
+int polyc__flat_init(polyc__arena *a, polyc__flat *f, uint32_t cap_lines, uint32_t cap_points)
 {
-    if (!flat_carve(&ctx->arena, f, cap_lines, cap_points))
-        return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the result polylines");
+    if (!flat_carve(a, f, cap_lines, cap_points))
+        return 0;
     f->cap_lines = cap_lines;
     f->cap_points = cap_points;
     f->start[0] = 0;
-    return POLYC_OK;
+    return 1;
 }
 
 void polyc__flat_from_store(polyc__flat *f, const polyc__store *s)

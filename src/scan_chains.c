@@ -13,7 +13,7 @@
  * front of the link between two endpoints (posts of a railing, a chair in
  * front of a wall) do not break it: several chains can be open at once, and
  * an endpoint joins the most recent one it links to. */
-#include "internal.h"
+#include "context.h"
 
 #include <math.h>
 
@@ -527,9 +527,11 @@ static int links(const chains *c, const open_chain *h, int32_t i, int32_t n)
 
 polyc_status polyc__chains_build(polyc_ctx *ctx)
 {
-    polyc_status st = polyc__store_init(ctx, &ctx->store, polyc__max_vertices(&ctx->lim));
-    if (st != POLYC_OK || ctx->scan_count == 0)
-        return st;
+    if (!polyc__store_init(&ctx->arena, &ctx->store, polyc__max_vertices(&ctx->lim)))
+        return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the polylines");
+    if (ctx->scan_count == 0)
+        return POLYC_OK;
+    polyc_status st;
     size_t after_store = ctx->arena.used; /* scratch released at the end */
     const polyc__scan *s = &ctx->scans[0];
     int32_t n = (int32_t)s->count;

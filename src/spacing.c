@@ -7,7 +7,7 @@
  * distance is measured to each pose when asked. The table's two passes
  * over every tile of the extent would take 5-6 % of a freiburg-campus
  * scan's time (13,000 tiles for its 80 m returns), for a handful of queries. */
-#include "internal.h"
+#include "context.h"
 
 #include <math.h>
 

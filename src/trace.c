@@ -2,7 +2,7 @@
  * Takes: contour cells (8-connected), thinned to one cell. Gives: polylines
  * in the store, started at contour endpoints, then the remaining cycles; points whose removal
  * leaves the polyline's length unchanged (collinear, in cell units) dropped. */
-#include "internal.h"
+#include "context.h"
 
 #include <math.h>
 #include <string.h>
@@ -312,9 +312,9 @@ void polyc__trace_reserve(polyc__arena *a, const polyc_limits *lim)
 polyc_status polyc__trace_build(polyc_ctx *ctx)
 {
     const polyc__grid *g = &ctx->grid;
-    polyc_status st = polyc__store_init(ctx, &ctx->store, polyc__max_vertices(&ctx->lim));
-    if (st != POLYC_OK)
-        return st;
+    if (!polyc__store_init(&ctx->arena, &ctx->store, polyc__max_vertices(&ctx->lim)))
+        return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the polylines");
+    polyc_status st;
     size_t after_store = ctx->arena.used; /* the walk scratch is released at the end */
     walk w;
     w.cap = ctx->contour_count + 1;

@@ -1,0 +1,71 @@
+/* context.h - the context: the state that lives from polyc_init to the
+ * block's release (configuration, limits, arena, scans, grid, contour,
+ * polylines, result, statistics, first error). api.c runs the stages on it;
+ * a stage reads the parts it needs and leaves its working state in its own
+ * structs (the optimiser's in polyc__opt, optimize.h). */
+#ifndef POLYC_CONTEXT_H
+#define POLYC_CONTEXT_H
+
+#include "internal.h"
+
+typedef enum polyc__stage {
+    POLYC__STAGE_SCANS = 0,
+    POLYC__STAGE_GRID,
+    POLYC__STAGE_CONTOUR,
+    POLYC__STAGE_TRACE,
+    POLYC__STAGE_OPTIMIZED
+} polyc__stage;
+
+struct polyc_ctx {
+    uint32_t magic;
+    polyc_config cfg;
+    polyc_limits lim;
+    polyc__arena arena;
+    size_t scans_mark;             /* arena use after the fixed scan storage */
+    polyc__stage stage;
+    const char *error;
+    int32_t error_scan;
+
+    double frame_x, frame_y;       /* first pose: stored floats are relative to it */
+    int have_frame;
+    /* an occupancy grid (occupancy.c) instead of scans: stored floats are in
+     * its frame, whose corner is frame_x, frame_y and whose x axis points
+     * along (frame_cos, frame_sin); its grid and contour are input, kept
+     * below scans_mark */
+    int from_grid;
+    double frame_cos, frame_sin;
+    size_t base_mark;              /* arena use after polyc_init's scan storage */
+    polyc_config grid_cfg;         /* the optimiser's weights for it (optimize.c);
+                                      here, not on the optimiser's stack */
+    polyc__scan *scans;
+    float *ranges;
+    uint32_t scan_count, range_count;
+    double ext_min_x, ext_min_y, ext_max_x, ext_max_y; /* frame-relative extent */
+    int have_extent;
+
+    polyc__grid grid;
+    int32_t *contour_xy;           /* 2 per contour cell */
+    uint32_t contour_count;
+    size_t grid_mark;              /* arena use after the grid */
+    size_t contour_mark;           /* arena use after the contour */
+
+    polyc__store store;
+    polyc__flat flat;
+    int opt_result_valid;          /* the store holds a map to publish */
+    size_t trace_mark;             /* arena use after the initial polylines */
+
+
+    polyc_stats stats;
+};
+
+#define POLYC__MAGIC 0x706f6c79u   /* "poly" */
+
+/* errors: keep the first message of an operation */
+static inline polyc_status polyc__fail(polyc_ctx *ctx, polyc_status st, const char *msg)
+{
+    if (ctx && !ctx->error)
+        ctx->error = msg;
+    return st;
+}
+
+#endif
