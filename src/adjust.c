@@ -156,7 +156,7 @@ int polyc__hill_climb(polyc__opt *o, int32_t v)
     if (V[v].line == POLYC__NONE || (V[v].prev == POLYC__NONE && V[v].next == POLYC__NONE))
         return 0;
     float step = o->cfg->step_m, gamma = o->cfg->gamma;
-    float reach = 0.05f - step; /* the hash buckets cover this much movement */
+    float reach = POLYC__CLIMB_REACH_M - step; /* the hash buckets cover this much movement */
     float x0 = V[v].x, y0 = V[v].y, x = x0, y = y0;
     int32_t old[2] = {V[v].prev, V[v].next != POLYC__NONE ? v : POLYC__NONE};
     float xy[8];
@@ -168,7 +168,7 @@ int polyc__hill_climb(polyc__opt *o, int32_t v)
     double cur = polyc__local_current(o) + (double)gamma * local_angles(o, &pl, v, x, y);
     int moved = 0, last = -1;
     int optimum = 0, cut = 0; /* no better trial in the last round; some trial was beyond reach */
-    for (int it = 0; it < 64; it++) {
+    for (int it = 0; it < POLYC__CLIMB_STEPS; it++) {
         cut = 0;
         double best = cur;
         int best_d = -1;

@@ -96,7 +96,8 @@ polyc_status polyc_config_check(const polyc_config *c, const char **why)
     else if (!in(c->gamma, 0.0f, 1e6f)) w = "gamma must be in [0, 1e6]";
     else if (!in(c->merge_dist_m, 0.0f, 100.0f)) w = "merge_dist_m must be in [0, 100]";
     else if (!in(c->split_gap_m, 1e-4f, 100.0f)) w = "split_gap_m must be in (0, 100]";
-    else if (!in(c->step_m, 1e-5f, 10.0f)) w = "step_m must be in (0, 10]";
+    else if (!in(c->step_m, 1e-5f, POLYC__STEP_MAX_M))
+        w = "step_m must be in (0, 0.025]: a longer step leaves the hill climb's reach";
     else if (!in(c->noise_m, 0.0f, 10.0f)) w = "noise_m must be in [0, 10]";
     else if (!in(c->noise_decay, 1e-6f, 1.0f)) w = "noise_decay must be in (0, 1]";
     else if (!in(c->overlap_m, 0.0f, 10.0f)) w = "overlap_m must be in [0, 10]";
@@ -187,16 +188,16 @@ polyc_status polyc_limits_for_scans(const polyc_config *config, const polyc_scan
         out->max_grid_cells = (uint32_t)cells;
     }
     /* Contours and weighted points follow the map (its walls), not the
-     * log's length: sized for a quarter of the beams or a wall every 64
-     * cells of the bounding box, whichever is less, with room to spare. */
-    uint64_t typical = beams / 4;
-    if ((uint64_t)out->max_grid_cells / 64 < typical)
-        typical = (uint64_t)out->max_grid_cells / 64;
-    typical += 4096;
+     * log's length (tunables.h) */
+    uint64_t typical = beams / POLYC__LIMITS_BEAM_SHARE;
+    if ((uint64_t)out->max_grid_cells / POLYC__LIMITS_CELLS_PER_WALL < typical)
+        typical = (uint64_t)out->max_grid_cells / POLYC__LIMITS_CELLS_PER_WALL;
+    typical += POLYC__LIMITS_SPARE;
+    uint64_t points = typical * POLYC__LIMITS_POINTS_NUM / POLYC__LIMITS_POINTS_DEN;
     if (typical < beams) {
-        out->max_vertices = (uint32_t)typical + 1024u;
-        if (!(config->flags & POLYC_FLAG_EXACT_POINTS) && typical * 5 / 4 < beams)
-            out->max_points = (uint32_t)(typical * 5 / 4);
+        out->max_vertices = (uint32_t)typical + POLYC__VERTEX_SPARE;
+        if (!(config->flags & POLYC_FLAG_EXACT_POINTS) && points < beams)
+            out->max_points = (uint32_t)points;
     }
     return POLYC_OK;
 }

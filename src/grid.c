@@ -119,7 +119,7 @@ static float incidence_sin(const polyc_ctx *ctx, const polyc__scan *s, uint32_t 
         return 1.0f;
     /* middle point (r, 0) must lie within 3 cm + 2% of the chord */
     float off = fabsf(tx * (0.0f - ay) - ty * (r - ax)) / len;
-    if (off > 0.03f + 0.02f * r)
+    if (off > POLYC__SURFACE_OFF_M + POLYC__SURFACE_OFF_REL * r)
         return 1.0f;
     return fabsf(ty) / len;
 }
@@ -165,7 +165,7 @@ static int beam_fill(const polyc_ctx *ctx, const polyc__scan *s, uint32_t i, pol
         /* The last cell / sin(incidence) of a beam runs within a cell of the
          * surface it hits: a grazing beam would count misses in the wall's
          * own cells there. Misses stop before that stretch. */
-        float sn = polyc__maxf(incidence_sin(ctx, s, i, r, rot), 0.05f);
+        float sn = polyc__maxf(incidence_sin(ctx, s, i, r, rot), POLYC__INCIDENCE_SIN_MIN);
         float skip = polyc__minf(ctx->cfg.grazing_cells / sn, 0.5f * len);
         b->miss_end = len > 0.0f ? 1.0f - skip / len : 0.0f;
     }

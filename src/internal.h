@@ -4,6 +4,7 @@
 #define POLYC_INTERNAL_H
 
 #include "polyc.h"
+#include "tunables.h"
 
 #ifndef POLYC_ASSERT
 #include <assert.h>

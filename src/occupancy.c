@@ -144,7 +144,7 @@ polyc_status polyc_limits_for_grid(const polyc_config *config, const polyc_occup
     if (tiles * 4 + 64 < dir_n)
         tiles = (dir_n - 64 + 3) / 4;
     out->max_grid_cells = (uint32_t)(tiles * POLYC__TILE_CELLS);
-    out->max_vertices = (uint32_t)occupied + 1024u;
+    out->max_vertices = (uint32_t)occupied + POLYC__VERTEX_SPARE;
     out->max_points = (uint32_t)occupied;
     return POLYC_OK;
 }

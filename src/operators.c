@@ -457,7 +457,7 @@ static float free_length(const polyc__opt *o, const polyc__vertex *a, const poly
 static float gap_needed(const polyc__opt *o, float x, float y)
 {
     float gap_min = o->cfg->split_gap_m;
-    float sparse = polyc__minf(2.5f * polyc__spacing_at(&o->spacing, x, y),
+    float sparse = polyc__minf(POLYC__GAP_SPACINGS * polyc__spacing_at(&o->spacing, x, y),
                                gap_min + 0.5f * o->support_m);
     return polyc__maxf(gap_min, sparse) + 0.5f * o->point_span_m;
 }

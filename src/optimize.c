@@ -8,10 +8,6 @@
 #include <math.h>
 #include <string.h>
 
-#define ADJUST_ROUNDS 4
-#define ADD_ROUNDS 4
-#define ADDED_CAP 64
-#define RECOVER_GAIN 5e-3 /* an iteration this much below the last does not use up patience */
 
 
 /* No copy for a context of one scan: its trials list fewer than 8 points
@@ -53,7 +49,7 @@ static int opt_carve(polyc__arena *a, polyc__opt *o, int32_t P, int32_t V, int v
     CARVE(o->gap_tail, V);
     CARVE(o->split_off, V + 1);
     /* cuts per pass (more wait for the next pass) */
-    o->cut_cap = V / 4 + 64;
+    o->cut_cap = V / POLYC__CUT_SHARE + POLYC__CUT_SPARE;
     CARVE(o->cut_seg, o->cut_cap);
     CARVE(o->cut_next, o->cut_cap);
     CARVE(o->cut_t0, o->cut_cap);
@@ -73,10 +69,10 @@ static int opt_carve(polyc__arena *a, polyc__opt *o, int32_t P, int32_t V, int v
     CARVE(o->split_due, V);
     CARVE(o->v_work, V);
     CARVE(o->v_touch, V);
-    o->heap_cap = V + 1024; /* a candidate that finds it full is not retried */
+    o->heap_cap = V + POLYC__HEAP_SPARE;
     CARVE(o->heap, o->heap_cap);
-    o->added_cap = ADDED_CAP;
-    CARVE(o->added, ADDED_CAP);
+    o->added_cap = POLYC__ADDED_CAP;
+    CARVE(o->added, POLYC__ADDED_CAP);
     o->dirty_cap = V;
     return ok;
 }
@@ -226,13 +222,13 @@ static polyc_status polish(polyc__opt *o, double best)
             return st;
         o->untangle_mark = o->zip_mark = 0;
     }
-    for (int k = 0; k < 8 && polyc__op_split(o) > 0; k++)
+    for (int k = 0; k < POLYC__POLISH_SPLITS && polyc__op_split(o) > 0; k++)
         ;
     polyc__op_trim_ends(o);
     uint32_t mark = ++o->touch_stamp;
     if (polyc__op_zip(o) > 0) {
         /* what is left of a zipped pair moves onto the data of both */
-        polyc__op_adjust(o, ADJUST_ROUNDS, mark);
+        polyc__op_adjust(o, POLYC__ADJUST_ROUNDS, mark);
         polyc__op_trim_ends(o);
         polyc__op_zip(o);
     }
@@ -286,23 +282,23 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
          * optimum stay there (on 200 freiburg-campus scans, with ends not
          * climbed, climbing them again takes a sixth of the time and
          * lowers the BIC by 0.15 %) */
-        polyc__op_adjust(&o, ADJUST_ROUNDS, o.rays.on && it > 0 ? prev_mark : since);
+        polyc__op_adjust(&o, POLYC__ADJUST_ROUNDS, o.rays.on && it > 0 ? prev_mark : since);
         uint32_t mark = ++o.touch_stamp;
         prev_mark = mark;
         polyc__op_zigzag(&o);            /* E */
         polyc__op_corners(&o, since);    /* corners (not in the paper) */
         polyc__op_remove_vertices(&o, mark); /* G */
         if (!o.rays.on) /* a single scan's chains start with more than enough */
-            polyc__op_add_vertices(&o, ADD_ROUNDS); /* G, more vertices */
-        polyc__op_adjust(&o, ADJUST_ROUNDS, mark);
+            polyc__op_add_vertices(&o, POLYC__ADD_ROUNDS); /* G, more vertices */
+        polyc__op_adjust(&o, POLYC__ADJUST_ROUNDS, mark);
         /* moves and additions can leave segments without data or hairpins:
          * clean them before the model is judged, so the best one is clean */
-        for (int round = 0; round < 3; round++) {
+        for (int round = 0; round < POLYC__CLEAN_ROUNDS; round++) {
             mark = ++o.touch_stamp;
             if ((o.rays.on ? 0 : polyc__op_split(&o)) + polyc__op_zigzag(&o) +
                     polyc__op_corners(&o, since) == 0)
                 break;
-            polyc__op_adjust(&o, ADJUST_ROUNDS, mark);
+            polyc__op_adjust(&o, POLYC__ADJUST_ROUNDS, mark);
         }
         polyc__op_trim_ends(&o); /* moves could push ends past the data */
         if (!o.rays.on)
@@ -320,11 +316,8 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
          * the noise is allowed to decay) */
         int gained = bic < best - (ctx->from_grid ? fmax(1.0, GRID_GAIN * fabs(best)) : 1.0);
         /* Nor do iterations that are still coming down from the noise by
-         * more than RECOVER_GAIN of the BIC each: where the points of a band
-         * weigh less (accuracy.c) the climb back is slower, and belgioioso's
-         * search stopped at iteration 0's map (958 vertices) while each
-         * iteration still gained 1-2 % (757 vertices when it may go on) */
-        int recovering = !ctx->from_grid && it > 0 && bic < prev_bic - RECOVER_GAIN * fabs(prev_bic);
+         * more than POLYC__RECOVER_GAIN of the BIC each (tunables.h) */
+        int recovering = !ctx->from_grid && it > 0 && bic < prev_bic - POLYC__RECOVER_GAIN * fabs(prev_bic);
         prev_bic = bic;
         quiet = gained ? 0 : ((noise > 0.0 && !ctx->from_grid) || recovering ? quiet : quiet + 1);
         if (bic < best - 1e-9 * fabs(best)) {

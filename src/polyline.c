@@ -8,7 +8,7 @@
 
 int32_t polyc__max_vertices(const polyc_limits *lim)
 {
-    uint64_t v = lim->max_vertices ? lim->max_vertices : (uint64_t)lim->max_beams + 1024u;
+    uint64_t v = lim->max_vertices ? lim->max_vertices : (uint64_t)lim->max_beams + POLYC__VERTEX_SPARE;
     if (v > 0x3fffffffu)
         v = 0x3fffffffu;
     return (int32_t)v;

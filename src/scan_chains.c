@@ -331,7 +331,7 @@ static void project(const fitted *f, const float *p, float *x, float *y)
 static int meet(const fitted *f, const fitted *g, float *x, float *y)
 {
     float den = f->dx * g->dy - f->dy * g->dx;
-    if (fabsf(den) < 0.17f)
+    if (fabsf(den) < POLYC__CORNER_SIN)
         return 0;
     float t = ((g->cx - f->cx) * g->dy - (g->cy - f->cy) * g->dx) / den;
     *x = f->cx + t * f->dx;

@@ -62,7 +62,7 @@ polyc_status polyc__hash_init(polyc__opt *o)
     float w_m = (float)g->width * g->cell_m + 2.0f * HASH_MARGIN_M;
     float h_m = (float)g->height * g->cell_m + 2.0f * HASH_MARGIN_M;
     /* at least the search radius plus the reach of one hill-climbing round */
-    float b = o->R + 0.05f;
+    float b = o->R + POLYC__CLIMB_REACH_M;
     while ((double)ceilf(w_m / b) * (double)ceilf(h_m / b) > (double)cap)
         b *= 1.25f;
     h->bucket_m = b;

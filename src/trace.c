@@ -63,7 +63,7 @@ static int32_t link_radius(const tracer *tr, int32_t ix, int32_t iy)
     const polyc__grid *g = tr->g;
     float x = (float)(tr->ox + ((double)ix + 0.5) * (double)g->cell_m);
     float y = (float)(tr->oy + ((double)iy + 0.5) * (double)g->cell_m);
-    float cells = 2.5f * polyc__spacing_at(&tr->spacing, x, y) * g->inv_cell;
+    float cells = POLYC__GAP_SPACINGS * polyc__spacing_at(&tr->spacing, x, y) * g->inv_cell;
     int32_t r = cells > (float)tr->link_max ? tr->link_max : (int32_t)cells;
     return r > tr->link ? r : tr->link;
 }
