@@ -113,31 +113,31 @@ static void commit_move(polyc__opt *o, int32_t v, float x, float y)
     int ns = segs_at(o, v, x, y, xy);
     id[0] = p != POLYC__NONE ? p : v;
     id[1] = v;
-    for (int32_t k = 0; k < o->loc_n; k++) {
-        int32_t i = o->loc_pt[k];
-        double c = o->loc_base[k];
-        int32_t sg = o->loc_seg[k];
+    for (int32_t k = 0; k < o->ev.loc_n; k++) {
+        int32_t i = o->ev.loc_pt[k];
+        double c = o->ev.loc_base[k];
+        int32_t sg = o->ev.loc_seg[k];
         for (int j = 0; j < ns; j++) {
-            double cj = polyc__cost(&o->pts[i], xy[4 * j], xy[4 * j + 1], xy[4 * j + 2], xy[4 * j + 3]);
+            double cj = polyc__cost(&o->d.pts[i], xy[4 * j], xy[4 * j + 1], xy[4 * j + 2], xy[4 * j + 3]);
             if (cj < c) {
                 c = cj;
                 sg = id[j];
             }
         }
-        o->err += c - o->pt_cost[i];
-        o->pt_cost[i] = c;
-        polyc__split_due_pt(o, o->pt_seg[i], sg);
-        o->pt_seg[i] = sg;
+        o->err += c - o->d.pt_cost[i];
+        o->d.pt_cost[i] = c;
+        polyc__split_due_pt(o, o->d.pt_seg[i], sg);
+        o->d.pt_seg[i] = sg;
     }
     /* the aggregated points: on their segment, whatever the move */
     for (int j = 0; j < ns; j++)
-        for (int32_t k = 0; k < o->agg_n[j]; k++) {
-            int32_t i = o->agg_pt[j == 0 ? k : o->agg_cap - 1 - k];
-            double c = polyc__cost(&o->pts[i], xy[4 * j], xy[4 * j + 1], xy[4 * j + 2], xy[4 * j + 3]);
-            o->err += c - o->pt_cost[i];
-            o->pt_cost[i] = c;
-            polyc__split_due_pt(o, o->pt_seg[i], id[j]);
-            o->pt_seg[i] = id[j];
+        for (int32_t k = 0; k < o->ev.agg_n[j]; k++) {
+            int32_t i = o->ev.agg_pt[j == 0 ? k : o->ev.agg_cap - 1 - k];
+            double c = polyc__cost(&o->d.pts[i], xy[4 * j], xy[4 * j + 1], xy[4 * j + 2], xy[4 * j + 3]);
+            o->err += c - o->d.pt_cost[i];
+            o->d.pt_cost[i] = c;
+            polyc__split_due_pt(o, o->d.pt_seg[i], id[j]);
+            o->d.pt_seg[i] = id[j];
         }
     for (int k = 0; k < 3; k++)
         if (nb[k] != POLYC__NONE) {

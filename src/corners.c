@@ -62,7 +62,7 @@ static int try_corner(polyc__opt *o, int32_t b, int32_t c, int k)
         if (nd != POLYC__NONE && nd != a)
             dangle += polyc__turn_cost(o, x, y, V[d].x, V[d].y, V[nd].x, V[nd].y);
     }
-    double dbic = (double)o->cfg->alpha * (derr + gamma * dangle) - (double)k * o->log_n;
+    double dbic = (double)o->cfg->alpha * (derr + gamma * dangle) - (double)k * o->d.log_n;
     if (dbic >= 0.0)
         return 0;
     float old_xy[4 * POLYC__EDIT_SEGS];

@@ -9,6 +9,23 @@
 #include <string.h>
 #include <stdlib.h>
 
+int polyc__split_carve(polyc__arena *a, polyc__split_scratch *sp, int32_t P, int32_t V)
+{
+    int ok = 1;
+    POLYC__CARVE(ok, a, sp->split_t, P > V ? P : V);
+    POLYC__CARVE(ok, a, sp->trim_head, V);
+    POLYC__CARVE_ZERO(ok, a, sp->gap_head, V);
+    POLYC__CARVE_ZERO(ok, a, sp->gap_tail, V);
+    POLYC__CARVE(ok, a, sp->split_off, V + 1);
+    /* cuts per pass (more wait for the next pass) */
+    sp->cut_cap = V / POLYC__CUT_SHARE + POLYC__CUT_SPARE;
+    POLYC__CARVE(ok, a, sp->cut_seg, sp->cut_cap);
+    POLYC__CARVE(ok, a, sp->cut_next, sp->cut_cap);
+    POLYC__CARVE(ok, a, sp->cut_t0, sp->cut_cap);
+    POLYC__CARVE(ok, a, sp->cut_t1, sp->cut_cap);
+    return ok;
+}
+
 /* ---- edits ---- */
 
 static int32_t prev_of(const polyc__opt *o, int32_t v)
@@ -102,7 +119,7 @@ int32_t polyc__op_insert_after(polyc__opt *o, int32_t u, float x, float y)
     }
     /* a fresh slot holds no angle; a slot freed and reused within this same
      * change was already taken out of the angle sum when it was freed */
-    if (o->v_dirty[v] != o->epoch)
+    if (o->chg.v_dirty[v] != o->chg.epoch)
         o->acost[v] = 0.0;
     o->seg_in[v] = 0;
     polyc__chg_dirty(o, v);
@@ -426,8 +443,8 @@ static int no_gap_over(const float *t, int32_t n, float len, float gap)
 static int supports(const polyc__opt *o, int32_t i, int32_t sg)
 {
     const polyc__vertex *a = &o->s->v[sg], *b = &o->s->v[a->next];
-    float lim = o->support_m;
-    return polyc__seg_dist2(o->pts[i].x, o->pts[i].y, a->x, a->y, b->x, b->y) <= lim * lim;
+    float lim = o->d.support_m;
+    return polyc__seg_dist2(o->d.pts[i].x, o->d.pts[i].y, a->x, a->y, b->x, b->y) <= lim * lim;
 }
 
 /* How much of the stretch [g0, g0 + len_gap] of segment a-b (of length
@@ -458,8 +475,8 @@ static float gap_needed(const polyc__opt *o, float x, float y)
 {
     float gap_min = o->cfg->split_gap_m;
     float sparse = polyc__minf(POLYC__GAP_SPACINGS * polyc__spacing_at(&o->spacing, x, y),
-                               gap_min + 0.5f * o->support_m);
-    return polyc__maxf(gap_min, sparse) + 0.5f * o->point_span_m;
+                               gap_min + 0.5f * o->d.support_m);
+    return polyc__maxf(gap_min, sparse) + 0.5f * o->d.point_span_m;
 }
 
 /* Takes vertex v out between the last data on its two segments: from
@@ -475,8 +492,8 @@ static int take_out_tip(polyc__opt *o, int32_t v, int cut)
     float nx = s->v[n].x, ny = s->v[n].y;
     float lp = sqrtf((vx - px) * (vx - px) + (vy - py) * (vy - py));
     float ln = sqrtf((nx - vx) * (nx - vx) + (ny - vy) * (ny - vy));
-    float ta = lp > 0.0f ? 1.0f - o->gap_tail[p] / lp : 0.0f; /* along p -> v */
-    float tb = ln > 0.0f ? o->gap_head[v] / ln : 1.0f;        /* along v -> n */
+    float ta = lp > 0.0f ? 1.0f - o->split.gap_tail[p] / lp : 0.0f; /* along p -> v */
+    float tb = ln > 0.0f ? o->split.gap_head[v] / ln : 1.0f;        /* along v -> n */
     polyc__chg_begin(o);
     int32_t a = p, b = n;
     int ok = 1;
@@ -509,27 +526,27 @@ int polyc__op_split(polyc__opt *o)
 {
     polyc__store *s = o->s;
     int32_t nv = s->v_high;
-    int32_t *off = o->split_off;
-    float *t = o->split_t;
+    int32_t *off = o->split.split_off;
+    float *t = o->split.split_t;
     const uint8_t *due = o->split_due;
     for (int32_t v = 0; v <= nv; v++)
         off[v] = 0;
-    for (int32_t i = 0; i < o->np; i++) {
-        int32_t sg = o->pt_seg[i];
+    for (int32_t i = 0; i < o->d.np; i++) {
+        int32_t sg = o->d.pt_seg[i];
         if (sg != POLYC__NONE && due[sg] && supports(o, i, sg))
             off[sg + 1]++;
     }
     for (int32_t v = 0; v < nv; v++)
         off[v + 1] += off[v];
     /* fill: positions along the segment, metres */
-    for (int32_t i = 0; i < o->np; i++) {
-        int32_t sg = o->pt_seg[i];
+    for (int32_t i = 0; i < o->d.np; i++) {
+        int32_t sg = o->d.pt_seg[i];
         if (sg == POLYC__NONE || !due[sg] || !supports(o, i, sg))
             continue;
         const polyc__vertex *a = &s->v[sg], *b = &s->v[a->next];
         float dx = b->x - a->x, dy = b->y - a->y;
         float len = sqrtf(dx * dx + dy * dy);
-        float u = len > 0.0f ? ((o->pts[i].x - a->x) * dx + (o->pts[i].y - a->y) * dy) / len : 0.0f;
+        float u = len > 0.0f ? ((o->d.pts[i].x - a->x) * dx + (o->d.pts[i].y - a->y) * dy) / len : 0.0f;
         t[off[sg]++] = u < 0.0f ? 0.0f : (u > len ? len : u);
     }
     for (int32_t v = nv; v > 0; v--)
@@ -555,8 +572,8 @@ int polyc__op_split(polyc__opt *o)
             t_min = polyc__minf(t_min, t[k]);
             t_max = polyc__maxf(t_max, t[k]);
         }
-        o->gap_head[v] = t_min;
-        o->gap_tail[v] = hi > lo ? len - t_max : len;
+        o->split.gap_head[v] = t_min;
+        o->split.gap_tail[v] = hi > lo ? len - t_max : len;
         if (len <= gap_min)
             continue;
         if (no_gap_over(t + lo, hi - lo, len, gap_min))
@@ -576,23 +593,23 @@ int polyc__op_split(polyc__opt *o)
         float need = gap_needed(o, gx, gy);
         if (best > need && o->ctx->from_grid)
             best = free_length(o, a, b, len, g0, best);
-        if (best > need && n_cut < o->cut_cap) {
-            o->cut_seg[n_cut] = v;
-            o->cut_next[n_cut] = a->next;
-            o->cut_t0[n_cut] = g0 / len;
-            o->cut_t1[n_cut] = (g0 + best) / len;
+        if (best > need && n_cut < o->split.cut_cap) {
+            o->split.cut_seg[n_cut] = v;
+            o->split.cut_next[n_cut] = a->next;
+            o->split.cut_t0[n_cut] = g0 / len;
+            o->split.cut_t1[n_cut] = (g0 + best) / len;
             n_cut++;
         } else if (best > need) {
             o->split_due[v] = 1; /* no room for its cut in this pass */
         }
     }
     for (int32_t k = 0; k < n_cut; k++) {
-        int32_t u = o->cut_seg[k];
-        if (s->v[u].line == POLYC__NONE || s->v[u].next != o->cut_next[k])
+        int32_t u = o->split.cut_seg[k];
+        if (s->v[u].line == POLYC__NONE || s->v[u].next != o->split.cut_next[k])
             continue; /* changed by an earlier cut */
         const polyc__vertex *a = &s->v[u], *b = &s->v[a->next];
         float ax = a->x, ay = a->y, dx = b->x - a->x, dy = b->y - a->y;
-        float t0 = o->cut_t0[k], t1 = o->cut_t1[k];
+        float t0 = o->split.cut_t0[k], t1 = o->split.cut_t1[k];
         polyc__chg_begin(o);
         int32_t c = u;
         if (t0 > 1e-3f)
@@ -621,7 +638,7 @@ int polyc__op_split(polyc__opt *o)
         /* only where the polyline turns by more than 120 degrees (a
          * spike): at a corner of a wall seen from one side the data stop
          * short of the corner on the unseen face, and the corner is real */
-        if (dot < -0.5f * lens && o->gap_tail[p] + o->gap_head[v] > gap_needed(o, c->x, c->y)) {
+        if (dot < -0.5f * lens && o->split.gap_tail[p] + o->split.gap_head[v] > gap_needed(o, c->x, c->y)) {
             n_cut += take_out_tip(o, v, 1);
             continue;
         }
@@ -629,7 +646,7 @@ int polyc__op_split(polyc__opt *o)
          * wall seen from both sides where one face's line overshoots to
          * meet the end's: pulled back to the data, as an open end is
          * (nothing in the BIC holds it there) */
-        if (dot < -0.5f * lens && o->gap_tail[p] >= TIP_GAP_M && o->gap_head[v] >= TIP_GAP_M)
+        if (dot < -0.5f * lens && o->split.gap_tail[p] >= TIP_GAP_M && o->split.gap_head[v] >= TIP_GAP_M)
             n_cut += take_out_tip(o, v, 0);
     }
     return n_cut;
@@ -663,9 +680,9 @@ int polyc__op_trim_ends(polyc__opt *o)
     int32_t nv = s->v_high;
     /* per end segment: farthest projection (metres from the inner vertex) */
     for (int32_t v = 0; v < nv; v++)
-        o->split_t[v] = o->trim_head[v] = -1.0f;
-    for (int32_t i = 0; i < o->np; i++) {
-        int32_t sg = o->pt_seg[i];
+        o->split.split_t[v] = o->split.trim_head[v] = -1.0f;
+    for (int32_t i = 0; i < o->d.np; i++) {
+        int32_t sg = o->d.pt_seg[i];
         if (sg == POLYC__NONE || (!o->rays.on && !supports(o, i, sg)))
             continue;
         const polyc__vertex *a = &s->v[sg], *b = &s->v[a->next];
@@ -675,14 +692,14 @@ int polyc__op_trim_ends(polyc__opt *o)
         float dx = b->x - a->x, dy = b->y - a->y, len = sqrtf(dx * dx + dy * dy);
         if (len <= 0.0f)
             continue;
-        float u = ((o->pts[i].x - a->x) * dx + (o->pts[i].y - a->y) * dy) / len;
+        float u = ((o->d.pts[i].x - a->x) * dx + (o->d.pts[i].y - a->y) * dy) / len;
         if (o->rays.on)
-            u = polyc__ray_position(&o->rays, a->x, a->y, b->x, b->y, o->pts[i].x, o->pts[i].y, u);
+            u = polyc__ray_position(&o->rays, a->x, a->y, b->x, b->y, o->d.pts[i].x, o->d.pts[i].y, u);
         /* store as fraction from the tail side and from the head side */
-        if (tail_end && u / len > o->split_t[sg])
-            o->split_t[sg] = u / len;
-        if (head_end && (1.0f - u / len) > o->trim_head[sg])
-            o->trim_head[sg] = 1.0f - u / len;
+        if (tail_end && u / len > o->split.split_t[sg])
+            o->split.split_t[sg] = u / len;
+        if (head_end && (1.0f - u / len) > o->split.trim_head[sg])
+            o->split.trim_head[sg] = 1.0f - u / len;
     }
     int changed = 0;
     for (int32_t v = 0; v < nv; v++) {
@@ -694,7 +711,7 @@ int polyc__op_trim_ends(polyc__opt *o)
         float len = sqrtf((bx - ax) * (bx - ax) + (by - ay) * (by - ay));
         /* a margin of half a beam spacing keeps the last point's own beam on the map */
         float margin = polyc__maxf(0.01f, 0.5f * polyc__spacing_at(&o->spacing, bx, by)) / len;
-        float keep_tail = o->split_t[v] + margin, keep_head = o->trim_head[v] + margin;
+        float keep_tail = o->split.split_t[v] + margin, keep_head = o->split.trim_head[v] + margin;
         /* a single scan's ends also grow to its end beams */
         float most = o->rays.on ? 1.0f + 4.0f * margin : 1.0f;
         keep_tail = polyc__minf(keep_tail, most);
@@ -707,12 +724,12 @@ int polyc__op_trim_ends(polyc__opt *o)
             keep_head = 1.0f;
         float tx = ax + keep_tail * (bx - ax), ty = ay + keep_tail * (by - ay);
         float hx = bx + keep_head * (ax - bx), hy = by + keep_head * (ay - by);
-        if (s->v[w].next == POLYC__NONE && o->split_t[v] >= 0.0f && keep_tail != 1.0f &&
+        if (s->v[w].next == POLYC__NONE && o->split.split_t[v] >= 0.0f && keep_tail != 1.0f &&
             !(keep_tail > 1.0f ? polyc__vertex_blocks(o, w, tx, ty) : trim_loses_returns(o, w, tx, ty))) {
             polyc__apply_move(o, w, tx, ty);
             changed++;
         }
-        if (a->prev == POLYC__NONE && o->trim_head[v] >= 0.0f && keep_head != 1.0f &&
+        if (a->prev == POLYC__NONE && o->split.trim_head[v] >= 0.0f && keep_head != 1.0f &&
             !(keep_head > 1.0f ? polyc__vertex_blocks(o, v, hx, hy) : trim_loses_returns(o, v, hx, hy))) {
             polyc__apply_move(o, v, hx, hy);
             changed++;
@@ -745,7 +762,7 @@ int polyc__op_zigzag(polyc__opt *o)
         int spike = lu < 0.3f && lw < 0.3f && dot < -0.5f * lu * lw;
         if (!fold && !spike)
             continue;
-        double bound = spike ? o->log_n : 0.0;
+        double bound = spike ? o->d.log_n : 0.0;
         if (polyc__removal_delta_below(o, v, bound) >= bound)
             continue;
         polyc__apply_remove(o, v);

@@ -18,65 +18,25 @@ static int32_t loc_soa_cap(const polyc_limits *lim)
     return lim->max_scans != 1 ? POLYC__LOC_SOA : 0;
 }
 
-/* The optimiser's own arrays for P points and V vertices (the points, the
- * spatial hash and the best model are carved by their files). */
-#define CARVE(ptr, count) (ok &= ((ptr) = polyc__alloc(a, (size_t)(count), sizeof *(ptr))) != NULL)
+/* The optimiser's own arrays for P points and V vertices, then each
+ * group's scratch by its file (the points, the spatial hash and the best
+ * model are carved by theirs). */
 static int opt_carve(polyc__arena *a, polyc__opt *o, int32_t P, int32_t V, int viewed, int32_t lsoa_cap)
 {
     int ok = 1;
-    CARVE(o->pt_seg, P);
-    CARVE(o->pt_cost, P);
-    CARVE(o->loc_pt, P);
-    CARVE(o->loc_base, P);
-    CARVE(o->loc_seg, P);
-    CARVE(o->agg_pt, P);
-    CARVE(o->cand_seg, POLYC__CAND_MAX);
-    CARVE(o->cand_box, 4 * POLYC__CAND_MAX);
-    o->lsoa_cap = lsoa_cap;
-    if (o->lsoa_cap > 0) {
-        CARVE(o->lsoa_x, o->lsoa_cap);
-        CARVE(o->lsoa_y, o->lsoa_cap);
-        CARVE(o->lsoa_w, o->lsoa_cap);
-        CARVE(o->lsoa_cxx, o->lsoa_cap);
-        CARVE(o->lsoa_cxy, o->lsoa_cap);
-        CARVE(o->lsoa_cyy, o->lsoa_cap);
-        CARVE(o->lsoa_c, o->lsoa_cap);
-    }
-    o->agg_cap = P;
-    CARVE(o->split_t, P > V ? P : V);
-    CARVE(o->trim_head, V);
-    CARVE(o->gap_head, V);
-    CARVE(o->gap_tail, V);
-    CARVE(o->split_off, V + 1);
-    /* cuts per pass (more wait for the next pass) */
-    o->cut_cap = V / POLYC__CUT_SHARE + POLYC__CUT_SPARE;
-    CARVE(o->cut_seg, o->cut_cap);
-    CARVE(o->cut_next, o->cut_cap);
-    CARVE(o->cut_t0, o->cut_cap);
-    CARVE(o->cut_t1, o->cut_cap);
-    CARVE(o->acost, V);
+    POLYC__CARVE(ok, a, o->d.pt_seg, P);
+    POLYC__CARVE(ok, a, o->d.pt_cost, P);
+    POLYC__CARVE(ok, a, o->acost, V);
     o->seg_side = NULL;
     if (viewed)
-        CARVE(o->seg_side, V);
-    CARVE(o->seg_sum, V);
-    CARVE(o->seg_w, V);
-    CARVE(o->seg_far_d, V);
-    CARVE(o->seg_far, V);
-    CARVE(o->seg_dead, V);
-    CARVE(o->v_dirty, V);
-    CARVE(o->dirty_list, V);
-    CARVE(o->seg_in, V);
-    CARVE(o->split_due, V);
-    CARVE(o->v_work, V);
-    CARVE(o->v_touch, V);
-    o->heap_cap = V + POLYC__HEAP_SPARE;
-    CARVE(o->heap, o->heap_cap);
-    o->added_cap = POLYC__ADDED_CAP;
-    CARVE(o->added, POLYC__ADDED_CAP);
-    o->dirty_cap = V;
-    return ok;
+        POLYC__CARVE(ok, a, o->seg_side, V);
+    POLYC__CARVE(ok, a, o->seg_in, V);
+    POLYC__CARVE(ok, a, o->split_due, V);
+    POLYC__CARVE(ok, a, o->v_work, V);
+    POLYC__CARVE(ok, a, o->v_touch, V);
+    return ok && polyc__change_carve(a, &o->chg, V) && polyc__eval_carve(a, &o->ev, P, lsoa_cap) &&
+           polyc__split_carve(a, &o->split, P, V) && polyc__size_carve(a, &o->size, V);
 }
-#undef CARVE
 
 /* What the optimiser takes from the block after the prior: the spacing
  * table, the spatial hash, the points, its own arrays and the best model,
@@ -152,17 +112,12 @@ polyc_status polyc__opt_setup(polyc_ctx *ctx, polyc__opt *o)
         return st;
     if ((st = polyc__points_collect(o)) != POLYC_OK)
         return st;
-    o->log_n = log(o->n > 1.0 ? o->n : 1.0);
-    int32_t P = o->np > 0 ? o->np : 1;
-    if (!opt_carve(&ctx->arena, o, P, V, o->pt_view != NULL, loc_soa_cap(&ctx->lim)))
+    o->d.log_n = log(o->d.n > 1.0 ? o->d.n : 1.0);
+    int32_t P = o->d.np > 0 ? o->d.np : 1;
+    if (!opt_carve(&ctx->arena, o, P, V, o->d.pt_view != NULL, loc_soa_cap(&ctx->lim)))
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the optimiser");
-    o->lsoa_n = -1;
-    memset(o->gap_head, 0, (size_t)V * sizeof(float));
-    memset(o->gap_tail, 0, (size_t)V * sizeof(float));
     memset(o->v_work, 0, (size_t)V * sizeof(uint32_t));
     memset(o->v_touch, 0, (size_t)V * sizeof(uint32_t));
-    memset(o->seg_dead, 0, (size_t)V * sizeof(uint32_t));
-    memset(o->v_dirty, 0, (size_t)V * sizeof(uint32_t));
     memset(o->seg_in, 0, (size_t)V);
     memset(o->split_due, 0, (size_t)V);
     if (!polyc__flat_init(&ctx->arena, &o->best, (uint32_t)polyc__line_cap(V), (uint32_t)V))

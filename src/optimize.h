@@ -22,40 +22,8 @@ typedef struct polyc__rays {
     double own_m;                  /* a return this near a segment's line is its own */
 } polyc__rays;
 
-typedef struct polyc__opt {
-    polyc_ctx *ctx;
-    const polyc_config *cfg;       /* ctx->cfg, or ctx->grid_cfg for an occupancy grid */
-    polyc__store *s;
-
-    /* data: weighted points sorted by hash bucket, and their assignment */
-    polyc__point *pts;
-    float *pt_view;                /* per point: the sum of unit vectors from its endpoints
-                                    * towards their sensors (NULL: not known, grids and
-                                    * single scans) */
-    int32_t np;
-    float *seg_side;               /* per vertex: its segment's side (topology.c, band zip) */
-    int32_t *pt_seg;               /* nearest segment (its start vertex) or NONE */
-    double *pt_cost;               /* capped cost of the point's endpoints */
-    double n, log_n;               /* BIC's n: every endpoint */
-    float R, R2;                   /* search radius: the cost of a point is capped at w R^2 */
-    float point_span_m;            /* side of the block a weighted point stands for */
-    float support_m;               /* a point supports the map this near it: POLYC__SUPPORT_M,
-                                    * or a point's span where that is wider (grids) */
-
-    /* model terms, kept incrementally */
-    double err;                    /* sum of pt_cost */
-    double angle;                  /* sum over vertices of (1 - p(turn | x, y)) */
-    double *acost;                 /* per vertex: 1 - p */
-    polyc__prior prior;
-    polyc__spacing spacing;        /* expected point spacing: the split scale */
-    polyc__rays rays;              /* single-scan mode: the beams' free space */
-
-    polyc__hash h;
-    uint8_t *seg_in;               /* per vertex: its segment is in the hash */
-    uint8_t *split_due;            /* per vertex: its segment or its points changed
-                                    * since op_split last looked at it */
-
-    /* one change (a batch of edits) being recorded */
+/* The books of one change (a batch of edits) being recorded (score.c). */
+typedef struct polyc__change {
     uint32_t epoch;
     uint32_t *seg_dead;            /* per vertex: == epoch when its segment changed */
     uint32_t *v_dirty;             /* per vertex: == epoch when its angle is pending */
@@ -65,8 +33,10 @@ typedef struct polyc__opt {
     uint32_t *bucket_mark;         /* per bucket: == epoch when listed */
     int32_t *bucket_list, bucket_n;
     int32_t added_cap, dirty_cap;
+} polyc__change;
 
-    /* local evaluation scratch */
+/* Trial evaluation's scratch (score.c; read by adjust.c and trial_costs.c). */
+typedef struct polyc__eval_scratch {
     int32_t *loc_pt;               /* points near the edited segments */
     double *loc_base;              /* their cost without the edited segments */
     int32_t *loc_seg;              /* and the segment giving it */
@@ -94,9 +64,11 @@ typedef struct polyc__opt {
     int agg_on;                    /* 0: no aggregation prepared */
     int agg_moving_b[2];           /* the moving end is the segment's b */
     double agg_ax[2], agg_ay[2], agg_m[2][3];
+} polyc__eval_scratch;
 
-    /* split scratch: per segment offsets, positions of its points (of the
-     * segments split_due only) */
+/* Split and end trimming's scratch (operators.c): per segment offsets,
+ * positions of its points (of the segments split_due only). */
+typedef struct polyc__split_scratch {
     int32_t *split_off;
     float *split_t;
     int32_t *cut_seg, *cut_next, cut_cap;
@@ -104,12 +76,58 @@ typedef struct polyc__opt {
     float *trim_head;              /* end trimming: farthest point from the head side */
     float *gap_head, *gap_tail;    /* per segment: its ends' distance to its nearest data
                                     * (split, valid while it is not split_due) */
+} polyc__split_scratch;
 
-    /* model size scratch: per segment sums, farthest point; removal heap */
+/* Vertex removal's scratch (model_size.c): per segment sums, farthest
+ * point; the removal heap. */
+typedef struct polyc__size_scratch {
     float *seg_sum, *seg_w, *seg_far_d;
     int32_t *seg_far;
     polyc__heap_entry *heap;
     int32_t heap_n, heap_cap;
+} polyc__size_scratch;
+
+/* The data: weighted points sorted by hash bucket (points.c), and their
+ * assignment to the model (score.c). */
+typedef struct polyc__data {
+    polyc__point *pts;
+    float *pt_view;                /* per point: the sum of unit vectors from its endpoints
+                                    * towards their sensors (NULL: not known, grids and
+                                    * single scans) */
+    int32_t np;
+    int32_t *pt_seg;               /* nearest segment (its start vertex) or NONE */
+    double *pt_cost;               /* capped cost of the point's endpoints */
+    double n, log_n;               /* BIC's n: every endpoint */
+    float point_span_m;            /* side of the block a weighted point stands for */
+    float support_m;               /* a point supports the map this near it: POLYC__SUPPORT_M,
+                                    * or a point's span where that is wider (grids) */
+} polyc__data;
+
+/* The optimiser's long-lived state: the model and its terms, the spatial
+ * index, the books of the current change and the stamps; each operator
+ * group's working state is its own struct, carved by its file. */
+typedef struct polyc__opt {
+    polyc_ctx *ctx;
+    const polyc_config *cfg;       /* ctx->cfg, or ctx->grid_cfg for an occupancy grid */
+    polyc__store *s;
+    float R, R2;                   /* search radius: the cost of a point is capped at w R^2 */
+
+    polyc__data d;
+    float *seg_side;               /* per vertex: its segment's side (topology.c, band zip) */
+
+    /* model terms, kept incrementally */
+    double err;                    /* sum of pt_cost */
+    double angle;                  /* sum over vertices of (1 - p(turn | x, y)) */
+    double *acost;                 /* per vertex: 1 - p */
+    polyc__prior prior;
+    polyc__spacing spacing;        /* expected point spacing: the split scale */
+    polyc__rays rays;              /* single-scan mode: the beams' free space */
+
+    polyc__hash h;
+    uint8_t *seg_in;               /* per vertex: its segment is in the hash */
+    uint8_t *split_due;            /* per vertex: its segment or its points changed
+                                    * since op_split last looked at it */
+    polyc__change chg;
 
     uint32_t *v_work;              /* per vertex: == round stamp when to be climbed */
     uint32_t work_stamp;
@@ -119,9 +137,28 @@ typedef struct polyc__opt {
                                     * edited since is looked at again */
     polyc__rng rng;
     polyc__flat best;
+
+    polyc__eval_scratch ev;
+    polyc__split_scratch split;
+    polyc__size_scratch size;
 } polyc__opt;
 
 #define POLYC__CAND_MAX 48
+
+/* ok &= carving count elements of *ptr from arena a (the carve functions:
+ * each group's scratch is carved by its own file, on the block or on the
+ * size query's counting arena) */
+#define POLYC__CARVE(ok, a, ptr, count) \
+    ((ok) &= ((ptr) = polyc__alloc((a), (size_t)(count), sizeof *(ptr))) != NULL)
+#define POLYC__CARVE_ZERO(ok, a, ptr, count) \
+    ((ok) &= ((ptr) = polyc__alloc_zero((a), (size_t)(count), sizeof *(ptr))) != NULL)
+/* score.c: the books of a change for V vertices; trial evaluation's scratch
+ * for P points (lsoa_cap: listed points copied by field, 0 for none) */
+int polyc__change_carve(polyc__arena *a, polyc__change *c, int32_t V);
+int polyc__eval_carve(polyc__arena *a, polyc__eval_scratch *ev, int32_t P, int32_t lsoa_cap);
+/* operators.c: split and trim scratch; model_size.c: vertex removal's */
+int polyc__split_carve(polyc__arena *a, polyc__split_scratch *sp, int32_t P, int32_t V);
+int polyc__size_carve(polyc__arena *a, polyc__size_scratch *sz, int32_t V);
 /* a data point supports the stretch of map within this distance of it:
  * splits and end trimming count only such points (not in the paper) */
 #define POLYC__SUPPORT_M 0.05f

@@ -301,7 +301,7 @@ polyc_status polyc__points_collect(polyc__opt *o)
     /* final array first, the unsorted one after it (released at the end);
      * where the endpoints were seen from: scans (more than one) only */
     int viewed = polyc__points_viewed(ctx);
-    int ok = points_carve(&ctx->arena, cap, viewed, &o->pts, &o->pt_view);
+    int ok = points_carve(&ctx->arena, cap, viewed, &o->d.pts, &o->d.pt_view);
     size_t mark = ctx->arena.used;
     polyc__point *tmp;
     float *tmp_view;
@@ -339,24 +339,24 @@ polyc_status polyc__points_collect(polyc__opt *o)
     for (int32_t i = 0; i < n; i++) {
         int32_t b = polyc__bucket_of(h, tmp[i].x, tmp[i].y);
         uint32_t at = h->pt_start[b]++;
-        o->pts[at] = tmp[i];
+        o->d.pts[at] = tmp[i];
         if (tmp_view) {
-            o->pt_view[2 * at] = tmp_view[2 * i];
-            o->pt_view[2 * at + 1] = tmp_view[2 * i + 1];
+            o->d.pt_view[2 * at] = tmp_view[2 * i];
+            o->d.pt_view[2 * at + 1] = tmp_view[2 * i + 1];
         }
     }
     for (int32_t b = nb; b > 0; b--)
         h->pt_start[b] = h->pt_start[b - 1];
     h->pt_start[0] = 0;
     ctx->arena.used = mark;
-    o->np = n;
-    o->n = total;
+    o->d.np = n;
+    o->d.n = total;
     /* the span of one weighted point: gaps between points shorter than it
      * say nothing (split) */
-    o->point_span_m = ctx->from_grid ? ctx->grid.cell_m
+    o->d.point_span_m = ctx->from_grid ? ctx->grid.cell_m
                       : exact        ? 0.0f
                                      : ctx->grid.cell_m * (float)BLOCK_SIDE;
-    o->support_m = polyc__maxf(POLYC__SUPPORT_M, o->point_span_m);
+    o->d.support_m = polyc__maxf(POLYC__SUPPORT_M, o->d.point_span_m);
     ctx->stats.data_points = (uint64_t)total;
     ctx->stats.weighted_points = (uint32_t)n;
     return POLYC_OK;

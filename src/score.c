@@ -7,6 +7,42 @@
 
 #include <math.h>
 
+int polyc__change_carve(polyc__arena *a, polyc__change *c, int32_t V)
+{
+    int ok = 1;
+    POLYC__CARVE_ZERO(ok, a, c->seg_dead, V);
+    POLYC__CARVE_ZERO(ok, a, c->v_dirty, V);
+    POLYC__CARVE(ok, a, c->dirty_list, V);
+    c->dirty_cap = V;
+    c->added_cap = POLYC__ADDED_CAP;
+    POLYC__CARVE(ok, a, c->added, POLYC__ADDED_CAP);
+    return ok;
+}
+
+int polyc__eval_carve(polyc__arena *a, polyc__eval_scratch *ev, int32_t P, int32_t lsoa_cap)
+{
+    int ok = 1;
+    POLYC__CARVE(ok, a, ev->loc_pt, P);
+    POLYC__CARVE(ok, a, ev->loc_base, P);
+    POLYC__CARVE(ok, a, ev->loc_seg, P);
+    POLYC__CARVE(ok, a, ev->agg_pt, P);
+    ev->agg_cap = P;
+    POLYC__CARVE(ok, a, ev->cand_seg, POLYC__CAND_MAX);
+    POLYC__CARVE(ok, a, ev->cand_box, 4 * POLYC__CAND_MAX);
+    ev->lsoa_cap = lsoa_cap;
+    ev->lsoa_n = -1;
+    if (lsoa_cap > 0) {
+        POLYC__CARVE(ok, a, ev->lsoa_x, lsoa_cap);
+        POLYC__CARVE(ok, a, ev->lsoa_y, lsoa_cap);
+        POLYC__CARVE(ok, a, ev->lsoa_w, lsoa_cap);
+        POLYC__CARVE(ok, a, ev->lsoa_cxx, lsoa_cap);
+        POLYC__CARVE(ok, a, ev->lsoa_cxy, lsoa_cap);
+        POLYC__CARVE(ok, a, ev->lsoa_cyy, lsoa_cap);
+        POLYC__CARVE(ok, a, ev->lsoa_c, lsoa_cap);
+    }
+    return ok;
+}
+
 /* Sum of squared distances of a weighted point's endpoints to segment a-b,
  * all of them taken to fall in the region (interior or end) of their mean. */
 double polyc__cost(const polyc__point *p, float ax, float ay, float bx, float by)
@@ -56,7 +92,7 @@ static double nearest_below(const polyc__opt *o, int32_t pi, const int32_t *skip
     static const int8_t ORDER[9][2] = {{0, 0}, {-1, 0}, {1, 0}, {0, -1}, {0, 1},
                                        {-1, -1}, {1, -1}, {-1, 1}, {1, 1}};
     const polyc__hash *h = &o->h;
-    const polyc__point *p = &o->pts[pi];
+    const polyc__point *p = &o->d.pts[pi];
     double best = start, w = (double)p->w;
     int32_t best_seg = POLYC__NONE;
     int32_t bx, by;
@@ -108,7 +144,7 @@ static double nearest_below(const polyc__opt *o, int32_t pi, const int32_t *skip
 double polyc__nearest(const polyc__opt *o, int32_t pi, const int32_t *skip, int n_skip,
                       int32_t *seg)
 {
-    return nearest_below(o, pi, skip, n_skip, cap_of(o, &o->pts[pi]), seg);
+    return nearest_below(o, pi, skip, n_skip, cap_of(o, &o->d.pts[pi]), seg);
 }
 
 /* 1 - p(turn | x, y) at v; open ends have no angle. */
@@ -126,7 +162,7 @@ double polyc__vertex_angle_cost(const polyc__opt *o, int32_t v)
 double polyc__bic(const polyc__opt *o)
 {
     return (double)o->cfg->alpha * (o->err + (double)o->cfg->gamma * o->angle) +
-           (double)o->s->v_live * o->log_n;
+           (double)o->s->v_live * o->d.log_n;
 }
 
 polyc_status polyc__rebuild(polyc__opt *o)
@@ -144,9 +180,9 @@ polyc_status polyc__rebuild(polyc__opt *o)
         o->angle += o->acost[v];
     }
     o->err = 0.0;
-    for (int32_t i = 0; i < o->np; i++) {
-        o->pt_cost[i] = polyc__nearest(o, i, NULL, 0, &o->pt_seg[i]);
-        o->err += o->pt_cost[i];
+    for (int32_t i = 0; i < o->d.np; i++) {
+        o->d.pt_cost[i] = polyc__nearest(o, i, NULL, 0, &o->d.pt_seg[i]);
+        o->err += o->d.pt_cost[i];
     }
     return POLYC_OK;
 }
@@ -162,11 +198,11 @@ static void mark_segment_region(polyc__opt *o, int32_t seg)
 
 void polyc__chg_begin(polyc__opt *o)
 {
-    o->epoch++;
-    o->bucket_n = 0;
-    o->added_n = 0;
-    o->added_overflow = 0;
-    o->dirty_n = 0;
+    o->chg.epoch++;
+    o->chg.bucket_n = 0;
+    o->chg.added_n = 0;
+    o->chg.added_overflow = 0;
+    o->chg.dirty_n = 0;
 }
 
 void polyc__chg_seg_out(polyc__opt *o, int32_t seg)
@@ -175,7 +211,7 @@ void polyc__chg_seg_out(polyc__opt *o, int32_t seg)
         return;
     mark_segment_region(o, seg);
     polyc__hash_remove(o, seg);
-    o->seg_dead[seg] = o->epoch;
+    o->chg.seg_dead[seg] = o->chg.epoch;
 }
 
 int polyc__chg_seg_in(polyc__opt *o, int32_t seg)
@@ -184,10 +220,10 @@ int polyc__chg_seg_in(polyc__opt *o, int32_t seg)
         return 1;
     int ok = polyc__hash_insert(o, seg);
     mark_segment_region(o, seg);
-    if (o->added_n < o->added_cap)
-        o->added[o->added_n++] = seg;
+    if (o->chg.added_n < o->chg.added_cap)
+        o->chg.added[o->chg.added_n++] = seg;
     else
-        o->added_overflow = 1; /* too many to compare: full queries in the region */
+        o->chg.added_overflow = 1; /* too many to compare: full queries in the region */
     return ok;
 }
 
@@ -196,51 +232,51 @@ void polyc__chg_dirty(polyc__opt *o, int32_t v)
     if (v == POLYC__NONE)
         return;
     o->v_touch[v] = o->touch_stamp;
-    if (o->v_dirty[v] == o->epoch || o->dirty_n >= o->dirty_cap)
+    if (o->chg.v_dirty[v] == o->chg.epoch || o->chg.dirty_n >= o->chg.dirty_cap)
         return;
-    o->v_dirty[v] = o->epoch;
+    o->chg.v_dirty[v] = o->chg.epoch;
     o->angle -= o->acost[v];
     o->acost[v] = 0.0;
-    o->dirty_list[o->dirty_n++] = v;
+    o->chg.dirty_list[o->chg.dirty_n++] = v;
 }
 
 void polyc__chg_commit(polyc__opt *o)
 {
     const polyc__hash *h = &o->h;
-    for (int32_t k = 0; k < o->bucket_n; k++) {
-        int32_t b = o->bucket_list[k];
+    for (int32_t k = 0; k < o->chg.bucket_n; k++) {
+        int32_t b = o->chg.bucket_list[k];
         for (uint32_t i = h->pt_start[b]; i < h->pt_start[b + 1]; i++) {
-            double old = o->pt_cost[i], c;
-            int32_t seg = o->pt_seg[i];
-            if (o->added_overflow || (seg != POLYC__NONE && o->seg_dead[seg] == o->epoch)) {
+            double old = o->d.pt_cost[i], c;
+            int32_t seg = o->d.pt_seg[i];
+            if (o->chg.added_overflow || (seg != POLYC__NONE && o->chg.seg_dead[seg] == o->chg.epoch)) {
                 c = polyc__nearest(o, (int32_t)i, NULL, 0, &seg);
             } else {
                 c = old;
-                for (int32_t a = 0; a < o->added_n; a++) {
-                    int32_t sg = o->added[a];
+                for (int32_t a = 0; a < o->chg.added_n; a++) {
+                    int32_t sg = o->chg.added[a];
                     if (!o->seg_in[sg])
                         continue;
-                    double ca = polyc__cost_seg(o, &o->pts[i], sg);
+                    double ca = polyc__cost_seg(o, &o->d.pts[i], sg);
                     if (ca < c) {
                         c = ca;
                         seg = sg;
                     }
                 }
             }
-            o->pt_cost[i] = c;
-            polyc__split_due_pt(o, o->pt_seg[i], seg);
-            o->pt_seg[i] = seg;
+            o->d.pt_cost[i] = c;
+            polyc__split_due_pt(o, o->d.pt_seg[i], seg);
+            o->d.pt_seg[i] = seg;
             o->err += c - old;
         }
     }
-    for (int32_t k = 0; k < o->dirty_n; k++) {
-        int32_t v = o->dirty_list[k];
+    for (int32_t k = 0; k < o->chg.dirty_n; k++) {
+        int32_t v = o->chg.dirty_list[k];
         if (o->s->v[v].line == POLYC__NONE)
             continue;
         o->acost[v] = polyc__vertex_angle_cost(o, v);
         o->angle += o->acost[v];
     }
-    o->bucket_n = o->added_n = o->dirty_n = 0;
+    o->chg.bucket_n = o->chg.added_n = o->chg.dirty_n = 0;
 }
 
 /* ---- local evaluation (read-only) ---- */
@@ -341,44 +377,44 @@ static void gather_start(polyc__opt *o, const int32_t *old, int n_old)
     /* a new epoch: the region's bucket marks are not needed any more (the
      * region is listed), and seg_dead (compared with the epoch of a change,
      * which starts a new one) marks the segments met */
-    o->cand_stamp = ++o->epoch;
-    o->cand_src = POLYC__NONE;
-    o->cand_n = 0;
+    o->ev.cand_stamp = ++o->chg.epoch;
+    o->ev.cand_src = POLYC__NONE;
+    o->ev.cand_n = 0;
     for (int j = 0; j < n_old; j++)
         if (old[j] != POLYC__NONE)
-            o->seg_dead[old[j]] = o->cand_stamp;
+            o->chg.seg_dead[old[j]] = o->ev.cand_stamp;
 }
 
 static void gather_around(polyc__opt *o, int32_t b)
 {
     const polyc__hash *h = &o->h;
-    const uint32_t stamp = o->cand_stamp;
-    if (b == o->cand_src)
+    const uint32_t stamp = o->ev.cand_stamp;
+    if (b == o->ev.cand_src)
         return; /* the points come bucket by bucket */
-    o->cand_src = b;
+    o->ev.cand_src = b;
     int32_t around[9];
     int n = polyc__buckets_around(h, b % h->bx, b / h->bx, around);
     for (int i = 0; i < n; i++) {
         int32_t nb = around[i];
-        if (o->bucket_mark[nb] == stamp)
+        if (o->chg.bucket_mark[nb] == stamp)
             continue;
-        o->bucket_mark[nb] = stamp;
+        o->chg.bucket_mark[nb] = stamp;
         for (int32_t e = h->seg_head[nb]; e != POLYC__NONE; e = h->entries[e].next) {
             int32_t sg = h->entries[e].seg;
-            if (o->seg_dead[sg] == stamp)
+            if (o->chg.seg_dead[sg] == stamp)
                 continue;
-            o->seg_dead[sg] = stamp;
-            if (o->cand_n == POLYC__CAND_MAX) {
-                o->cand_n = POLYC__CAND_MAX + 1; /* too many: the hash is queried */
+            o->chg.seg_dead[sg] = stamp;
+            if (o->ev.cand_n == POLYC__CAND_MAX) {
+                o->ev.cand_n = POLYC__CAND_MAX + 1; /* too many: the hash is queried */
                 return;
             }
             const polyc__vertex *a = &o->s->v[sg], *c = &o->s->v[a->next];
-            float *box = o->cand_box + 4 * o->cand_n;
+            float *box = o->ev.cand_box + 4 * o->ev.cand_n;
             box[0] = polyc__minf(a->x, c->x);
             box[1] = polyc__minf(a->y, c->y);
             box[2] = polyc__maxf(a->x, c->x);
             box[3] = polyc__maxf(a->y, c->y);
-            o->cand_seg[o->cand_n++] = sg;
+            o->ev.cand_seg[o->ev.cand_n++] = sg;
         }
     }
 }
@@ -387,11 +423,11 @@ static void gather_around(polyc__opt *o, int32_t b)
  * look at, and a box test instead of the bucket walk. */
 static double nearest_candidate(const polyc__opt *o, int32_t pi, double start, int32_t *seg)
 {
-    const polyc__point *p = &o->pts[pi];
+    const polyc__point *p = &o->d.pts[pi];
     double best = start, w = (double)p->w;
     int32_t best_seg = POLYC__NONE;
-    for (int32_t k = 0; k < o->cand_n; k++) {
-        const float *box = o->cand_box + 4 * k;
+    for (int32_t k = 0; k < o->ev.cand_n; k++) {
+        const float *box = o->ev.cand_box + 4 * k;
         /* distance to the box, a lower bound of the segment's: differences
          * of floats are exact in double, so the bound is never too high */
         double px = (double)p->x, py = (double)p->y;
@@ -401,10 +437,10 @@ static double nearest_candidate(const polyc__opt *o, int32_t pi, double start, i
         gy = gy > 0.0 ? gy : 0.0;
         if (0.999 * w * (gx * gx + gy * gy) >= best)
             continue;
-        double c = polyc__cost_seg(o, p, o->cand_seg[k]);
+        double c = polyc__cost_seg(o, p, o->ev.cand_seg[k]);
         if (c < best) {
             best = c;
-            best_seg = o->cand_seg[k];
+            best_seg = o->ev.cand_seg[k];
         }
     }
     *seg = best_seg;
@@ -456,8 +492,8 @@ static void prepare(polyc__opt *o, const int32_t *old, int n_old, const float *s
     POLYC_ASSERT(n_new <= 4);
     for (int j = 0; j < n_new; j++)
         span[j] = seg_span_of(seg_xy + 4 * j);
-    o->epoch++;
-    o->bucket_n = 0;
+    o->chg.epoch++;
+    o->chg.bucket_n = 0;
     for (int k = 0; k < n_old; k++)
         if (old[k] != POLYC__NONE)
             mark_segment_region(o, old[k]);
@@ -467,33 +503,33 @@ static void prepare(polyc__opt *o, const int32_t *old, int n_old, const float *s
         const float *q = seg_xy + 4 * k;
         polyc__segment_region(o, q[0], q[1], q[2], q[3]);
     }
-    o->cand_n = -1;
-    o->loc_n = 0;
-    o->loc_fixed = 0.0;
-    o->loc_fixed_cur = 0.0;
-    o->agg_on = move && n_new <= 2;
-    o->agg_n[0] = o->agg_n[1] = 0;
+    o->ev.cand_n = -1;
+    o->ev.loc_n = 0;
+    o->ev.loc_fixed = 0.0;
+    o->ev.loc_fixed_cur = 0.0;
+    o->ev.agg_on = move && n_new <= 2;
+    o->ev.agg_n[0] = o->ev.agg_n[1] = 0;
     for (int j = 0; j < 2; j++) {
-        o->agg_m[j][0] = o->agg_m[j][1] = o->agg_m[j][2] = 0.0;
-        o->agg_moving_b[j] = 0;
-        o->agg_ax[j] = o->agg_ay[j] = 0.0;
+        o->ev.agg_m[j][0] = o->ev.agg_m[j][1] = o->ev.agg_m[j][2] = 0.0;
+        o->ev.agg_moving_b[j] = 0;
+        o->ev.agg_ax[j] = o->ev.agg_ay[j] = 0.0;
     }
-    if (o->agg_on)
+    if (o->ev.agg_on)
         for (int j = 0; j < n_new; j++) {
             const float *q = seg_xy + 4 * j;
             int b = q[2] == mx && q[3] == my;
-            o->agg_moving_b[j] = b;
-            o->agg_ax[j] = (double)(b ? q[0] : q[2]);
-            o->agg_ay[j] = (double)(b ? q[1] : q[3]);
+            o->ev.agg_moving_b[j] = b;
+            o->ev.agg_ax[j] = (double)(b ? q[0] : q[2]);
+            o->ev.agg_ay[j] = (double)(b ? q[1] : q[3]);
         }
-    for (int32_t k = 0; k < o->bucket_n; k++) {
-        int32_t b = o->bucket_list[k];
+    for (int32_t k = 0; k < o->chg.bucket_n; k++) {
+        int32_t b = o->chg.bucket_list[k];
         for (uint32_t i = h->pt_start[b]; i < h->pt_start[b + 1]; i++) {
-            int32_t seg = o->pt_seg[i];
+            int32_t seg = o->d.pt_seg[i];
             int hit = is_old(&olds, seg);
             int32_t base_seg = seg;
-            double base = o->pt_cost[i];
-            const polyc__point *p = &o->pts[i];
+            double base = o->d.pt_cost[i];
+            const polyc__point *p = &o->d.pts[i];
             double d[2] = {1e30, 1e30};
             if (reach > 0.0f) {
                 double dmin = 1e30;
@@ -506,24 +542,24 @@ static void prepare(polyc__opt *o, const int32_t *old, int n_old, const float *s
                 }
                 dmin -= (double)reach;
                 if (!hit && dmin > 0.0 && base <= (double)p->w * dmin * dmin) {
-                    o->loc_fixed += base;
-                    o->loc_fixed_cur += o->pt_cost[i];
+                    o->ev.loc_fixed += base;
+                    o->ev.loc_fixed_cur += o->d.pt_cost[i];
                     continue;
                 }
             }
             int j = n_new == 2 && d[1] < d[0];
-            double bound = o->agg_on ? stay_bound(p, o->agg_ax[j], o->agg_ay[j], (double)mx,
+            double bound = o->ev.agg_on ? stay_bound(p, o->ev.agg_ax[j], o->ev.agg_ay[j], (double)mx,
                                                   (double)my, (double)reach, d[j], d[1 - j])
                                      : 0.0;
             if (hit) {
                 /* without the old segments: a query within the bound is
                  * enough to tell that the point stays (most do) */
                 double cap = cap_of(o, p), start = bound > 0.0 && bound < cap ? bound : cap;
-                if (o->cand_n < 0)
+                if (o->ev.cand_n < 0)
                     gather_start(o, old, n_old);
-                if (o->cand_n >= 0 && o->cand_n <= POLYC__CAND_MAX)
+                if (o->ev.cand_n >= 0 && o->ev.cand_n <= POLYC__CAND_MAX)
                     gather_around(o, b);
-                base = o->cand_n >= 0 && o->cand_n <= POLYC__CAND_MAX
+                base = o->ev.cand_n >= 0 && o->ev.cand_n <= POLYC__CAND_MAX
                            ? nearest_candidate(o, (int32_t)i, start, &base_seg)
                            : nearest_below(o, (int32_t)i, old, n_old, start, &base_seg);
                 if (base_seg != POLYC__NONE)
@@ -536,38 +572,38 @@ static void prepare(polyc__opt *o, const int32_t *old, int n_old, const float *s
                 bound = 0.0;
             }
             if (bound > 0.0) {
-                double dx = (double)p->x - o->agg_ax[j], dy = (double)p->y - o->agg_ay[j];
+                double dx = (double)p->x - o->ev.agg_ax[j], dy = (double)p->y - o->ev.agg_ay[j];
                 double w = (double)p->w;
-                o->agg_m[j][0] += w * dx * dx + (double)p->cxx;
-                o->agg_m[j][1] += w * dx * dy + (double)p->cxy;
-                o->agg_m[j][2] += w * dy * dy + (double)p->cyy;
-                int32_t slot = j == 0 ? o->agg_n[0] : o->agg_cap - 1 - o->agg_n[1];
-                o->agg_pt[slot] = (int32_t)i;
-                o->agg_n[j]++;
-                o->loc_fixed_cur += o->pt_cost[i];
+                o->ev.agg_m[j][0] += w * dx * dx + (double)p->cxx;
+                o->ev.agg_m[j][1] += w * dx * dy + (double)p->cxy;
+                o->ev.agg_m[j][2] += w * dy * dy + (double)p->cyy;
+                int32_t slot = j == 0 ? o->ev.agg_n[0] : o->ev.agg_cap - 1 - o->ev.agg_n[1];
+                o->ev.agg_pt[slot] = (int32_t)i;
+                o->ev.agg_n[j]++;
+                o->ev.loc_fixed_cur += o->d.pt_cost[i];
                 continue;
             }
-            o->loc_pt[o->loc_n] = (int32_t)i;
-            o->loc_base[o->loc_n] = base;
-            o->loc_seg[o->loc_n] = base_seg;
-            o->loc_n++;
+            o->ev.loc_pt[o->ev.loc_n] = (int32_t)i;
+            o->ev.loc_base[o->ev.loc_n] = base;
+            o->ev.loc_seg[o->ev.loc_n] = base_seg;
+            o->ev.loc_n++;
         }
     }
-    o->bucket_n = 0;
-    o->lsoa_n = -1;
+    o->chg.bucket_n = 0;
+    o->ev.lsoa_n = -1;
     /* for a few points (most of a single scan's trials) the copy costs
      * more than it saves */
-    if (o->loc_n >= 8 && o->loc_n <= o->lsoa_cap) {
-        for (int32_t k = 0; k < o->loc_n; k++) {
-            const polyc__point *p = &o->pts[o->loc_pt[k]];
-            o->lsoa_x[k] = (double)p->x;
-            o->lsoa_y[k] = (double)p->y;
-            o->lsoa_w[k] = (double)p->w;
-            o->lsoa_cxx[k] = (double)p->cxx;
-            o->lsoa_cxy[k] = (double)p->cxy;
-            o->lsoa_cyy[k] = (double)p->cyy;
+    if (o->ev.loc_n >= 8 && o->ev.loc_n <= o->ev.lsoa_cap) {
+        for (int32_t k = 0; k < o->ev.loc_n; k++) {
+            const polyc__point *p = &o->d.pts[o->ev.loc_pt[k]];
+            o->ev.lsoa_x[k] = (double)p->x;
+            o->ev.lsoa_y[k] = (double)p->y;
+            o->ev.lsoa_w[k] = (double)p->w;
+            o->ev.lsoa_cxx[k] = (double)p->cxx;
+            o->ev.lsoa_cxy[k] = (double)p->cxy;
+            o->ev.lsoa_cyy[k] = (double)p->cyy;
         }
-        o->lsoa_n = o->loc_n;
+        o->ev.lsoa_n = o->ev.loc_n;
     }
 }
 
@@ -589,31 +625,31 @@ double polyc__local_eval(const polyc__opt *o, const float *seg_xy, int n_new)
     POLYC_ASSERT(n_new <= 4);
     for (int j = 0; j < n_new; j++)
         seg_prepare(&q[j], seg_xy + 4 * j);
-    double sum = o->loc_fixed;
-    if (o->agg_on)
+    double sum = o->ev.loc_fixed;
+    if (o->ev.agg_on)
         for (int j = 0; j < n_new; j++) {
-            if (o->agg_n[j] == 0)
+            if (o->ev.agg_n[j] == 0)
                 continue;
             /* n'Mn with n the unit normal of the segment from its fixed end */
-            const float *e = seg_xy + 4 * j + (o->agg_moving_b[j] ? 2 : 0);
-            double ux = (double)e[0] - o->agg_ax[j], uy = (double)e[1] - o->agg_ay[j];
-            const double *m = o->agg_m[j];
+            const float *e = seg_xy + 4 * j + (o->ev.agg_moving_b[j] ? 2 : 0);
+            double ux = (double)e[0] - o->ev.agg_ax[j], uy = (double)e[1] - o->ev.agg_ay[j];
+            const double *m = o->ev.agg_m[j];
             sum += (m[0] * uy * uy - 2.0 * m[1] * ux * uy + m[2] * ux * ux) / (ux * ux + uy * uy);
         }
-    if (o->lsoa_n == o->loc_n) {
-        double *c = o->lsoa_c;
-        for (int32_t k = 0; k < o->loc_n; k++)
-            c[k] = o->loc_base[k];
+    if (o->ev.lsoa_n == o->ev.loc_n) {
+        double *c = o->ev.lsoa_c;
+        for (int32_t k = 0; k < o->ev.loc_n; k++)
+            c[k] = o->ev.loc_base[k];
         for (int j = 0; j < n_new; j++)
             polyc__trial_costs_min(o, &q[j], c);
         /* summed in the order of the scalar loop below: the same bits */
-        for (int32_t k = 0; k < o->loc_n; k++)
+        for (int32_t k = 0; k < o->ev.loc_n; k++)
             sum += c[k];
         return sum;
     }
-    for (int32_t k = 0; k < o->loc_n; k++) {
-        const polyc__point *p = &o->pts[o->loc_pt[k]];
-        double c = o->loc_base[k];
+    for (int32_t k = 0; k < o->ev.loc_n; k++) {
+        const polyc__point *p = &o->d.pts[o->ev.loc_pt[k]];
+        double c = o->ev.loc_base[k];
         for (int j = 0; j < n_new; j++) {
             double cj = seg_cost(&q[j], p);
             if (cj < c)
@@ -626,9 +662,9 @@ double polyc__local_eval(const polyc__opt *o, const float *seg_xy, int n_new)
 
 double polyc__local_current(const polyc__opt *o)
 {
-    double sum = o->loc_fixed_cur;
-    for (int32_t k = 0; k < o->loc_n; k++)
-        sum += o->pt_cost[o->loc_pt[k]];
+    double sum = o->ev.loc_fixed_cur;
+    for (int32_t k = 0; k < o->ev.loc_n; k++)
+        sum += o->d.pt_cost[o->ev.loc_pt[k]];
     return sum;
 }
 
@@ -637,22 +673,22 @@ double polyc__local_current(const polyc__opt *o)
 /* Max-heap on loc_base (the most a pending point can add) over loc_pt. */
 static void pend_sift(polyc__opt *o, int32_t i, int32_t n)
 {
-    double key = o->loc_base[i];
-    int32_t pt = o->loc_pt[i];
+    double key = o->ev.loc_base[i];
+    int32_t pt = o->ev.loc_pt[i];
     for (;;) {
         int32_t c = 2 * i + 1;
         if (c >= n)
             break;
-        if (c + 1 < n && o->loc_base[c + 1] > o->loc_base[c])
+        if (c + 1 < n && o->ev.loc_base[c + 1] > o->ev.loc_base[c])
             c++;
-        if (o->loc_base[c] <= key)
+        if (o->ev.loc_base[c] <= key)
             break;
-        o->loc_base[i] = o->loc_base[c];
-        o->loc_pt[i] = o->loc_pt[c];
+        o->ev.loc_base[i] = o->ev.loc_base[c];
+        o->ev.loc_pt[i] = o->ev.loc_pt[c];
         i = c;
     }
-    o->loc_base[i] = key;
-    o->loc_pt[i] = pt;
+    o->ev.loc_base[i] = key;
+    o->ev.loc_pt[i] = pt;
 }
 
 /* The change of the error when the `old` segments are replaced by seg_xy,
@@ -672,8 +708,8 @@ double polyc__local_delta(polyc__opt *o, const int32_t *old, int n_old, const fl
     POLYC_ASSERT(n_new <= 4);
     for (int j = 0; j < n_new; j++)
         seg_prepare(&q[j], seg_xy + 4 * j);
-    o->epoch++;
-    o->bucket_n = 0;
+    o->chg.epoch++;
+    o->chg.bucket_n = 0;
     for (int k = 0; k < n_old; k++)
         if (old[k] != POLYC__NONE)
             mark_segment_region(o, old[k]);
@@ -683,18 +719,18 @@ double polyc__local_delta(polyc__opt *o, const int32_t *old, int n_old, const fl
     }
     double sure = 0.0; /* exact part so far; pending points add >= 0 each */
     int32_t n = 0;
-    o->lsoa_n = -1; /* loc_pt and loc_base are a heap here */
-    for (int32_t k = 0; k < o->bucket_n; k++) {
-        int32_t b = o->bucket_list[k];
+    o->ev.lsoa_n = -1; /* loc_pt and loc_base are a heap here */
+    for (int32_t k = 0; k < o->chg.bucket_n; k++) {
+        int32_t b = o->chg.bucket_list[k];
         for (uint32_t i = h->pt_start[b]; i < h->pt_start[b + 1]; i++) {
-            const polyc__point *p = &o->pts[i];
-            double cur = o->pt_cost[i], c = 1e300;
+            const polyc__point *p = &o->d.pts[i];
+            double cur = o->d.pt_cost[i], c = 1e300;
             for (int j = 0; j < n_new; j++) {
                 double cj = seg_cost(&q[j], p);
                 if (cj < c)
                     c = cj;
             }
-            int32_t seg = o->pt_seg[i];
+            int32_t seg = o->d.pt_seg[i];
             int hit = is_old(&olds, seg);
             if (!hit || c <= cur) {
                 /* not hit: its cost without the old segments is cur; hit
@@ -703,24 +739,24 @@ double polyc__local_delta(polyc__opt *o, const int32_t *old, int n_old, const fl
                 continue;
             }
             double cap = cap_of(o, p);
-            o->loc_pt[n] = (int32_t)i;
-            o->loc_base[n] = (c < cap ? c : cap) - cur;
+            o->ev.loc_pt[n] = (int32_t)i;
+            o->ev.loc_base[n] = (c < cap ? c : cap) - cur;
             n++;
         }
     }
-    o->bucket_n = 0;
+    o->chg.bucket_n = 0;
     for (int32_t i = n / 2 - 1; i >= 0; i--)
         pend_sift(o, i, n);
     while (n > 0 && sure < limit) {
-        int32_t i = o->loc_pt[0];
-        double most = o->loc_base[0];
+        int32_t i = o->ev.loc_pt[0];
+        double most = o->ev.loc_base[0];
         /* only a segment cheaper than the new one matters: a query within
          * that cost (usually the point's own bucket) */
-        sure += nearest_below(o, i, old, n_old, most + o->pt_cost[i], NULL) - o->pt_cost[i];
+        sure += nearest_below(o, i, old, n_old, most + o->d.pt_cost[i], NULL) - o->d.pt_cost[i];
         n--;
         if (n > 0) {
-            o->loc_base[0] = o->loc_base[n];
-            o->loc_pt[0] = o->loc_pt[n];
+            o->ev.loc_base[0] = o->ev.loc_base[n];
+            o->ev.loc_pt[0] = o->ev.loc_pt[n];
             pend_sift(o, 0, n);
         }
     }

@@ -42,9 +42,9 @@ static int hash_carve(polyc__arena *a, polyc__opt *o, size_t nb, int32_t entry_c
     h->pt_start = polyc__alloc(a, nb + 1, sizeof(uint32_t));
     h->entry_cap = entry_cap;
     h->entries = polyc__alloc(a, (size_t)h->entry_cap, sizeof(polyc__hash_entry));
-    o->bucket_mark = polyc__alloc_zero(a, nb, sizeof(uint32_t));
-    o->bucket_list = polyc__alloc(a, nb, sizeof(int32_t));
-    return h->seg_head && h->pt_start && h->entries && o->bucket_mark && o->bucket_list;
+    o->chg.bucket_mark = polyc__alloc_zero(a, nb, sizeof(uint32_t));
+    o->chg.bucket_list = polyc__alloc(a, nb, sizeof(int32_t));
+    return h->seg_head && h->pt_start && h->entries && o->chg.bucket_mark && o->chg.bucket_list;
 }
 
 void polyc__hash_reserve(polyc__arena *a, polyc__opt *o, const polyc_limits *lim)
@@ -191,7 +191,7 @@ void polyc__segment_buckets(polyc__opt *o, float ax, float ay, float bx, float b
 void polyc__segment_region(polyc__opt *o, float ax, float ay, float bx, float by)
 {
     const polyc__hash *h = &o->h;
-    const uint32_t epoch = o->epoch;
+    const uint32_t epoch = o->chg.epoch;
     path_walk p;
     int32_t ix, iy, around[9];
     if (!path_begin(h, ax, ay, bx, by, &p))
@@ -200,10 +200,10 @@ void polyc__segment_region(polyc__opt *o, float ax, float ay, float bx, float by
         int n = polyc__buckets_around(h, ix, iy, around);
         for (int i = 0; i < n; i++) {
             int32_t k = around[i];
-            if (o->bucket_mark[k] == epoch)
+            if (o->chg.bucket_mark[k] == epoch)
                 continue;
-            o->bucket_mark[k] = epoch;
-            o->bucket_list[o->bucket_n++] = k;
+            o->chg.bucket_mark[k] = epoch;
+            o->chg.bucket_list[o->chg.bucket_n++] = k;
         }
     }
 }

@@ -157,7 +157,7 @@ static void try_cut(polyc__opt *o, int32_t seg, float t, int32_t keep, fix *best
         dk = 1.0;                  /* the cut adds the vertex at the cut */
         dangle = -o->acost[gone];  /* and the far vertex becomes an end */
     }
-    double alpha = (double)o->cfg->alpha, fixed = alpha * (double)o->cfg->gamma * dangle + dk * o->log_n;
+    double alpha = (double)o->cfg->alpha, fixed = alpha * (double)o->cfg->gamma * dangle + dk * o->d.log_n;
     /* a cut only takes map away, so its error change is >= 0: it matters
      * only below the best fix so far, and is exact below that */
     double limit = best->kind != 0 ? (best->delta - fixed) / alpha : (double)INFINITY;
@@ -286,15 +286,15 @@ static void find_sides(polyc__opt *o)
     float *side = o->seg_side;
     for (int32_t v = 0; v < s->v_high; v++)
         side[v] = 0.0f;
-    for (int32_t i = 0; i < o->np; i++) {
-        int32_t sg = o->pt_seg[i];
+    for (int32_t i = 0; i < o->d.np; i++) {
+        int32_t sg = o->d.pt_seg[i];
         if (sg == POLYC__NONE || s->v[sg].next == POLYC__NONE)
             continue;
         const polyc__vertex *a = &s->v[sg], *b = &s->v[a->next];
-        const polyc__point *p = &o->pts[i];
+        const polyc__point *p = &o->d.pts[i];
         if (polyc__seg_dist2(p->x, p->y, a->x, a->y, b->x, b->y) > SIDE_REACH_M * SIDE_REACH_M)
             continue;
-        side[sg] += o->pt_view[2 * i] * (a->y - b->y) + o->pt_view[2 * i + 1] * (b->x - a->x);
+        side[sg] += o->d.pt_view[2 * i] * (a->y - b->y) + o->d.pt_view[2 * i + 1] * (b->x - a->x);
     }
 }
 
@@ -485,7 +485,7 @@ static double drop_delta(polyc__opt *o, int32_t v, float t0, float t1)
         dangle -= o->acost[w];
     }
     double derr = polyc__local_delta(o, &v, 1, xy, n_new, INFINITY);
-    return (double)o->cfg->alpha * (derr + (double)o->cfg->gamma * dangle) + dk * o->log_n;
+    return (double)o->cfg->alpha * (derr + (double)o->cfg->gamma * dangle) + dk * o->d.log_n;
 }
 
 /* Cuts stretch [t0, t1] out of segment v; 0 if there was no room. */

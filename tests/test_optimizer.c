@@ -127,7 +127,7 @@ static void fx_open(fixture *f, float gamma, float noise_m, uint32_t flags)
 {
     fx_context(f, gamma, noise_m, flags);
     fx_setup_opt(f);
-    f->pt_cap = f->o.np;
+    f->pt_cap = f->o.d.np;
 }
 
 /* For hand-made cases: raw points (so that the per-point arrays hold one
@@ -164,22 +164,22 @@ static void set_points_seen(fixture *f, const float *xy, const float *seen_xy, i
     for (int i = 0; i < n; i++) {
         int32_t b = polyc__bucket_of(h, xy[2 * i], xy[2 * i + 1]);
         uint32_t at = h->pt_start[b]++;
-        polyc__point *p = &o->pts[at];
+        polyc__point *p = &o->d.pts[at];
         memset(p, 0, sizeof *p);
         p->x = xy[2 * i];
         p->y = xy[2 * i + 1];
         p->w = 1.0f;
-        if (o->pt_view) {
-            o->pt_view[2 * at] = seen_xy ? seen_xy[2 * i] - p->x : 0.0f;
-            o->pt_view[2 * at + 1] = seen_xy ? seen_xy[2 * i + 1] - p->y : 0.0f;
+        if (o->d.pt_view) {
+            o->d.pt_view[2 * at] = seen_xy ? seen_xy[2 * i] - p->x : 0.0f;
+            o->d.pt_view[2 * at + 1] = seen_xy ? seen_xy[2 * i + 1] - p->y : 0.0f;
         }
     }
     for (int32_t b = nb; b > 0; b--)
         h->pt_start[b] = h->pt_start[b - 1];
     h->pt_start[0] = 0;
-    o->np = n;
-    o->n = (double)n;
-    o->log_n = log(o->n > 1.0 ? o->n : 1.0);
+    o->d.np = n;
+    o->d.n = (double)n;
+    o->d.log_n = log(o->d.n > 1.0 ? o->d.n : 1.0);
 }
 
 static void set_points(fixture *f, const float *xy, int n)
@@ -438,23 +438,23 @@ static void check_books(polyc__opt *o, const char *where)
     check_store(o, where);
     check_hash(o, where);
     double err = 0.0;
-    for (int32_t i = 0; i < o->np; i++) {
-        const polyc__point *p = &o->pts[i];
+    for (int32_t i = 0; i < o->d.np; i++) {
+        const polyc__point *p = &o->d.pts[i];
         int32_t seg;
         double c = brute_nearest(o, p, &seg);
         err += c;
-        if (!close_rel(o->pt_cost[i], c, 1e-12))
+        if (!close_rel(o->d.pt_cost[i], c, 1e-12))
             fail_msg("%s: point %d (%.4f %.4f w %g) cost %.12g, from scratch %.12g (seg %d vs %d)",
-                     where, i, (double)p->x, (double)p->y, (double)p->w, o->pt_cost[i], c,
-                     o->pt_seg[i], seg);
-        int32_t ps = o->pt_seg[i];
+                     where, i, (double)p->x, (double)p->y, (double)p->w, o->d.pt_cost[i], c,
+                     o->d.pt_seg[i], seg);
+        int32_t ps = o->d.pt_seg[i];
         if (ps == POLYC__NONE) {
-            if (o->pt_cost[i] != (double)p->w * (double)o->R2)
-                fail_msg("%s: point %d unassigned with cost %.12g below the cap", where, i, o->pt_cost[i]);
+            if (o->d.pt_cost[i] != (double)p->w * (double)o->R2)
+                fail_msg("%s: point %d unassigned with cost %.12g below the cap", where, i, o->d.pt_cost[i]);
         } else if (!seg_live(o, ps)) {
             fail_msg("%s: point %d assigned to dead segment %d", where, i, ps);
-        } else if (polyc__cost_seg(o, p, ps) != o->pt_cost[i]) {
-            fail_msg("%s: point %d cost %.12g is not its segment %d's %.12g", where, i, o->pt_cost[i],
+        } else if (polyc__cost_seg(o, p, ps) != o->d.pt_cost[i]) {
+            fail_msg("%s: point %d cost %.12g is not its segment %d's %.12g", where, i, o->d.pt_cost[i],
                      ps, polyc__cost_seg(o, p, ps));
         }
     }
@@ -477,13 +477,13 @@ static void check_books(polyc__opt *o, const char *where)
 static double scratch_bic(polyc__opt *o)
 {
     double err = 0.0, angle = 0.0;
-    for (int32_t i = 0; i < o->np; i++)
-        err += brute_nearest(o, &o->pts[i], NULL);
+    for (int32_t i = 0; i < o->d.np; i++)
+        err += brute_nearest(o, &o->d.pts[i], NULL);
     for (int32_t v = 0; v < o->s->v_high; v++)
         if (o->s->v[v].line != POLYC__NONE)
             angle += polyc__vertex_angle_cost(o, v);
     return (double)o->cfg->alpha * (err + (double)o->cfg->gamma * angle) +
-           (double)o->s->v_live * o->log_n;
+           (double)o->s->v_live * o->d.log_n;
 }
 
 /* ---- random edits ---- */
@@ -746,7 +746,7 @@ static void test_move_eval_moments_match(void **state)
             polyc__local_prepare(&f.o, old, 2, xy, ns, reach);
             double plain = polyc__local_eval(&f.o, trial, ns), plain_cur = polyc__local_current(&f.o);
             polyc__local_prepare_move(&f.o, old, 2, xy, ns, reach, x0, y0);
-            aggregated += f.o.agg_n[0] + f.o.agg_n[1];
+            aggregated += f.o.ev.agg_n[0] + f.o.ev.agg_n[1];
             double agg = polyc__local_eval(&f.o, trial, ns), agg_cur = polyc__local_current(&f.o);
             if (!close_rel(plain, agg, 1e-9) || !close_rel(plain_cur, agg_cur, 1e-9))
                 fail_msg("vertex %d trial %d: plain %.12f / %.12f, moments %.12f / %.12f", v, t, plain,
@@ -764,8 +764,8 @@ static void test_move_eval_moments_match(void **state)
 static double brute_error(const polyc__opt *o)
 {
     double e = 0.0;
-    for (int32_t i = 0; i < o->np; i++)
-        e += brute_nearest(o, &o->pts[i], NULL);
+    for (int32_t i = 0; i < o->d.np; i++)
+        e += brute_nearest(o, &o->d.pts[i], NULL);
     return e;
 }
 
@@ -813,10 +813,10 @@ static void test_move_eval_sees_neighbouring_buckets(void **state)
             V[v].y = cy;
             double brute = brute_error(o) - before;
             /* some point of A is nearer to B than to the moved A */
-            for (int32_t i = 0; i < o->np && !differs; i++) {
+            for (int32_t i = 0; i < o->d.np && !differs; i++) {
                 int32_t seg;
-                brute_nearest(o, &o->pts[i], &seg);
-                differs = fabsf(o->pts[i].y - dy) < 1e-4f && seg != POLYC__NONE &&
+                brute_nearest(o, &o->d.pts[i], &seg);
+                differs = fabsf(o->d.pts[i].y - dy) < 1e-4f && seg != POLYC__NONE &&
                           o->s->v[seg].line != la;
             }
             V[v].x = x0;
@@ -837,7 +837,7 @@ static void test_trial_costs_by_field_match(void **state)
     (void)state;
     static fixture f;
     fx_open(&f, 0.0f, 0.002f, 0); /* weighted: moments in the costs */
-    assert_true(f.o.lsoa_cap > 0); /* several scans: the copy is made */
+    assert_true(f.o.ev.lsoa_cap > 0); /* several scans: the copy is made */
     polyc__rng r = {91};
     make_start_map(&f.o, &r);
     polyc__op_noise(&f.o, 0.02);
@@ -862,11 +862,11 @@ static void test_trial_costs_by_field_match(void **state)
                     polyc__local_prepare_move(&f.o, old, 2, xy, 2, reach, x0, y0);
                 else
                     polyc__local_prepare(&f.o, old, 2, xy, 2, reach);
-                if (f.o.lsoa_n != f.o.loc_n)
+                if (f.o.ev.lsoa_n != f.o.ev.loc_n)
                     continue;
                 by_field++;
                 double vec = polyc__local_eval(&f.o, trial, 2);
-                f.o.lsoa_n = -1;
+                f.o.ev.lsoa_n = -1;
                 double one = polyc__local_eval(&f.o, trial, 2);
                 if (memcmp(&vec, &one, sizeof vec) != 0)
                     fail_msg("vertex %d trial %d move %d: by field %.17g, point by point %.17g", v, t,
@@ -1193,8 +1193,8 @@ static double longest_unsupported(const polyc__opt *o)
         for (int k = 0; k <= n; k++) {
             double x = (double)V[a].x + dx * k / n, y = (double)V[a].y + dy * k / n;
             int near = 0;
-            for (int32_t i = 0; i < o->np && !near; i++) {
-                double ex = (double)o->pts[i].x - x, ey = (double)o->pts[i].y - y;
+            for (int32_t i = 0; i < o->d.np && !near; i++) {
+                double ex = (double)o->d.pts[i].x - x, ey = (double)o->d.pts[i].y - y;
                 near = ex * ex + ey * ey <= 0.0025;
             }
             run = near ? 0.0 : run + len / n;
@@ -1690,7 +1690,7 @@ static void test_remove_collinear_vertex(void **state)
     int32_t l = add_line(&f.o, xy, 3, 0);
     rebuild(&f.o);
     double d = polyc__removal_delta_below(&f.o, 1, INFINITY);
-    assert_true(fabs(d + f.o.log_n) < 1e-9); /* no error change, one vertex less */
+    assert_true(fabs(d + f.o.d.log_n) < 1e-9); /* no error change, one vertex less */
     assert_int_equal(polyc__op_remove_vertices(&f.o, 0), 1);
     check_books(&f.o, "remove");
     assert_line_is(&f.o, l, after, 2);
@@ -1767,7 +1767,7 @@ static void test_removal_delta_is_exact(void **state)
             double before = polyc__bic(&f.o), d = polyc__removal_delta_below(&f.o, v, INFINITY);
             /* bounded: exact below the bound, at least the bound above it */
             for (int b = 0; b < 3; b++) {
-                double bound = b == 0 ? 0.0 : (b == 1 ? f.o.log_n : d), db = polyc__removal_delta_below(&f.o, v, bound);
+                double bound = b == 0 ? 0.0 : (b == 1 ? f.o.d.log_n : d), db = polyc__removal_delta_below(&f.o, v, bound);
                 if (d < bound ? fabs(db - d) > 1e-6 * (1.0 + fabs(before)) : db < bound - 1e-9 * (1.0 + fabs(before)))
                     fail_msg("vertex %d bound %.6f: exact %.9f, bounded %.9f", v, bound, d, db);
             }
@@ -2034,12 +2034,12 @@ static void test_hash_matches_brute_force(void **state)
     set_points(&f, xy, n);
     rebuild(&f.o);
     int within = 0;
-    for (int32_t i = 0; i < f.o.np; i++) {
+    for (int32_t i = 0; i < f.o.d.np; i++) {
         int32_t sh, sb;
-        double ch = polyc__nearest(&f.o, i, NULL, 0, &sh), cb = brute_nearest(&f.o, &f.o.pts[i], &sb);
+        double ch = polyc__nearest(&f.o, i, NULL, 0, &sh), cb = brute_nearest(&f.o, &f.o.d.pts[i], &sb);
         if (ch != cb)
             fail_msg("point (%.3f, %.3f): hash %.12g (seg %d), brute force %.12g (seg %d)",
-                     (double)f.o.pts[i].x, (double)f.o.pts[i].y, ch, sh, cb, sb);
+                     (double)f.o.d.pts[i].x, (double)f.o.d.pts[i].y, ch, sh, cb, sb);
         within += sb != POLYC__NONE;
     }
     assert_true(within > n / 4); /* the check saw many points in reach */
@@ -2085,17 +2085,17 @@ static void test_hash_segment_leaving_area(void **state)
         rebuild(&f.o);
         int bad = 0;
         float bx = 0.0f, by = 0.0f;
-        for (int32_t i = 0; i < f.o.np; i++) {
+        for (int32_t i = 0; i < f.o.d.np; i++) {
             double ch = polyc__nearest(&f.o, i, NULL, 0, NULL);
-            double cb = brute_nearest(&f.o, &f.o.pts[i], NULL);
+            double cb = brute_nearest(&f.o, &f.o.d.pts[i], NULL);
             if (ch != cb && bad++ == 0) {
-                bx = f.o.pts[i].x;
-                by = f.o.pts[i].y;
+                bx = f.o.d.pts[i].x;
+                by = f.o.d.pts[i].y;
             }
         }
         if (bad)
             fail_msg("segment (0, 0)-(%g, %g): %d of %d points miss it, e.g. (%.3f, %.3f)",
-                     (double)far_end[c][0], (double)far_end[c][1], bad, f.o.np, (double)bx,
+                     (double)far_end[c][0], (double)far_end[c][1], bad, f.o.d.np, (double)bx,
                      (double)by);
     }
     fx_close(&f);
