@@ -421,7 +421,7 @@ static polyc_status stage_grid(polyc_ctx *ctx)
 /* Initial polylines from a single scan's beam order (scan_chains.c) */
 static int one_scan_chains(const polyc_ctx *ctx)
 {
-    return ctx->scan_count == 1 && !(ctx->cfg.flags & POLYC_FLAG_GRID_TRACE);
+    return polyc__input_kind(ctx) == POLYC__INPUT_ONE_SCAN;
 }
 
 static polyc_status stage_contour(polyc_ctx *ctx)

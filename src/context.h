@@ -60,6 +60,23 @@ struct polyc_ctx {
 
 #define POLYC__MAGIC 0x706f6c79u   /* "poly" */
 
+/* The kind of input, decided here once: an occupancy grid, a single scan
+ * (mapped from its beam order, scan_chains.c, and checked against its
+ * beams, ray_check.c; unless POLYC_FLAG_GRID_TRACE asks for the grid's
+ * trace) or scans. */
+typedef enum polyc__input {
+    POLYC__INPUT_SCANS = 0,
+    POLYC__INPUT_ONE_SCAN,
+    POLYC__INPUT_GRID
+} polyc__input;
+static inline polyc__input polyc__input_kind(const polyc_ctx *ctx)
+{
+    if (ctx->from_grid)
+        return POLYC__INPUT_GRID;
+    return ctx->scan_count == 1 && !(ctx->cfg.flags & POLYC_FLAG_GRID_TRACE) ? POLYC__INPUT_ONE_SCAN
+                                                                              : POLYC__INPUT_SCANS;
+}
+
 /* errors: keep the first message of an operation */
 static inline polyc_status polyc__fail(polyc_ctx *ctx, polyc_status st, const char *msg)
 {

@@ -591,7 +591,7 @@ int polyc__op_split(polyc__opt *o)
         float gx = a->x + (b->x - a->x) * (g0 + 0.5f * best) / len;
         float gy = a->y + (b->y - a->y) * (g0 + 0.5f * best) / len;
         float need = gap_needed(o, gx, gy);
-        if (best > need && o->ctx->from_grid)
+        if (best > need && o->pol.gaps_free_only)
             best = free_length(o, a, b, len, g0, best);
         if (best > need && n_cut < o->split.cut_cap) {
             o->split.cut_seg[n_cut] = v;

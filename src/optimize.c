@@ -73,6 +73,18 @@ void polyc__optimizer_reserve(polyc__arena *a, const polyc_config *cfg, const po
  * iterations, 0.85 s, the same map. */
 #define GRID_GAIN 2e-3
 
+static polyc__policy policy_for(polyc__input kind)
+{
+    polyc__policy p;
+    int one = kind == POLYC__INPUT_ONE_SCAN, grid = kind == POLYC__INPUT_GRID;
+    p.restructure = p.add_vertices = p.noise = !one;
+    p.climb_since_prev = p.stop_without_gain = one;
+    p.gain_share = grid ? GRID_GAIN : 0.0;
+    p.noise_spares_patience = p.recover = !grid;
+    p.gaps_free_only = grid;
+    return p;
+}
+
 static const polyc_config *grid_config(polyc_ctx *ctx)
 {
     polyc_config *c = &ctx->grid_cfg;
@@ -92,7 +104,9 @@ polyc_status polyc__opt_setup(polyc_ctx *ctx, polyc__opt *o)
 {
     memset(o, 0, sizeof *o);
     o->ctx = ctx;
-    o->cfg = ctx->from_grid ? grid_config(ctx) : &ctx->cfg;
+    polyc__input kind = polyc__input_kind(ctx);
+    o->pol = policy_for(kind);
+    o->cfg = kind == POLYC__INPUT_GRID ? grid_config(ctx) : &ctx->cfg;
     o->s = &ctx->store;
     o->R = o->cfg->search_radius_m;
     o->R2 = o->R * o->R;
@@ -213,8 +227,8 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
          * could not correct it. Without noise, only what changed since the
          * previous iteration is adjusted and offered for removal again. */
         double noise = it > 0 && sigma >= 0.5 * (double)cfg->step_m ? sigma : 0.0;
-        if (o.rays.on)
-            noise = 0.0; /* single scan: see docs/algorithm.md */
+        if (!o.pol.noise)
+            noise = 0.0;
         if (noise > 0.0) {
             polyc__op_noise(&o, noise);
             o.untangle_mark = o.zip_mark = 0; /* every segment moved */
@@ -223,9 +237,7 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
         }
         uint32_t since = it == 0 || noise > 0.0 ? 0 : prev_start;
         prev_start = start;
-        if (!o.rays.on) {
-            /* a single scan's chains already join what its beam order
-             * joins: overlaps, merges and splits are its beams' business */
+        if (o.pol.restructure) {
             polyc__op_overlaps(&o);      /* A */
             polyc__op_merge(&o);         /* B */
             polyc__op_split(&o);         /* C */
@@ -237,26 +249,26 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
          * optimum stay there (on 200 freiburg-campus scans, with ends not
          * climbed, climbing them again takes a sixth of the time and
          * lowers the BIC by 0.15 %) */
-        polyc__op_adjust(&o, POLYC__ADJUST_ROUNDS, o.rays.on && it > 0 ? prev_mark : since);
+        polyc__op_adjust(&o, POLYC__ADJUST_ROUNDS, o.pol.climb_since_prev && it > 0 ? prev_mark : since);
         uint32_t mark = ++o.touch_stamp;
         prev_mark = mark;
         polyc__op_zigzag(&o);            /* E */
         polyc__op_corners(&o, since);    /* corners (not in the paper) */
         polyc__op_remove_vertices(&o, mark); /* G */
-        if (!o.rays.on) /* a single scan's chains start with more than enough */
+        if (o.pol.add_vertices)
             polyc__op_add_vertices(&o, POLYC__ADD_ROUNDS); /* G, more vertices */
         polyc__op_adjust(&o, POLYC__ADJUST_ROUNDS, mark);
         /* moves and additions can leave segments without data or hairpins:
          * clean them before the model is judged, so the best one is clean */
         for (int round = 0; round < POLYC__CLEAN_ROUNDS; round++) {
             mark = ++o.touch_stamp;
-            if ((o.rays.on ? 0 : polyc__op_split(&o)) + polyc__op_zigzag(&o) +
+            if ((!o.pol.restructure ? 0 : polyc__op_split(&o)) + polyc__op_zigzag(&o) +
                     polyc__op_corners(&o, since) == 0)
                 break;
             polyc__op_adjust(&o, POLYC__ADJUST_ROUNDS, mark);
         }
         polyc__op_trim_ends(&o); /* moves could push ends past the data */
-        if (!o.rays.on)
+        if (o.pol.restructure)
             polyc__op_zip(&o);   /* one piece of map per wall */
         polyc__op_untangle(&o);  /* last: the map judged has no crossing */
         if (o.h.out_of_entries)
@@ -269,12 +281,12 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
          * on purpose, and a run of them all worse than iteration 0 stopped
          * infinite-corridor at iteration 5 with 5,766 vertices (3,793 when
          * the noise is allowed to decay) */
-        int gained = bic < best - (ctx->from_grid ? fmax(1.0, GRID_GAIN * fabs(best)) : 1.0);
+        int gained = bic < best - (o.pol.gain_share > 0.0 ? fmax(1.0, o.pol.gain_share * fabs(best)) : 1.0);
         /* Nor do iterations that are still coming down from the noise by
          * more than POLYC__RECOVER_GAIN of the BIC each (tunables.h) */
-        int recovering = !ctx->from_grid && it > 0 && bic < prev_bic - POLYC__RECOVER_GAIN * fabs(prev_bic);
+        int recovering = o.pol.recover && it > 0 && bic < prev_bic - POLYC__RECOVER_GAIN * fabs(prev_bic);
         prev_bic = bic;
-        quiet = gained ? 0 : ((noise > 0.0 && !ctx->from_grid) || recovering ? quiet : quiet + 1);
+        quiet = gained ? 0 : ((noise > 0.0 && o.pol.noise_spares_patience) || recovering ? quiet : quiet + 1);
         if (bic < best - 1e-9 * fabs(best)) {
             best = bic;
             polyc__flat_from_store(&o.best, o.s);
@@ -300,14 +312,14 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
          * and of what the previous one edited: one that edited nothing is
          * followed by copies of itself, so the patience would run out on
          * the same best map. */
-        int noisy_later = !o.rays.on && sigma >= 0.5 * (double)cfg->step_m;
+        int noisy_later = o.pol.noise && sigma >= 0.5 * (double)cfg->step_m;
         if (!noisy_later && !edited_since(&o, start))
             break;
         /* A single scan has no noise either: an iteration that gained less
          * than one BIC unit leaves so little edited that the next ones gain
          * nothing measurable (the 130 bench scans: 4 vertices more in
          * all, the same f and ray RMSE, 4 % fewer instructions) */
-        if (o.rays.on && !gained)
+        if (o.pol.stop_without_gain && !gained)
             break;
     }
     ctx->stats.iterations = it < cfg->max_iterations ? it + (result == POLYC_OK) : it;
@@ -317,7 +329,7 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
     ctx->opt_result_valid = 1;
     if ((st = polyc__rebuild(&o)) != POLYC_OK)
         return st;
-    if (!o.rays.on && result == POLYC_OK && (st = polish(&o, best)) != POLYC_OK)
+    if (o.pol.restructure && result == POLYC_OK && (st = polish(&o, best)) != POLYC_OK)
         return st;
     fill_stats(&o);
     return result;

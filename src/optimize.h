@@ -103,6 +103,28 @@ typedef struct polyc__data {
                                     * or a point's span where that is wider (grids) */
 } polyc__data;
 
+/* What the search does for the kind of input (polyc__input_kind), decided
+ * once in polyc__opt_setup; the loop (optimize.c) reads it. */
+typedef struct polyc__policy {
+    /* A single scan's chains already join what its beam order joins: no
+     * overlaps, merges, splits or zips (A, B, C), nor the polish of the
+     * best map; they start with more than enough vertices: no additions
+     * (G); and no noise (F, docs/algorithm.md) */
+    int restructure, add_vertices, noise;
+    /* a single scan's later iterations climb only what the previous one
+     * edited after its first climbs, and it stops after an iteration
+     * without gain */
+    int climb_since_prev, stop_without_gain;
+    /* an occupancy grid: an iteration gains only if the BIC falls by more
+     * than gain_share of it (0: by one unit); noisy iterations and ones
+     * still recovering from the noise do not spare the patience */
+    double gain_share;
+    int noise_spares_patience, recover;
+    /* an occupancy grid: a gap in the data is cut only as far as the grid
+     * has free cells along it (operators.c) */
+    int gaps_free_only;
+} polyc__policy;
+
 /* The optimiser's long-lived state: the model and its terms, the spatial
  * index, the books of the current change and the stamps; each operator
  * group's working state is its own struct, carved by its file. */
@@ -110,6 +132,7 @@ typedef struct polyc__opt {
     polyc_ctx *ctx;
     const polyc_config *cfg;       /* ctx->cfg, or ctx->grid_cfg for an occupancy grid */
     polyc__store *s;
+    polyc__policy pol;
     float R, R2;                   /* search radius: the cost of a point is capped at w R^2 */
 
     polyc__data d;
