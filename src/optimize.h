@@ -284,6 +284,7 @@ void polyc__op_remove(polyc__opt *o, int32_t v);
 int32_t polyc__op_insert_after(polyc__opt *o, int32_t u, float x, float y);
 void polyc__op_cut(polyc__opt *o, int32_t u);                 /* cut link u -> next */
 int polyc__op_link(polyc__opt *o, int32_t tail, int32_t head); /* join or close */
+void polyc__op_reverse(polyc__opt *o, int32_t l);              /* reverse polyline l */
 /* one edit as a change of its own (begin, edit, commit) */
 void polyc__apply_remove(polyc__opt *o, int32_t v);
 void polyc__apply_move(polyc__opt *o, int32_t v, float x, float y);
