@@ -178,6 +178,8 @@ typedef struct polyc__opt {
 /* score.c: the books of a change for V vertices; trial evaluation's scratch
  * for P points (lsoa_cap: listed points copied by field, 0 for none) */
 int polyc__change_carve(polyc__arena *a, polyc__change *c, int32_t V);
+/* change.c: lists the buckets a segment's points can be in for rescoring */
+void polyc__chg_mark_region(polyc__opt *o, int32_t seg);
 int polyc__eval_carve(polyc__arena *a, polyc__eval_scratch *ev, int32_t P, int32_t lsoa_cap);
 /* operators.c: split and trim scratch; model_size.c: vertex removal's */
 int polyc__split_carve(polyc__arena *a, polyc__split_scratch *sp, int32_t P, int32_t V);

@@ -1,0 +1,43 @@
+/* cost.h - the cost kernel (paper eq. 2), inline: the cost of a weighted
+ * point against a segment. cost.c exports it (polyc__cost) to the files
+ * that price trials; the trial evaluation (score.c) and the books
+ * (change.c) use it inline in their loops. */
+#ifndef POLYC_COST_H
+#define POLYC_COST_H
+
+#include "optimize.h"
+
+/* Sum of squared distances of a weighted point's endpoints to segment a-b,
+ * all of them taken to fall in the region (interior or end) of their mean. */
+static inline double polyc__point_cost(const polyc__point *p, float ax, float ay, float bx, float by)
+{
+    double dx = (double)bx - (double)ax, dy = (double)by - (double)ay;
+    double mx = (double)p->x - (double)ax, my = (double)p->y - (double)ay;
+    double l2 = dx * dx + dy * dy;
+    double trace = (double)p->cxx + (double)p->cyy;
+    double t = l2 > 1e-18 ? (mx * dx + my * dy) / l2 : 0.0;
+    if (t <= 0.0)
+        return (double)p->w * (mx * mx + my * my) + trace;
+    if (t >= 1.0) {
+        double ex = (double)p->x - (double)bx, ey = (double)p->y - (double)by;
+        return (double)p->w * (ex * ex + ey * ey) + trace;
+    }
+    /* w (n.m)^2 + n'Cn with n = (-dy, dx) / |d|: one division, no root.
+     * C, central moments summed in float, can be a rounding error short of
+     * positive semi-definite (cxy^2 > cxx cyy): n'Cn then dips below 0 for
+     * a point whose endpoints lie on a line, and a map's error could be
+     * -1e-12 (found by fuzz_library). A sum of squares is never negative. */
+    double cross = dx * my - dy * mx;
+    double c = ((double)p->w * cross * cross + dy * dy * (double)p->cxx -
+                2.0 * dx * dy * (double)p->cxy + dx * dx * (double)p->cyy) / l2;
+    return c > 0.0 ? c : 0.0;
+}
+
+static inline double polyc__point_seg_cost(const polyc__opt *o, const polyc__point *p, int32_t seg)
+{
+    const polyc__vertex *a = &o->s->v[seg];
+    const polyc__vertex *b = &o->s->v[a->next];
+    return polyc__point_cost(p, a->x, a->y, b->x, b->y);
+}
+
+#endif
