@@ -280,9 +280,9 @@ polyc_status polyc_init(void *block, size_t size, const polyc_config *config,
     if (!scans_carve(&ctx->arena, limits, &ctx->scans, &ctx->ranges))
         return POLYC_ERR_NOMEM;
     ctx->scans_mark = ctx->base_mark = ctx->arena.used;
-    ctx->frame_cos = 1.0;
+    ctx->frame_dir.cos = 1.0;
     ctx->stats.memory_size_bytes = size;
-    ctx->error_scan = -1;
+    ctx->err.scan = -1;
     *out = ctx;
     return POLYC_OK;
 }
@@ -294,16 +294,16 @@ polyc_status polyc_reset(polyc_ctx *ctx)
         return cst;
     ctx->arena.used = ctx->scans_mark = ctx->base_mark;
     ctx->scan_count = ctx->range_count = 0;
-    ctx->have_frame = ctx->have_extent = 0;
+    ctx->have_frame = ctx->ext.have = 0;
     ctx->from_grid = 0;
     ctx->frame_x = ctx->frame_y = 0.0;
-    ctx->frame_cos = 1.0;
-    ctx->frame_sin = 0.0;
+    ctx->frame_dir.cos = 1.0;
+    ctx->frame_dir.sin = 0.0;
     memset(&ctx->grid, 0, sizeof ctx->grid);
     ctx->contour_count = 0;
     ctx->stage = POLYC__STAGE_SCANS;
-    ctx->error = NULL;
-    ctx->error_scan = -1;
+    ctx->err.msg = NULL;
+    ctx->err.scan = -1;
     ctx->flat.count = 0;
     uint64_t size = ctx->stats.memory_size_bytes;
     memset(&ctx->stats, 0, sizeof ctx->stats);
@@ -316,7 +316,7 @@ polyc_status polyc_add_scan(polyc_ctx *ctx, const polyc_scan *s)
     polyc_status cst = check_ctx(ctx);
     if (cst != POLYC_OK || !s)
         return cst != POLYC_OK ? cst : POLYC_ERR_NULL;
-    ctx->error = NULL;
+    ctx->err.msg = NULL;
     if (ctx->from_grid)
         return polyc__fail(ctx, POLYC_ERR_STATE,
                            "the context holds a grid: scans need a context of their own");
@@ -335,7 +335,7 @@ polyc_status polyc_add_scan(polyc_ctx *ctx, const polyc_scan *s)
     else if (s->reserved != 0)
         bad = "scan.reserved must be 0";
     if (bad) {
-        ctx->error_scan = (int32_t)ctx->scan_count;
+        ctx->err.scan = (int32_t)ctx->scan_count;
         return polyc__fail(ctx, POLYC_ERR_SCAN, bad);
     }
     if (ctx->scan_count >= ctx->lim.max_scans ||
@@ -364,12 +364,12 @@ polyc_status polyc_add_scan(polyc_ctx *ctx, const polyc_scan *s)
             ctx->stats.hits++;
         ctx->ranges[ctx->range_count + i] = r;
     }
-    double box[4] = {ctx->ext_min_x, ctx->ext_min_y, ctx->ext_max_x, ctx->ext_max_y};
-    extent_add(s, ctx->frame_x, ctx->frame_y, box, &ctx->have_extent);
-    ctx->ext_min_x = box[0];
-    ctx->ext_min_y = box[1];
-    ctx->ext_max_x = box[2];
-    ctx->ext_max_y = box[3];
+    double box[4] = {ctx->ext.min_x, ctx->ext.min_y, ctx->ext.max_x, ctx->ext.max_y};
+    extent_add(s, ctx->frame_x, ctx->frame_y, box, &ctx->ext.have);
+    ctx->ext.min_x = box[0];
+    ctx->ext.min_y = box[1];
+    ctx->ext.max_x = box[2];
+    ctx->ext.max_y = box[3];
     ctx->range_count += s->beam_count;
     ctx->scan_count++;
     ctx->stats.scans = ctx->scan_count;
@@ -383,7 +383,7 @@ polyc_status polyc_add_grid(polyc_ctx *ctx, const polyc_occupancy_grid *grid)
     polyc_status cst = check_ctx(ctx);
     if (cst != POLYC_OK || !grid)
         return cst != POLYC_OK ? cst : POLYC_ERR_NULL;
-    ctx->error = NULL;
+    ctx->err.msg = NULL;
     return polyc__occ_add(ctx, grid);
 }
 
@@ -438,8 +438,8 @@ static void export_result(polyc_ctx *ctx)
     polyc__flat_from_store(&ctx->flat, &ctx->store);
     for (uint32_t i = 0; ctx->from_grid && i < ctx->flat.points; i++) {
         double x = (double)ctx->flat.xy[2 * i], y = (double)ctx->flat.xy[2 * i + 1];
-        ctx->flat.xy[2 * i] = (float)(ctx->frame_x + ctx->frame_cos * x - ctx->frame_sin * y);
-        ctx->flat.xy[2 * i + 1] = (float)(ctx->frame_y + ctx->frame_sin * x + ctx->frame_cos * y);
+        ctx->flat.xy[2 * i] = (float)(ctx->frame_x + ctx->frame_dir.cos * x - ctx->frame_dir.sin * y);
+        ctx->flat.xy[2 * i + 1] = (float)(ctx->frame_y + ctx->frame_dir.sin * x + ctx->frame_dir.cos * y);
     }
     for (uint32_t i = 0; !ctx->from_grid && i < ctx->flat.points; i++) {
         ctx->flat.xy[2 * i] = (float)((double)ctx->flat.xy[2 * i] + ctx->frame_x);
@@ -501,7 +501,7 @@ polyc_status polyc_build_grid(polyc_ctx *ctx)
     polyc_status cst = check_ctx(ctx);
     if (cst != POLYC_OK)
         return cst;
-    ctx->error = NULL;
+    ctx->err.msg = NULL;
     /* explicit call: rebuild (an occupancy grid's is its input: the results
      * after it are dropped) */
     ctx->stage = ctx->from_grid ? POLYC__STAGE_CONTOUR : POLYC__STAGE_SCANS;
@@ -513,7 +513,7 @@ polyc_status polyc_extract_contour(polyc_ctx *ctx)
     polyc_status cst = check_ctx(ctx);
     if (cst != POLYC_OK)
         return cst;
-    ctx->error = NULL;
+    ctx->err.msg = NULL;
     if (ctx->stage >= POLYC__STAGE_CONTOUR)
         ctx->stage = ctx->from_grid ? POLYC__STAGE_CONTOUR : POLYC__STAGE_GRID;
     return need_stage(ctx, POLYC__STAGE_CONTOUR);
@@ -524,7 +524,7 @@ polyc_status polyc_trace(polyc_ctx *ctx)
     polyc_status cst = check_ctx(ctx);
     if (cst != POLYC_OK)
         return cst;
-    ctx->error = NULL;
+    ctx->err.msg = NULL;
     if (ctx->stage >= POLYC__STAGE_TRACE)
         ctx->stage = POLYC__STAGE_CONTOUR;
     return need_stage(ctx, POLYC__STAGE_TRACE);
@@ -553,7 +553,7 @@ polyc_status polyc_optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *us
     polyc_status cst = check_ctx(ctx);
     if (cst != POLYC_OK)
         return cst;
-    ctx->error = NULL;
+    ctx->err.msg = NULL;
     polyc_status st = need_stage(ctx, POLYC__STAGE_TRACE);
     if (st != POLYC_OK)
         return st;
@@ -576,7 +576,7 @@ polyc_status polyc_build(polyc_ctx *ctx, polyc_progress_fn progress, void *user)
     polyc_status cst = check_ctx(ctx);
     if (cst != POLYC_OK)
         return cst;
-    ctx->error = NULL;
+    ctx->err.msg = NULL;
     polyc_status st = need_stage(ctx, POLYC__STAGE_TRACE);
     if (st != POLYC_OK || ctx->cfg.max_iterations == 0)
         return st;
@@ -588,7 +588,7 @@ polyc_status polyc_score(polyc_ctx *ctx, double *bic, double *err)
     polyc_status cst = check_ctx(ctx);
     if (cst != POLYC_OK)
         return cst;
-    ctx->error = NULL;
+    ctx->err.msg = NULL;
     if (ctx->stage < POLYC__STAGE_TRACE)
         return polyc__fail(ctx, POLYC_ERR_STATE, "no polylines yet: run polyc_trace first");
     ctx->arena.used = ctx->trace_mark;
@@ -693,5 +693,5 @@ const char *polyc_last_error(const polyc_ctx *ctx)
         return "called from inside the progress callback";
     if (cst != POLYC_OK)
         return "invalid context";
-    return ctx->error ? ctx->error : "";
+    return ctx->err.msg ? ctx->err.msg : "";
 }

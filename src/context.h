@@ -16,6 +16,24 @@ typedef enum polyc__stage {
     POLYC__STAGE_OPTIMIZED
 } polyc__stage;
 
+/* the first error of an operation: its static message and, for one met in
+ * a scan, that scan's index (-1: none) */
+typedef struct polyc__error {
+    const char *msg;
+    int32_t scan;
+} polyc__error;
+
+/* a direction, as its cosine and sine */
+typedef struct polyc__turn {
+    double cos, sin;
+} polyc__turn;
+
+/* a box, with whether it holds anything yet */
+typedef struct polyc__extent {
+    double min_x, min_y, max_x, max_y;
+    int have;
+} polyc__extent;
+
 struct polyc_ctx {
     uint32_t magic;
     polyc_config cfg;
@@ -23,25 +41,23 @@ struct polyc_ctx {
     polyc__arena arena;
     size_t scans_mark;             /* arena use after the fixed scan storage */
     polyc__stage stage;
-    const char *error;
-    int32_t error_scan;
+    polyc__error err;
 
     double frame_x, frame_y;       /* first pose: stored floats are relative to it */
     int have_frame;
     /* an occupancy grid (occupancy.c) instead of scans: stored floats are in
      * its frame, whose corner is frame_x, frame_y and whose x axis points
-     * along (frame_cos, frame_sin); its grid and contour are input, kept
+     * along frame_dir; its grid and contour are input, kept
      * below scans_mark */
     int from_grid;
-    double frame_cos, frame_sin;
+    polyc__turn frame_dir;
     size_t base_mark;              /* arena use after polyc_init's scan storage */
     polyc_config grid_cfg;         /* the optimiser's weights for it (optimize.c);
                                       here, not on the optimiser's stack */
     polyc__scan *scans;
     float *ranges;
     uint32_t scan_count, range_count;
-    double ext_min_x, ext_min_y, ext_max_x, ext_max_y; /* frame-relative extent */
-    int have_extent;
+    polyc__extent ext;             /* frame-relative extent of the scans */
 
     polyc__grid grid;
     int32_t *contour_xy;           /* 2 per contour cell */
@@ -80,8 +96,8 @@ static inline polyc__input polyc__input_kind(const polyc_ctx *ctx)
 /* errors: keep the first message of an operation */
 static inline polyc_status polyc__fail(polyc_ctx *ctx, polyc_status st, const char *msg)
 {
-    if (ctx && !ctx->error)
-        ctx->error = msg;
+    if (ctx && !ctx->err.msg)
+        ctx->err.msg = msg;
     return st;
 }
 

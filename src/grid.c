@@ -286,20 +286,20 @@ polyc_status polyc__grid_build(polyc_ctx *ctx)
 {
     polyc__grid *g = &ctx->grid;
     memset(g, 0, sizeof *g);
-    if (!ctx->have_extent)
+    if (!ctx->ext.have)
         return POLYC_OK; /* no data: an empty grid */
     float cell = ctx->cfg.cell_m;
     double cell_d = (double)cell, ext = (double)ctx->cfg.max_extent_m;
     double pad = 2.0 * cell_d;
-    double w_m = ctx->ext_max_x - ctx->ext_min_x + 2.0 * pad;
-    double h_m = ctx->ext_max_y - ctx->ext_min_y + 2.0 * pad;
+    double w_m = ctx->ext.max_x - ctx->ext.min_x + 2.0 * pad;
+    double h_m = ctx->ext.max_y - ctx->ext.min_y + 2.0 * pad;
     if (w_m > ext || h_m > ext)
         return polyc__fail(ctx, POLYC_ERR_EXTENT,
                            "the data span more than config.max_extent_m (a far-away scan?)");
     g->cell_m = cell;
     g->inv_cell = 1.0f / cell;
-    g->origin_x_m = ctx->frame_x + ctx->ext_min_x - pad;
-    g->origin_y_m = ctx->frame_y + ctx->ext_min_y - pad;
+    g->origin_x_m = ctx->frame_x + ctx->ext.min_x - pad;
+    g->origin_y_m = ctx->frame_y + ctx->ext.min_y - pad;
     double wc = ceil(w_m / cell_d), hc = ceil(h_m / cell_d);
     if (wc > 2147483000.0 || hc > 2147483000.0)
         return polyc__fail(ctx, POLYC_ERR_EXTENT, "grid too large for 32-bit cell indices");

@@ -331,8 +331,8 @@ polyc_status polyc__occ_add(polyc_ctx *ctx, const polyc_occupancy_grid *grid)
     ctx->frame_x = grid->origin_x_m;
     ctx->frame_y = grid->origin_y_m;
     ctx->have_frame = 1;
-    ctx->frame_cos = cos(grid->origin_yaw_rad);
-    ctx->frame_sin = sin(grid->origin_yaw_rad);
+    ctx->frame_dir.cos = cos(grid->origin_yaw_rad);
+    ctx->frame_dir.sin = sin(grid->origin_yaw_rad);
     /* the grid and its contour are this context's input: stages restart
      * after them */
     ctx->scans_mark = ctx->grid_mark = ctx->contour_mark = ctx->arena.used;

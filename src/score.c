@@ -235,6 +235,48 @@ static double nearest_candidate(const polyc__opt *o, int32_t pi, double start, i
 
 /* The old segments of an edit, for the test every listed point makes: the
  * first two compared directly (a climb has two), the rest in a loop. */
+/* The aggregation of a move (prepare): on when moving the shared end of at
+ * most two segments; each segment's fixed end. */
+static void agg_begin(polyc__eval_scratch *ev, int move, const float *seg_xy, int n_new, float mx,
+                      float my)
+{
+    ev->agg_on = move && n_new <= 2;
+    ev->agg_n[0] = ev->agg_n[1] = 0;
+    for (int j = 0; j < 2; j++) {
+        ev->agg_m[j][0] = ev->agg_m[j][1] = ev->agg_m[j][2] = 0.0;
+        ev->agg_moving_b[j] = 0;
+        ev->agg_ax[j] = ev->agg_ay[j] = 0.0;
+    }
+    if (ev->agg_on)
+        for (int j = 0; j < n_new; j++) {
+            const float *q = seg_xy + 4 * j;
+            int b = q[2] == mx && q[3] == my;
+            ev->agg_moving_b[j] = b;
+            ev->agg_ax[j] = (double)(b ? q[0] : q[2]);
+            ev->agg_ay[j] = (double)(b ? q[1] : q[3]);
+        }
+}
+
+/* The listed points again, by field (trial_costs.c) */
+static void copy_listed(polyc__opt *o)
+{
+    o->ev.lsoa_n = -1;
+    /* for a few points (most of a single scan's trials) the copy costs
+     * more than it saves */
+    if (o->ev.loc_n >= 8 && o->ev.loc_n <= o->ev.lsoa_cap) {
+        for (int32_t k = 0; k < o->ev.loc_n; k++) {
+            const polyc__point *p = &o->d.pts[o->ev.loc_pt[k]];
+            o->ev.lsoa_x[k] = (double)p->x;
+            o->ev.lsoa_y[k] = (double)p->y;
+            o->ev.lsoa_w[k] = (double)p->w;
+            o->ev.lsoa_cxx[k] = (double)p->cxx;
+            o->ev.lsoa_cxy[k] = (double)p->cxy;
+            o->ev.lsoa_cyy[k] = (double)p->cyy;
+        }
+        o->ev.lsoa_n = o->ev.loc_n;
+    }
+}
+
 /* Collects the points near the `old` segments and the candidate geometry,
  * with their cost when the old segments are gone (loc_base, loc_seg). With
  * reach > 0 the candidates stay within `reach` of seg_xy: a point not on an
@@ -266,21 +308,7 @@ static void prepare(polyc__opt *o, const int32_t *old, int n_old, const float *s
     o->ev.loc_n = 0;
     o->ev.loc_fixed = 0.0;
     o->ev.loc_fixed_cur = 0.0;
-    o->ev.agg_on = move && n_new <= 2;
-    o->ev.agg_n[0] = o->ev.agg_n[1] = 0;
-    for (int j = 0; j < 2; j++) {
-        o->ev.agg_m[j][0] = o->ev.agg_m[j][1] = o->ev.agg_m[j][2] = 0.0;
-        o->ev.agg_moving_b[j] = 0;
-        o->ev.agg_ax[j] = o->ev.agg_ay[j] = 0.0;
-    }
-    if (o->ev.agg_on)
-        for (int j = 0; j < n_new; j++) {
-            const float *q = seg_xy + 4 * j;
-            int b = q[2] == mx && q[3] == my;
-            o->ev.agg_moving_b[j] = b;
-            o->ev.agg_ax[j] = (double)(b ? q[0] : q[2]);
-            o->ev.agg_ay[j] = (double)(b ? q[1] : q[3]);
-        }
+    agg_begin(&o->ev, move, seg_xy, n_new, mx, my);
     for (int32_t k = 0; k < o->chg.bucket_n; k++) {
         int32_t b = o->chg.bucket_list[k];
         for (uint32_t i = h->pt_start[b]; i < h->pt_start[b + 1]; i++) {
@@ -349,21 +377,7 @@ static void prepare(polyc__opt *o, const int32_t *old, int n_old, const float *s
         }
     }
     o->chg.bucket_n = 0;
-    o->ev.lsoa_n = -1;
-    /* for a few points (most of a single scan's trials) the copy costs
-     * more than it saves */
-    if (o->ev.loc_n >= 8 && o->ev.loc_n <= o->ev.lsoa_cap) {
-        for (int32_t k = 0; k < o->ev.loc_n; k++) {
-            const polyc__point *p = &o->d.pts[o->ev.loc_pt[k]];
-            o->ev.lsoa_x[k] = (double)p->x;
-            o->ev.lsoa_y[k] = (double)p->y;
-            o->ev.lsoa_w[k] = (double)p->w;
-            o->ev.lsoa_cxx[k] = (double)p->cxx;
-            o->ev.lsoa_cxy[k] = (double)p->cxy;
-            o->ev.lsoa_cyy[k] = (double)p->cyy;
-        }
-        o->ev.lsoa_n = o->ev.loc_n;
-    }
+    copy_listed(o);
 }
 
 void polyc__local_prepare(polyc__opt *o, const int32_t *old, int n_old, const float *seg_xy,
