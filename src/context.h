@@ -75,6 +75,12 @@ struct polyc_ctx {
 };
 
 #define POLYC__MAGIC 0x706f6c79u   /* "poly" */
+/* While the progress callback runs, the context is lent to the optimiser:
+ * its magic reads POLYC__MAGIC_BUSY and every entry point refuses it with
+ * POLYC_ERR_BUSY (api.c, guarded_progress). */
+#define POLYC__MAGIC_BUSY 0x62757379u /* "busy" */
+/* POLYC_OK for a context an entry point may use (api.c) */
+polyc_status polyc__check_ctx(const polyc_ctx *ctx);
 
 /* The kind of input, decided here once: an occupancy grid, a single scan
  * (mapped from its beam order, scan_chains.c, and checked against its

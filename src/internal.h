@@ -230,6 +230,12 @@ polyc_status polyc__spacing_build(polyc_ctx *ctx, polyc__spacing *sp);
 float polyc__spacing_at(const polyc__spacing *sp, float x, float y);
 
 
+/* config.c: a pose is usable (finite, within 10,000 km); the extent rule
+ * (the pose and every reflected endpoint, frame shifted by ox, oy) grows
+ * box[4] = min x, min y, max x, max y (have: it holds something) */
+int polyc__pose_ok(double x, double y, double th);
+void polyc__extent_add(const polyc_scan *s, double ox, double oy, double *box, int *have);
+
 /* grid.c */
 /* entries the grid's tile directory may have under the limits */
 size_t polyc__grid_dir_cap(const polyc_limits *lim);
