@@ -148,6 +148,7 @@ typedef struct polyc__hash {
  * p(turn angle | x, y) from corners between lines fitted in single scans.
  * The prior grid is the tile grid: one cell per 32 x 32 grid cells. */
 #define POLYC__ANGLE_BINS 18       /* 10 degree bins of the turn angle, 0..180 */
+#define POLYC__BINS_PER_RAD 5.729577951f /* 18 / pi: 10 degree bins */
 typedef struct polyc__prior {
     double origin_x, origin_y;     /* frame-relative lower-left corner */
     float cell_m, inv_cell;
@@ -199,6 +200,11 @@ size_t polyc__prior_bytes(const polyc_limits *lim);
  * with `spare` bytes or more of the block free beyond what the later stages
  * are budgeted, also the table of smoothed counts (p->smooth). */
 polyc_status polyc__prior_build(polyc_ctx *ctx, polyc__prior *p, size_t spare);
+/* prior_learn.c: the counts from every scan, into p (laid out, rows handed
+ * out as cells get evidence); cache: cache_cap beams' endpoints (NULL: none);
+ * acc: the accuracy's samples (NULL: none) */
+void polyc__prior_learn(const polyc_ctx *ctx, polyc__prior *p, float *cache, uint32_t cache_cap,
+                        polyc__acc_learn *acc);
 /* p(turn | x, y) in [0, 1]; x, y frame-relative metres; turn in [0, pi]. */
 float polyc__prior_p(const polyc__prior *p, float x, float y, float turn_rad);
 /* The same for many turns at one place: its cell's smoothed counts. */
