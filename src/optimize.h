@@ -168,6 +168,22 @@ typedef struct polyc__opt {
 
 #define POLYC__CAND_MAX 48
 
+/* topology.c, zip.c */
+/* Does segment sg share vertex a or b (NONE: a new point)? */
+static inline int polyc__touches(const polyc__store *s, int32_t sg, int32_t a, int32_t b)
+{
+    int32_t e = s->v[sg].next;
+    return (a != POLYC__NONE && (sg == a || e == a)) || (b != POLYC__NONE && (sg == b || e == b));
+}
+/* Whether segment v (live) was edited since the touch stamp `since`: a
+ * crossing or a doubly covered stretch that is new has a new or moved
+ * segment on one side, so a pass needs to look only at those. */
+static inline int polyc__edited_since(const polyc__opt *o, int32_t v, uint32_t since)
+{
+    return o->v_touch[v] >= since || o->v_touch[o->s->v[v].next] >= since;
+}
+
+
 /* ok &= carving count elements of *ptr from arena a (the carve functions:
  * each group's scratch is carved by its own file, on the block or on the
  * size query's counting arena) */

@@ -64,6 +64,10 @@
 #define POLYC__SURFACE_OFF_REL 0.02f
 #define POLYC__INCIDENCE_SIN_MIN 0.05f
 
+/* untangling and zipping (topology.c, zip.c): fixes per segment in one
+ * pass, which bounds a pass's work */
+#define POLYC__FIXES_PER_SEGMENT 16
+
 /* ---- the search (optimize.c) ---- */
 
 /* hill-climbing rounds after each operator that moves or adds vertices */
