@@ -79,7 +79,7 @@ unit: $(TEST_BIN) $(BUILD)/polyc
 # What a newcomer and CI run (README.md): dependencies, then every step of
 # CHECK_STEPS, each into build-check/STEP.log: one line per step (the log's
 # tail if it failed), and last a line `N passed, N failed` alone (CI reads it).
-CHECK_STEPS = unit test-cli test-fuzz-replay test-asan test-cxx test-install test-python \
+CHECK_STEPS = unit test-checks test-cli test-fuzz-replay test-asan test-cxx test-install test-python \
               test-embedded test-opt-O3 test-opt-Os test-valgrind cross
 check: deps
 	@mkdir -p build-check; pass=0; fail=0; \
@@ -92,6 +92,13 @@ check: deps
 	  fi; \
 	done; \
 	echo "$$pass passed, $$fail failed"; test $$fail -eq 0
+
+# The unit suites on a library with its invariant checkers built in
+# (src/checks.c): the optimiser asserts its store, hash and arena after
+# every iteration, and its unit tests check the books from scratch.
+.PHONY: test-checks
+test-checks:
+	$(MAKE) BUILD=build-checks CFLAGS=-DPOLYC_CHECKS unit
 
 # The unit suites again under other optimisation settings (-O3, -Os -flto).
 .PHONY: test-opt test-opt-O3 test-opt-Os
@@ -106,7 +113,7 @@ deps:
 
 # Also: the header as C++, an installed copy used through pkg-config, the
 # Python binding against build/libpolyc.so, the 128 KiB example on the host
-test: unit test-cli test-fuzz-replay test-asan test-cxx test-install test-python test-embedded
+test: unit test-checks test-cli test-fuzz-replay test-asan test-cxx test-install test-python test-embedded
 test-cxx: $(BUILD)/tests/cxx_header
 	$(BUILD)/tests/cxx_header
 $(BUILD)/tests/cxx_header: tests/cxx_header.cpp include/polyc.h $(BUILD)/libpolyc.a

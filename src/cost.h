@@ -33,11 +33,31 @@ static inline double polyc__point_cost(const polyc__point *p, float ax, float ay
     return c > 0.0 ? c : 0.0;
 }
 
+/* a point's cost when no segment is within the search radius: w R^2 */
+static inline double polyc__point_cap(const polyc__opt *o, const polyc__point *p)
+{
+    return (double)p->w * (double)o->R2;
+}
+
 static inline double polyc__point_seg_cost(const polyc__opt *o, const polyc__point *p, int32_t seg)
 {
     const polyc__vertex *a = &o->s->v[seg];
     const polyc__vertex *b = &o->s->v[a->next];
     return polyc__point_cost(p, a->x, a->y, b->x, b->y);
 }
+
+/* checks.c, with -DPOLYC_CHECKS: invariants, NULL when they hold, else
+ * the first violation (*at: its point, vertex, line or bucket, -1 none) */
+#ifdef POLYC_CHECKS
+const char *polyc__check_arena(const polyc__arena *a);
+const char *polyc__check_store(const polyc__store *s, int32_t *at);
+const char *polyc__check_hash(polyc__opt *o, int32_t *at);
+const char *polyc__check_books(const polyc__opt *o, int32_t *at);
+/* the cheap ones (arena, store, hash), asserted after each iteration */
+void polyc__checks_iteration(polyc__opt *o);
+#define POLYC__CHECKS_ITERATION(o) polyc__checks_iteration(o)
+#else
+#define POLYC__CHECKS_ITERATION(o) ((void)0)
+#endif
 
 #endif

@@ -3,7 +3,7 @@
  * found by repeating the operators (overlaps, merge, split, vertex moves,
  * zigzags, noise, vertex count) until `patience` iterations bring no better
  * BIC, or the iteration cap or the caller's progress callback stops it. */
-#include "optimize.h"
+#include "cost.h"
 
 #include <math.h>
 #include <string.h>
@@ -150,6 +150,7 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
         prev_mark = operators(&o, since, o.pol.climb_since_prev && it > 0 ? prev_mark : since);
         if (o.h.out_of_entries)
             return restore_best(&o, polyc__fail(ctx, POLYC_ERR_NOMEM, "spatial hash full"));
+        POLYC__CHECKS_ITERATION(&o);
         double bic = polyc__bic(&o);
         /* any better map is kept; a gain under one BIC unit (no evidence
          * either way) does not restart the patience: late iterations can

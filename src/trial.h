@@ -1,5 +1,5 @@
 /* trial.h - what the trial evaluation (score.c) and the bounded removal
- * delta (delta.c) share: a point's cost cap, a segment prepared for many
+ * delta (delta.c) share: a segment prepared for many
  * cost queries (the same value as polyc__cost without its divisions), the
  * set of segments an edit takes out, and the nearest segment below a bound. */
 #ifndef POLYC_TRIAL_H
@@ -8,12 +8,6 @@
 #include "cost.h"
 
 #include <math.h>
-
-static inline double polyc__point_cap(const polyc__opt *o, const polyc__point *p)
-{
-    return (double)p->w * (double)o->R2;
-}
-
 
 static inline void polyc__seg_prepare(polyc__seg_pre *q, const float *xy)
 {

@@ -28,7 +28,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "optimize.h"
+#include "cost.h"
 
 #define PI_D 3.14159265358979323846
 #define BEAMS 360
@@ -432,9 +432,23 @@ static void check_hash(polyc__opt *o, const char *where)
         fail_msg("%s: paths visit %d buckets, hash holds %d entries", where, expect, total);
 }
 
-/* The incremental books against a recomputation from scratch. */
+/* The incremental books against a recomputation from scratch: the
+ * library's checkers (src/checks.c) where they are built in, then the
+ * test's own, which say more about a failure. */
 static void check_books(polyc__opt *o, const char *where)
 {
+#ifdef POLYC_CHECKS
+    int32_t at = -1;
+    const char *why = polyc__check_arena(&o->ctx->arena);
+    if (!why)
+        why = polyc__check_store(o->s, &at);
+    if (!why)
+        why = polyc__check_hash(o, &at);
+    if (!why)
+        why = polyc__check_books(o, &at);
+    if (why)
+        fail_msg("%s: %s (at %d)", where, why, at);
+#endif
     check_store(o, where);
     check_hash(o, where);
     double err = 0.0;
