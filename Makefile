@@ -72,6 +72,11 @@ $(BUILD)/tests/%: tests/%.c $(TOOL_OBJ) $(EVAL_OBJ) $(BUILD)/libpolyc.a $(wildca
 	@mkdir -p $(dir $@)
 	$(CC) $(EVAL_CFLAGS) -Isrc -Itests $< $(TOOL_OBJ) $(EVAL_OBJ) $(BUILD)/libpolyc.a -o $@ -lcmocka $(LDLIBS)
 
+# the optimiser's suites share their harness (tests/opt_harness.c)
+$(BUILD)/tests/test_opt_%: tests/test_opt_%.c tests/opt_harness.c $(TOOL_OBJ) $(EVAL_OBJ) $(BUILD)/libpolyc.a $(wildcard tests/*.h)
+	@mkdir -p $(dir $@)
+	$(CC) $(EVAL_CFLAGS) -Isrc -Itests $< tests/opt_harness.c $(TOOL_OBJ) $(EVAL_OBJ) $(BUILD)/libpolyc.a -o $@ -lcmocka $(LDLIBS)
+
 # every suite runs even when an earlier one fails; the target fails at the end
 unit: $(TEST_BIN) $(BUILD)/polyc
 	@fail=0; for t in $(TEST_BIN); do echo "== $$t"; $$t || fail=1; done; exit $$fail
