@@ -2,7 +2,7 @@
  * Takes: the optimiser state. Gives: hill climbing of each vertex in 8
  * directions with a fixed step while the BIC falls, evaluated on the points
  * near its two segments only; and Gaussian noise on all vertices. */
-#include "optimize.h"
+#include "cost.h"
 
 #include <math.h>
 

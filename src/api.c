@@ -6,6 +6,8 @@
 #include <math.h>
 #include <string.h>
 
+extern inline polyc_status polyc__fail(polyc_ctx *ctx, polyc_status st, const char *msg);
+
 /* ---- sizing and context ---- */
 
 /* the scans' poses and their ranges */

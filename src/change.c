@@ -86,7 +86,7 @@ void polyc__chg_commit(polyc__opt *o)
                     int32_t sg = o->chg.added[a];
                     if (!o->seg_in[sg])
                         continue;
-                    double ca = polyc__point_seg_cost(o, &o->d.pts[i], sg);
+                    double ca = polyc__cost_seg(o, &o->d.pts[i], sg);
                     if (ca < c) {
                         c = ca;
                         seg = sg;

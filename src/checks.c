@@ -125,7 +125,7 @@ static double brute_nearest(const polyc__opt *o, const polyc__point *p)
     double best = polyc__point_cap(o, p);
     for (int32_t v = 0; v < o->s->v_high; v++)
         if (seg_live(o, v)) {
-            double c = polyc__point_seg_cost(o, p, v);
+            double c = polyc__cost_seg(o, p, v);
             best = c < best ? c : best;
         }
     return best;
@@ -147,7 +147,7 @@ const char *polyc__check_books(const polyc__opt *o, int32_t *at)
                 return "books: an unassigned point's cost is below the cap";
         } else if (!seg_live(o, ps)) {
             return "books: a point is assigned to a dead segment";
-        } else if (polyc__point_seg_cost(o, p, ps) != o->d.pt_cost[i]) {
+        } else if (polyc__cost_seg(o, p, ps) != o->d.pt_cost[i]) {
             return "books: a point's cost is not its segment's";
         }
     }

@@ -99,8 +99,9 @@ static inline polyc__input polyc__input_kind(const polyc_ctx *ctx)
                                                                               : POLYC__INPUT_SCANS;
 }
 
-/* errors: keep the first message of an operation */
-static inline polyc_status polyc__fail(polyc_ctx *ctx, polyc_status st, const char *msg)
+/* errors: keep the first message of an operation (C99 inline: its external
+ * definition is in api.c) */
+inline polyc_status polyc__fail(polyc_ctx *ctx, polyc_status st, const char *msg)
 {
     if (ctx && !ctx->err.msg)
         ctx->err.msg = msg;

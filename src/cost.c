@@ -7,15 +7,11 @@
 
 #include <math.h>
 
-double polyc__cost(const polyc__point *p, float ax, float ay, float bx, float by)
-{
-    return polyc__point_cost(p, ax, ay, bx, by);
-}
-
-double polyc__cost_seg(const polyc__opt *o, const polyc__point *p, int32_t seg)
-{
-    return polyc__point_seg_cost(o, p, seg);
-}
+/* the external definitions of cost.h's inline functions (C99: used
+ * where a caller does not inline them, as at -Os) */
+extern inline double polyc__cost(const polyc__point *p, float ax, float ay, float bx, float by);
+extern inline double polyc__point_cap(const polyc__opt *o, const polyc__point *p);
+extern inline double polyc__cost_seg(const polyc__opt *o, const polyc__point *p, int32_t seg);
 
 /* 1 - p(turn | x, y) at v; open ends have no angle. */
 double polyc__vertex_angle_cost(const polyc__opt *o, int32_t v)

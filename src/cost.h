@@ -1,7 +1,7 @@
-/* cost.h - the cost kernel (paper eq. 2), inline: the cost of a weighted
- * point against a segment. cost.c exports it (polyc__cost) to the files
- * that price trials; the trial evaluation (score.c) and the books
- * (change.c) use it inline in their loops. */
+/* cost.h - the cost kernel (paper eq. 2): the cost of a weighted point
+ * against a segment, as C99 inline functions, so that the loops that call
+ * it most (trial evaluation, the books) can inline it; cost.c holds their
+ * one external definition (what -Os calls). */
 #ifndef POLYC_COST_H
 #define POLYC_COST_H
 
@@ -9,7 +9,7 @@
 
 /* Sum of squared distances of a weighted point's endpoints to segment a-b,
  * all of them taken to fall in the region (interior or end) of their mean. */
-static inline double polyc__point_cost(const polyc__point *p, float ax, float ay, float bx, float by)
+inline double polyc__cost(const polyc__point *p, float ax, float ay, float bx, float by)
 {
     double dx = (double)bx - (double)ax, dy = (double)by - (double)ay;
     double mx = (double)p->x - (double)ax, my = (double)p->y - (double)ay;
@@ -34,16 +34,16 @@ static inline double polyc__point_cost(const polyc__point *p, float ax, float ay
 }
 
 /* a point's cost when no segment is within the search radius: w R^2 */
-static inline double polyc__point_cap(const polyc__opt *o, const polyc__point *p)
+inline double polyc__point_cap(const polyc__opt *o, const polyc__point *p)
 {
     return (double)p->w * (double)o->R2;
 }
 
-static inline double polyc__point_seg_cost(const polyc__opt *o, const polyc__point *p, int32_t seg)
+inline double polyc__cost_seg(const polyc__opt *o, const polyc__point *p, int32_t seg)
 {
     const polyc__vertex *a = &o->s->v[seg];
     const polyc__vertex *b = &o->s->v[a->next];
-    return polyc__point_cost(p, a->x, a->y, b->x, b->y);
+    return polyc__cost(p, a->x, a->y, b->x, b->y);
 }
 
 /* checks.c, with -DPOLYC_CHECKS: invariants, NULL when they hold, else

@@ -75,7 +75,7 @@ void polyc__optimizer_reserve(polyc__arena *a, const polyc_config *cfg, const po
 static polyc__policy policy_for(polyc__input kind)
 {
     polyc__policy p;
-    int one = kind == POLYC__INPUT_ONE_SCAN, grid = kind == POLYC__INPUT_GRID;
+    uint8_t one = kind == POLYC__INPUT_ONE_SCAN, grid = kind == POLYC__INPUT_GRID;
     p.restructure = p.add_vertices = p.noise = !one;
     p.climb_since_prev = p.stop_without_gain = one;
     p.gain_share = grid ? GRID_GAIN : 0.0;

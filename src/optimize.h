@@ -106,23 +106,22 @@ typedef struct polyc__data {
 /* What the search does for the kind of input (polyc__input_kind), decided
  * once in polyc__opt_setup; the loop (optimize.c) reads it. */
 typedef struct polyc__policy {
-    /* A single scan's chains already join what its beam order joins: no
+    /* an occupancy grid: an iteration gains only if the BIC falls by more
+     * than gain_share of it (0: by one unit) */
+    double gain_share;
+    /* flags (bytes: the policy rides on the optimiser's stack). A single scan's chains already join what its beam order joins: no
      * overlaps, merges, splits or zips (A, B, C), nor the polish of the
      * best map; they start with more than enough vertices: no additions
      * (G); and no noise (F, docs/algorithm.md) */
-    int restructure, add_vertices, noise;
+    uint8_t restructure, add_vertices, noise;
     /* a single scan's later iterations climb only what the previous one
      * edited after its first climbs, and it stops after an iteration
      * without gain */
-    int climb_since_prev, stop_without_gain;
-    /* an occupancy grid: an iteration gains only if the BIC falls by more
-     * than gain_share of it (0: by one unit); noisy iterations and ones
-     * still recovering from the noise do not spare the patience */
-    double gain_share;
-    int noise_spares_patience, recover;
-    /* an occupancy grid: a gap in the data is cut only as far as the grid
-     * has free cells along it (operators.c) */
-    int gaps_free_only;
+    uint8_t climb_since_prev, stop_without_gain;
+    /* an occupancy grid: noisy iterations and ones still recovering from
+     * the noise do not spare the patience; a gap in the data is cut only as
+     * far as the grid has free cells along it (split.c) */
+    uint8_t noise_spares_patience, recover, gaps_free_only;
 } polyc__policy;
 
 /* The optimiser's long-lived state: the model and its terms, the spatial
@@ -170,7 +169,7 @@ typedef struct polyc__opt {
 
 /* topology.c, zip.c */
 /* Does segment sg share vertex a or b (NONE: a new point)? */
-static inline int polyc__touches(const polyc__store *s, int32_t sg, int32_t a, int32_t b)
+inline int polyc__touches(const polyc__store *s, int32_t sg, int32_t a, int32_t b)
 {
     int32_t e = s->v[sg].next;
     return (a != POLYC__NONE && (sg == a || e == a)) || (b != POLYC__NONE && (sg == b || e == b));
@@ -178,7 +177,7 @@ static inline int polyc__touches(const polyc__store *s, int32_t sg, int32_t a, i
 /* Whether segment v (live) was edited since the touch stamp `since`: a
  * crossing or a doubly covered stretch that is new has a new or moved
  * segment on one side, so a pass needs to look only at those. */
-static inline int polyc__edited_since(const polyc__opt *o, int32_t v, uint32_t since)
+inline int polyc__edited_since(const polyc__opt *o, int32_t v, uint32_t since)
 {
     return o->v_touch[v] >= since || o->v_touch[o->s->v[v].next] >= since;
 }
@@ -231,7 +230,7 @@ void polyc__hash_remove(polyc__opt *o, int32_t seg);
 void polyc__hash_clear(polyc__opt *o);
 int32_t polyc__bucket_of(const polyc__hash *h, float x, float y);
 /* the column and row of the bucket holding (x, y), clamped to the hash */
-static inline void polyc__bucket_xy(const polyc__hash *h, float x, float y, int32_t *ix, int32_t *iy)
+inline void polyc__bucket_xy(const polyc__hash *h, float x, float y, int32_t *ix, int32_t *iy)
 {
     float fx = (x - h->origin_x) * h->inv_bucket, fy = (y - h->origin_y) * h->inv_bucket;
     *ix = fx < 0.0f ? 0 : (fx >= (float)h->bx ? h->bx - 1 : (int32_t)fx);
@@ -239,7 +238,7 @@ static inline void polyc__bucket_xy(const polyc__hash *h, float x, float y, int3
 }
 /* The 3 x 3 buckets around bucket (bx, by) that lie in the hash, row by
  * row, into out; returns their count (the one bucket walk of the library). */
-static inline int polyc__buckets_around(const polyc__hash *h, int32_t bx, int32_t by, int32_t out[9])
+inline int polyc__buckets_around(const polyc__hash *h, int32_t bx, int32_t by, int32_t out[9])
 {
     int32_t x0 = bx > 0 ? bx - 1 : 0, x1 = bx + 1 < h->bx ? bx + 1 : h->bx - 1;
     int32_t y0 = by > 0 ? by - 1 : 0, y1 = by + 1 < h->by ? by + 1 : h->by - 1;
@@ -267,8 +266,6 @@ typedef struct polyc__seg_pre {
 void polyc__trial_costs_min(const polyc__opt *o, const polyc__seg_pre *q, double *c);
 
 /* score.c */
-double polyc__cost(const polyc__point *p, float ax, float ay, float bx, float by);
-double polyc__cost_seg(const polyc__opt *o, const polyc__point *p, int32_t seg);
 /* nearest segment within reach, skipping up to n_skip segments */
 double polyc__nearest(const polyc__opt *o, int32_t pi, const int32_t *skip, int n_skip,
                       int32_t *seg);
@@ -327,7 +324,7 @@ int polyc__op_remove_vertices(polyc__opt *o, uint32_t since);
  * some value >= bound (INFINITY: always exact) */
 double polyc__removal_delta_below(polyc__opt *o, int32_t v, double bound);
 /* Squared distance from (px, py) to segment a-b. */
-static inline float polyc__seg_dist2(float px, float py, float ax, float ay, float bx, float by)
+inline float polyc__seg_dist2(float px, float py, float ax, float ay, float bx, float by)
 {
     float dx = bx - ax, dy = by - ay, mx = px - ax, my = py - ay;
     float l2 = dx * dx + dy * dy;

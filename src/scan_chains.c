@@ -17,6 +17,12 @@
 
 #include <math.h>
 
+/* the external definitions of scan_chains.h's inline functions (C99: used
+ * where a caller does not inline them, as at -Os) */
+extern inline float polyc__seg_dist2f(const float *p, const float *a, const float *b);
+extern inline int polyc__chain_has_point(const chains *c, int32_t i);
+extern inline int polyc__chain_member(const chains *c, int32_t i);
+
 #define LAMBDA_RAD 0.1745f   /* 10 degrees: flatter surfaces count as jumps */
 #define GRAZING_REACH 4.0f  /* ... times farther if the chain goes straight on */
 #define COS2_TURN 0.9698f    /* cos^2 of 10 degrees: "straight on" */

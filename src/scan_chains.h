@@ -19,7 +19,7 @@ typedef struct chains {
     float alpha, log_n;        /* the BIC's weight of the error; log of the returns */
 } chains;
 
-static inline float polyc__seg_dist2f(const float *p, const float *a, const float *b)
+inline float polyc__seg_dist2f(const float *p, const float *a, const float *b)
 {
     float dx = b[0] - a[0], dy = b[1] - a[1], l2 = dx * dx + dy * dy;
     float t = l2 > 0.0f ? ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2 : 0.0f;
@@ -28,13 +28,13 @@ static inline float polyc__seg_dist2f(const float *p, const float *a, const floa
     return ex * ex + ey * ey;
 }
 
-static inline int polyc__chain_has_point(const chains *c, int32_t i)
+inline int polyc__chain_has_point(const chains *c, int32_t i)
 {
     return c->xy[2 * i] == c->xy[2 * i];
 }
 
 /* beam i has a hit of the chain being emitted */
-static inline int polyc__chain_member(const chains *c, int32_t i)
+inline int polyc__chain_member(const chains *c, int32_t i)
 {
     return c->chain_of[i] == c->cur;
 }

@@ -8,6 +8,13 @@
 
 #include <math.h>
 
+/* the external definitions of trial.h's inline functions (C99: used
+ * where a caller does not inline them, as at -Os) */
+extern inline void polyc__seg_prepare(polyc__seg_pre *q, const float *xy);
+extern inline double polyc__seg_pre_cost(const polyc__seg_pre *q, const polyc__point *p);
+extern inline polyc__old_set polyc__old_set_of(const int32_t *old, int n_old);
+extern inline int polyc__is_old(const polyc__old_set *s, int32_t seg);
+
 int polyc__eval_carve(polyc__arena *a, polyc__eval_scratch *ev, int32_t P, int32_t lsoa_cap)
 {
     int ok = 1;
@@ -80,7 +87,7 @@ double polyc__nearest_below(const polyc__opt *o, int32_t pi, const int32_t *skip
                 skipped |= skip[j] == sg;
             if (skipped)
                 continue;
-            double c = polyc__point_seg_cost(o, p, sg);
+            double c = polyc__cost_seg(o, p, sg);
             if (c < best) {
                 best = c;
                 best_seg = sg;
@@ -223,7 +230,7 @@ static double nearest_candidate(const polyc__opt *o, int32_t pi, double start, i
         gy = gy > 0.0 ? gy : 0.0;
         if (0.999 * w * (gx * gx + gy * gy) >= best)
             continue;
-        double c = polyc__point_seg_cost(o, p, o->ev.cand_seg[k]);
+        double c = polyc__cost_seg(o, p, o->ev.cand_seg[k]);
         if (c < best) {
             best = c;
             best_seg = o->ev.cand_seg[k];

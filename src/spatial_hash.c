@@ -7,6 +7,12 @@
 #include "optimize.h"
 #include "walk.h"
 
+/* the external definitions of optimize.h's inline functions (C99: used
+ * where a caller does not inline them, as at -Os) */
+extern inline int polyc__buckets_around(const polyc__hash *h, int32_t bx, int32_t by, int32_t out[9]);
+extern inline void polyc__bucket_xy(const polyc__hash *h, float x, float y, int32_t *ix, int32_t *iy);
+extern inline float polyc__seg_dist2(float px, float py, float ax, float ay, float bx, float by);
+
 #include <math.h>
 #include <string.h>
 

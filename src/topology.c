@@ -13,6 +13,11 @@
 
 #include <math.h>
 
+/* the external definitions of optimize.h's inline functions (C99: used
+ * where a caller does not inline them, as at -Os) */
+extern inline int polyc__touches(const polyc__store *s, int32_t sg, int32_t a, int32_t b);
+extern inline int polyc__edited_since(const polyc__opt *o, int32_t v, uint32_t since);
+
 #define CROSS_END_M 0.002f  /* a crossing this near a segment end is a junction */
 #define CUT_BACK_M 0.002f   /* a cut arm ends this short of the other segment */
 #define LOSES_RETURNS 1e6   /* single scans: an edit that loses returns comes last */

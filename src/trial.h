@@ -9,7 +9,7 @@
 
 #include <math.h>
 
-static inline void polyc__seg_prepare(polyc__seg_pre *q, const float *xy)
+inline void polyc__seg_prepare(polyc__seg_pre *q, const float *xy)
 {
     q->ax = (double)xy[0];
     q->ay = (double)xy[1];
@@ -25,7 +25,7 @@ static inline void polyc__seg_prepare(polyc__seg_pre *q, const float *xy)
 }
 
 /* Same value as polyc__cost, without the per-call divisions. */
-static inline double polyc__seg_pre_cost(const polyc__seg_pre *q, const polyc__point *p)
+inline double polyc__seg_pre_cost(const polyc__seg_pre *q, const polyc__point *p)
 {
     double mx = (double)p->x - q->ax, my = (double)p->y - q->ay;
     double t = (mx * q->dx + my * q->dy) * q->inv_l2;
@@ -49,7 +49,7 @@ typedef struct polyc__old_set {
     int n_rest;
 } polyc__old_set;
 
-static inline polyc__old_set polyc__old_set_of(const int32_t *old, int n_old)
+inline polyc__old_set polyc__old_set_of(const int32_t *old, int n_old)
 {
     polyc__old_set s;
     s.a = n_old > 0 ? old[0] : POLYC__NONE;
@@ -60,7 +60,7 @@ static inline polyc__old_set polyc__old_set_of(const int32_t *old, int n_old)
 }
 
 /* whether the point's segment seg (NONE: none) is one of them */
-static inline int polyc__is_old(const polyc__old_set *s, int32_t seg)
+inline int polyc__is_old(const polyc__old_set *s, int32_t seg)
 {
     if (seg == POLYC__NONE)
         return 0;
