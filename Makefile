@@ -72,10 +72,13 @@ $(BUILD)/tests/%: tests/%.c $(TOOL_OBJ) $(EVAL_OBJ) $(BUILD)/libpolyc.a $(wildca
 	@mkdir -p $(dir $@)
 	$(CC) $(EVAL_CFLAGS) -Isrc -Itests $< $(TOOL_OBJ) $(EVAL_OBJ) $(BUILD)/libpolyc.a -o $@ -lcmocka $(LDLIBS)
 
-# the optimiser's suites share their harness (tests/opt_harness.c)
-$(BUILD)/tests/test_opt_%: tests/test_opt_%.c tests/opt_harness.c $(TOOL_OBJ) $(EVAL_OBJ) $(BUILD)/libpolyc.a $(wildcard tests/*.h)
+# the optimiser's suites share their harness (tests/opt_harness.c), whose
+# oracles are the library's invariant checkers (src/checks.c): compiled in
+# here when the library was built without them
+OPT_CHECKS = $(if $(findstring -DPOLYC_CHECKS,$(CFLAGS)),,-DPOLYC_CHECKS src/checks.c)
+$(BUILD)/tests/test_opt_%: tests/test_opt_%.c tests/opt_harness.c src/checks.c $(TOOL_OBJ) $(EVAL_OBJ) $(BUILD)/libpolyc.a $(wildcard tests/*.h src/*.h)
 	@mkdir -p $(dir $@)
-	$(CC) $(EVAL_CFLAGS) -Isrc -Itests $< tests/opt_harness.c $(TOOL_OBJ) $(EVAL_OBJ) $(BUILD)/libpolyc.a -o $@ -lcmocka $(LDLIBS)
+	$(CC) $(EVAL_CFLAGS) -Isrc -Itests $< tests/opt_harness.c $(OPT_CHECKS) $(TOOL_OBJ) $(EVAL_OBJ) $(BUILD)/libpolyc.a -o $@ -lcmocka $(LDLIBS)
 
 # every suite runs even when an earlier one fails; the target fails at the end
 unit: $(TEST_BIN) $(BUILD)/polyc

@@ -68,19 +68,32 @@ const char *polyc__check_store(const polyc__store *s, int32_t *at)
     return NULL;
 }
 
-/* one live segment's path through the hash: every bucket it visits holds it */
+/* one live segment's path through the hash: each bucket it visits holds
+ * it once per visit */
 typedef struct path_check {
-    int32_t seg, visits, missing;
+    int32_t seg, visits, wrong;
+    float ax, ay, bx, by;
+    int32_t bucket, count;         /* the inner walk: visits of `bucket` */
 } path_check;
+
+static void count_visits(polyc__opt *o, void *user, int32_t bucket)
+{
+    (void)o;
+    path_check *pc = user;
+    pc->count += bucket == pc->bucket;
+}
 
 static void visit_bucket(polyc__opt *o, void *user, int32_t bucket)
 {
     path_check *pc = user;
-    int found = 0;
-    for (int32_t e = o->h.seg_head[bucket]; e != POLYC__NONE && !found; e = o->h.entries[e].next)
-        found = o->h.entries[e].seg == pc->seg;
+    int32_t have = 0;
+    for (int32_t e = o->h.seg_head[bucket]; e != POLYC__NONE; e = o->h.entries[e].next)
+        have += o->h.entries[e].seg == pc->seg;
+    pc->bucket = bucket;
+    pc->count = 0;
+    polyc__segment_buckets(o, pc->ax, pc->ay, pc->bx, pc->by, count_visits, pc);
     pc->visits++;
-    pc->missing += !found;
+    pc->wrong += have != pc->count;
 }
 
 const char *polyc__check_hash(polyc__opt *o, int32_t *at)
@@ -107,10 +120,10 @@ const char *polyc__check_hash(polyc__opt *o, int32_t *at)
         if (!o->seg_in[v])
             return "hash: a live segment is not marked in the hash";
         const polyc__vertex *a = &o->s->v[v], *c = &o->s->v[a->next];
-        path_check pc = {v, 0, 0};
+        path_check pc = {v, 0, 0, a->x, a->y, c->x, c->y, 0, 0};
         polyc__segment_buckets(o, a->x, a->y, c->x, c->y, visit_bucket, &pc);
-        if (pc.missing)
-            return "hash: a bucket on a segment's path does not hold it";
+        if (pc.wrong)
+            return "hash: a bucket on a segment's path holds it other than once per visit";
         expect += pc.visits;
     }
     *at = -1;

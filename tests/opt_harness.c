@@ -280,159 +280,39 @@ int close_rel(double a, double b, double rel)
     return fabs(a - b) <= rel * (1.0 + fmax(fabs(a), fabs(b)));
 }
 
+/* The oracles: the library's invariant checkers (src/checks.c, linked into
+ * every tests/test_opt_* suite with POLYC_CHECKS), failing the test with
+ * the first violation. */
+static void fail_if(const char *why, int32_t at, const char *where)
+{
+    if (why)
+        fail_msg("%s: %s (at %d)", where, why, at);
+}
+
 /* Linked lists, line ids, counts, ends, live counts. */
 void check_store(const polyc__opt *o, const char *where)
 {
-    const polyc__store *s = o->s;
-    int32_t verts = 0, lines = 0;
-    for (int32_t l = 0; l < s->l_high; l++) {
-        const polyc__line *ln = &s->l[l];
-        if (ln->closed == POLYC__NONE)
-            continue;
-        lines++;
-        if (ln->count < 1)
-            fail_msg("%s: line %d has %d vertices", where, l, ln->count);
-        if (ln->closed && ln->count < 3)
-            fail_msg("%s: closed line %d has %d vertices", where, l, ln->count);
-        if (ln->count < 2) /* a polyline left with one vertex goes (op_remove, op_cut) */
-            fail_msg("%s: line %d has a single vertex", where, l);
-        int32_t v = ln->head, prev = ln->closed ? ln->tail : POLYC__NONE;
-        for (int32_t k = 0; k < ln->count; k++) {
-            if (v < 0 || v >= s->v_high || s->v[v].line != l)
-                fail_msg("%s: line %d vertex %d (step %d) not on it", where, l, v, k);
-            if (s->v[v].prev != prev)
-                fail_msg("%s: line %d vertex %d prev %d, expected %d", where, l, v, s->v[v].prev, prev);
-            prev = v;
-            v = s->v[v].next;
-        }
-        if (prev != ln->tail)
-            fail_msg("%s: line %d ends at %d, tail is %d", where, l, prev, ln->tail);
-        if (v != (ln->closed ? ln->head : POLYC__NONE))
-            fail_msg("%s: line %d tail links to %d", where, l, v);
-        verts += ln->count;
-    }
-    if (verts != s->v_live || lines != s->l_live)
-        fail_msg("%s: %d vertices / %d lines on lines, v_live %d l_live %d", where, verts, lines,
-                 s->v_live, s->l_live);
+    int32_t at = -1;
+    fail_if(polyc__check_store(o->s, &at), at, where);
 }
 
-static int32_t g_walk[MAX_WALK];
-
-static int g_walk_n;
-
-void collect_bucket(polyc__opt *o, void *user, int32_t bucket)
-{
-    (void)o;
-    (void)user;
-    assert_true(g_walk_n < MAX_WALK);
-    g_walk[g_walk_n++] = bucket;
-}
-
-int entries_of(const polyc__hash *h, int32_t bucket, int32_t seg)
-{
-    int n = 0;
-    for (int32_t e = h->seg_head[bucket]; e != POLYC__NONE; e = h->entries[e].next)
-        n += h->entries[e].seg == seg;
-    return n;
-}
-
-/* Walks every bucket: each entry is a live segment marked in the hash; each
- * live segment is in exactly the buckets its path crosses, once per visit. */
+/* Every entry is a live segment marked in the hash; each live segment is in
+ * exactly the buckets its path crosses, once per visit. */
 void check_hash(polyc__opt *o, const char *where)
 {
-    const polyc__hash *h = &o->h;
-    int32_t nb = h->bx * h->by, total = 0;
-    for (int32_t b = 0; b < nb; b++)
-        for (int32_t e = h->seg_head[b]; e != POLYC__NONE; e = h->entries[e].next) {
-            int32_t sg = h->entries[e].seg;
-            if (!seg_live(o, sg) || !o->seg_in[sg])
-                fail_msg("%s: bucket %d holds segment %d (live %d, seg_in %d)", where, b, sg,
-                         seg_live(o, sg), sg >= 0 && sg < o->s->v_cap ? o->seg_in[sg] : -1);
-            total++;
-        }
-    if (total != h->entry_live)
-        fail_msg("%s: %d entries in buckets, entry_live %d", where, total, h->entry_live);
-    int32_t expect = 0;
-    for (int32_t v = 0; v < o->s->v_high; v++) {
-        if (!seg_live(o, v)) {
-            if (o->seg_in[v])
-                fail_msg("%s: vertex %d (line %d) has no segment but is marked in the hash", where,
-                         v, o->s->v[v].line);
-            continue;
-        }
-        if (!o->seg_in[v])
-            fail_msg("%s: live segment %d not marked in the hash", where, v);
-        const polyc__vertex *a = &o->s->v[v], *c = &o->s->v[a->next];
-        g_walk_n = 0;
-        polyc__segment_buckets(o, a->x, a->y, c->x, c->y, collect_bucket, NULL);
-        expect += g_walk_n;
-        for (int k = 0; k < g_walk_n; k++) {
-            int visits = 0;
-            for (int j = 0; j < g_walk_n; j++)
-                visits += g_walk[j] == g_walk[k];
-            int have = entries_of(h, g_walk[k], v);
-            if (have != visits)
-                fail_msg("%s: segment %d in bucket %d %d times, its path visits it %d times", where,
-                         v, g_walk[k], have, visits);
-        }
-    }
-    if (expect != total)
-        fail_msg("%s: paths visit %d buckets, hash holds %d entries", where, expect, total);
+    int32_t at = -1;
+    fail_if(polyc__check_hash(o, &at), at, where);
 }
 
-/* The incremental books against a recomputation from scratch: the
- * library's checkers (src/checks.c) where they are built in, then the
- * test's own, which say more about a failure. */
+/* The incremental books against a recomputation from scratch, with the
+ * store, the hash and the arena. */
 void check_books(polyc__opt *o, const char *where)
 {
-#ifdef POLYC_CHECKS
     int32_t at = -1;
-    const char *why = polyc__check_arena(&o->ctx->arena);
-    if (!why)
-        why = polyc__check_store(o->s, &at);
-    if (!why)
-        why = polyc__check_hash(o, &at);
-    if (!why)
-        why = polyc__check_books(o, &at);
-    if (why)
-        fail_msg("%s: %s (at %d)", where, why, at);
-#endif
+    fail_if(polyc__check_arena(&o->ctx->arena), -1, where);
     check_store(o, where);
     check_hash(o, where);
-    double err = 0.0;
-    for (int32_t i = 0; i < o->d.np; i++) {
-        const polyc__point *p = &o->d.pts[i];
-        int32_t seg;
-        double c = brute_nearest(o, p, &seg);
-        err += c;
-        if (!close_rel(o->d.pt_cost[i], c, 1e-12))
-            fail_msg("%s: point %d (%.4f %.4f w %g) cost %.12g, from scratch %.12g (seg %d vs %d)",
-                     where, i, (double)p->x, (double)p->y, (double)p->w, o->d.pt_cost[i], c,
-                     o->d.pt_seg[i], seg);
-        int32_t ps = o->d.pt_seg[i];
-        if (ps == POLYC__NONE) {
-            if (o->d.pt_cost[i] != (double)p->w * (double)o->R2)
-                fail_msg("%s: point %d unassigned with cost %.12g below the cap", where, i, o->d.pt_cost[i]);
-        } else if (!seg_live(o, ps)) {
-            fail_msg("%s: point %d assigned to dead segment %d", where, i, ps);
-        } else if (polyc__cost_seg(o, p, ps) != o->d.pt_cost[i]) {
-            fail_msg("%s: point %d cost %.12g is not its segment %d's %.12g", where, i, o->d.pt_cost[i],
-                     ps, polyc__cost_seg(o, p, ps));
-        }
-    }
-    if (!close_rel(o->err, err, 1e-9))
-        fail_msg("%s: err %.12g, from scratch %.12g", where, o->err, err);
-    double angle = 0.0;
-    for (int32_t v = 0; v < o->s->v_high; v++) {
-        if (o->s->v[v].line == POLYC__NONE)
-            continue;
-        double a = polyc__vertex_angle_cost(o, v);
-        angle += a;
-        if (!close_rel(o->acost[v], a, 1e-9))
-            fail_msg("%s: vertex %d angle cost %.12g, from scratch %.12g", where, v, o->acost[v], a);
-    }
-    if (!close_rel(o->angle, angle, 1e-9))
-        fail_msg("%s: angle %.12g, from scratch %.12g", where, o->angle, angle);
+    fail_if(polyc__check_books(o, &at), at, where);
 }
 
 /* BIC of the current map recomputed from scratch */

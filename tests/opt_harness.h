@@ -46,8 +46,6 @@ typedef struct ptlist {
     int n;
 } ptlist;
 
-/* buckets visited by polyc__segment_buckets, with multiplicity */
-#define MAX_WALK 4096
 
 /* range from (px, py) along (c, s) to the walls of the room */
 double room_range(double px, double py, double c, double s);
@@ -119,9 +117,7 @@ int close_rel(double a, double b, double rel);
 /* Linked lists, line ids, counts, ends, live counts. */
 void check_store(const polyc__opt *o, const char *where);
 
-void collect_bucket(polyc__opt *o, void *user, int32_t bucket);
 
-int entries_of(const polyc__hash *h, int32_t bucket, int32_t seg);
 
 /* Walks every bucket: each entry is a live segment marked in the hash; each
  * live segment is in exactly the buckets its path crosses, once per visit. */
