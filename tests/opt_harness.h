@@ -3,8 +3,8 @@
  * 4 x 3 m room seen from three poses (analytic ranges), traced, with an
  * optimiser state set up by polyc__opt_setup as polyc_optimize does; data
  * points and polylines replaced by hand-made ones; and the oracles, which
- * compare the incremental books with a recomputation from scratch (the
- * library's checkers, src/checks.c, where they are built in). */
+ * compare the incremental books with a recomputation from scratch: the
+ * library's checkers (src/checks.c, compiled into every test_opt_* suite). */
 #ifndef OPT_HARNESS_H
 #define OPT_HARNESS_H
 
