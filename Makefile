@@ -77,6 +77,14 @@ $(BUILD)/tests/%: tests/%.c $(TOOL_OBJ) $(EVAL_OBJ) $(BUILD)/libpolyc.a $(wildca
 	@mkdir -p $(dir $@)
 	$(CC) $(EVAL_CFLAGS) -Isrc -Itests $< $(TOOL_OBJ) $(EVAL_OBJ) $(BUILD)/libpolyc.a -o $@ -lcmocka $(LDLIBS)
 
+# the optimiser's suites share their harness (tests/opt_harness.c), whose
+# oracles are the library's invariant checkers (src/checks.c): compiled in
+# here when the library was built without them
+OPT_CHECKS = $(if $(findstring -DPOLYC_CHECKS,$(CFLAGS)),,-DPOLYC_CHECKS src/checks.c)
+$(BUILD)/tests/test_opt_%: tests/test_opt_%.c tests/opt_harness.c src/checks.c $(TOOL_OBJ) $(EVAL_OBJ) $(BUILD)/libpolyc.a $(wildcard tests/*.h src/*.h)
+	@mkdir -p $(dir $@)
+	$(CC) $(EVAL_CFLAGS) -Isrc -Itests $< tests/opt_harness.c $(OPT_CHECKS) $(TOOL_OBJ) $(EVAL_OBJ) $(BUILD)/libpolyc.a -o $@ -lcmocka $(LDLIBS)
+
 # every suite runs even when an earlier one fails; the target fails at the end
 unit: $(TEST_BIN) $(BUILD)/polyc
 	@fail=0; for t in $(TEST_BIN); do echo "== $$t"; $$t || fail=1; done; exit $$fail
@@ -84,8 +92,8 @@ unit: $(TEST_BIN) $(BUILD)/polyc
 # What a newcomer and CI run (README.md): dependencies, then every step of
 # CHECK_STEPS, each into build-check/STEP.log: one line per step (the log's
 # tail if it failed), and last a line `N passed, N failed` alone (CI reads it).
-CHECK_STEPS = unit test-cli test-fuzz-replay test-asan test-cxx test-install test-python \
-              test-embedded test-opt-O3 test-opt-Os test-golden test-valgrind cross
+CHECK_STEPS = unit test-checks test-cli test-fuzz-replay test-asan test-cxx test-install \
+              test-python test-embedded test-opt-O3 test-opt-Os test-golden test-valgrind cross
 check: deps
 	@mkdir -p build-check; pass=0; fail=0; \
 	for s in $(CHECK_STEPS); do \
@@ -97,6 +105,13 @@ check: deps
 	  fi; \
 	done; \
 	echo "$$pass passed, $$fail failed"; test $$fail -eq 0
+
+# The unit suites on a library with its invariant checkers built in
+# (src/checks.c): the optimiser asserts its store, hash and arena after
+# every iteration, and its unit tests check the books from scratch.
+.PHONY: test-checks
+test-checks:
+	$(MAKE) BUILD=build-checks CFLAGS=-DPOLYC_CHECKS unit
 
 # The unit suites again under other optimisation settings (-O3, -Os -flto).
 .PHONY: test-opt test-opt-O3 test-opt-Os
@@ -111,9 +126,10 @@ deps:
 
 # Also: the header as C++, an installed copy used through pkg-config, the
 # Python binding against build/libpolyc.so, the 128 KiB example on the host,
-# and the tool's bytes across optimisation levels (test-golden)
-test: unit test-cli test-fuzz-replay test-asan test-cxx test-install test-python test-embedded \
-      test-golden
+# the unit suites with the invariant checkers built in (test-checks), and the
+# tool's bytes across optimisation levels (test-golden)
+test: unit test-checks test-cli test-fuzz-replay test-asan test-cxx test-install test-python \
+      test-embedded test-golden
 # tests/golden.sh: the tool built at -O0, -O2, -O3 and -Os -flto (in
 # build-golden-*/) writes the same bytes on simulated scenes, examples/office.log
 # and its grid as a ROS map

@@ -79,7 +79,7 @@ typedef struct polyc_config {
     float gamma;               /* weight of the angle prior; 0 = uniform prior */
     float merge_dist_m;        /* join polyline ends closer than this; paper 0.15 */
     float split_gap_m;         /* split segments with a data gap longer; paper 0.20 */
-    float step_m;              /* hill-climbing step; paper 0.01 */
+    float step_m;              /* hill-climbing step; paper 0.01; at most 0.025 */
     float noise_m;             /* initial std-dev of the vertex noise; paper 0.05 */
     float noise_decay;         /* noise std-dev factor per iteration, (0, 1] */
     float overlap_m;           /* polyline ends this close to another polyline are

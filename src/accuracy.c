@@ -60,18 +60,6 @@ typedef struct acc_cell {
     uint32_t samples, pairs;
 } acc_cell;
 
-size_t polyc__accuracy_bytes(const polyc_limits *lim, size_t cells)
-{
-    if (lim->max_scans <= 1)
-        return 0; /* one scan has no other to compare with */
-    size_t n = polyc__bytes(cells, sizeof(float));                       /* weights */
-    size_t samples = (size_t)lim->max_beams / SAMPLE_BEAMS + 1;
-    n = polyc__add(n, polyc__bytes(samples, sizeof(acc_sample)));
-    n = polyc__add(n, polyc__bytes(samples, sizeof(uint32_t)));          /* order */
-    n = polyc__add(n, polyc__bytes(cells + 1, sizeof(uint32_t)));        /* starts */
-    return polyc__add(polyc__add(n, polyc__bytes(cells, sizeof(acc_cell))), 4 * 16);
-}
-
 int polyc__accuracy_begin(polyc__acc_learn *L, polyc__prior *p, polyc__arena *a,
                           const polyc_limits *lim)
 {
@@ -83,7 +71,7 @@ int polyc__accuracy_begin(polyc__acc_learn *L, polyc__prior *p, polyc__arena *a,
     p->weight = polyc__alloc(a, cells, sizeof(float));
     if (!p->weight)
         return 0;
-    for (size_t c = 0; c < cells; c++)
+    for (size_t c = 0; a->base && c < cells; c++) /* (a counting arena: no block) */
         p->weight[c] = 1.0f;
     L->p = p;
     return 1;
@@ -151,6 +139,21 @@ static void pair_up(acc_cell *cells, const acc_sample *smp, const uint32_t *orde
     }
 }
 
+/* the pairing's index: the samples in cell order */
+static int index_carve(polyc__arena *a, size_t cells, uint32_t n, uint32_t **start, uint32_t **order)
+{
+    *start = polyc__alloc_zero(a, cells + 1, sizeof(uint32_t));
+    *order = polyc__alloc(a, n, sizeof(uint32_t));
+    return *start && *order;
+}
+
+void polyc__accuracy_reserve_finish(polyc__acc_learn *L, polyc__arena *a)
+{
+    uint32_t *start, *order;
+    if (L->p)
+        index_carve(a, (size_t)L->p->w * (size_t)L->p->h, L->cap, &start, &order);
+}
+
 void polyc__accuracy_finish(polyc__acc_learn *L, polyc__arena *a, float alpha)
 {
     polyc__prior *p = L->p;
@@ -159,9 +162,8 @@ void polyc__accuracy_finish(polyc__acc_learn *L, polyc__arena *a, float alpha)
     size_t cells = (size_t)p->w * (size_t)p->h;
     const acc_sample *smp = L->samples;
     acc_cell *cell = L->cells;
-    uint32_t *start = polyc__alloc_zero(a, cells + 1, sizeof(uint32_t));
-    uint32_t *order = polyc__alloc(a, L->n, sizeof(uint32_t));
-    if (!start || !order)
+    uint32_t *start, *order;
+    if (!index_carve(a, cells, L->n, &start, &order))
         return; /* cannot happen: budgeted; the weights stay 1 */
     for (uint32_t i = 0; i < L->n; i++)
         start[smp[i].cell + 1]++;

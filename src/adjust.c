@@ -2,7 +2,7 @@
  * Takes: the optimiser state. Gives: hill climbing of each vertex in 8
  * directions with a fixed step while the BIC falls, evaluated on the points
  * near its two segments only; and Gaussian noise on all vertices. */
-#include "optimize.h"
+#include "cost.h"
 
 #include <math.h>
 
@@ -113,31 +113,31 @@ static void commit_move(polyc__opt *o, int32_t v, float x, float y)
     int ns = segs_at(o, v, x, y, xy);
     id[0] = p != POLYC__NONE ? p : v;
     id[1] = v;
-    for (int32_t k = 0; k < o->loc_n; k++) {
-        int32_t i = o->loc_pt[k];
-        double c = o->loc_base[k];
-        int32_t sg = o->loc_seg[k];
+    for (int32_t k = 0; k < o->ev.loc_n; k++) {
+        int32_t i = o->ev.loc_pt[k];
+        double c = o->ev.loc_base[k];
+        int32_t sg = o->ev.loc_seg[k];
         for (int j = 0; j < ns; j++) {
-            double cj = polyc__cost(&o->pts[i], xy[4 * j], xy[4 * j + 1], xy[4 * j + 2], xy[4 * j + 3]);
+            double cj = polyc__cost(&o->d.pts[i], xy[4 * j], xy[4 * j + 1], xy[4 * j + 2], xy[4 * j + 3]);
             if (cj < c) {
                 c = cj;
                 sg = id[j];
             }
         }
-        o->err += c - o->pt_cost[i];
-        o->pt_cost[i] = c;
-        polyc__split_due_pt(o, o->pt_seg[i], sg);
-        o->pt_seg[i] = sg;
+        o->err += c - o->d.pt_cost[i];
+        o->d.pt_cost[i] = c;
+        polyc__split_due_pt(o, o->d.pt_seg[i], sg);
+        o->d.pt_seg[i] = sg;
     }
     /* the aggregated points: on their segment, whatever the move */
     for (int j = 0; j < ns; j++)
-        for (int32_t k = 0; k < o->agg_n[j]; k++) {
-            int32_t i = o->agg_pt[j == 0 ? k : o->agg_cap - 1 - k];
-            double c = polyc__cost(&o->pts[i], xy[4 * j], xy[4 * j + 1], xy[4 * j + 2], xy[4 * j + 3]);
-            o->err += c - o->pt_cost[i];
-            o->pt_cost[i] = c;
-            polyc__split_due_pt(o, o->pt_seg[i], id[j]);
-            o->pt_seg[i] = id[j];
+        for (int32_t k = 0; k < o->ev.agg_n[j]; k++) {
+            int32_t i = o->ev.agg_pt[j == 0 ? k : o->ev.agg_cap - 1 - k];
+            double c = polyc__cost(&o->d.pts[i], xy[4 * j], xy[4 * j + 1], xy[4 * j + 2], xy[4 * j + 3]);
+            o->err += c - o->d.pt_cost[i];
+            o->d.pt_cost[i] = c;
+            polyc__split_due_pt(o, o->d.pt_seg[i], id[j]);
+            o->d.pt_seg[i] = id[j];
         }
     for (int k = 0; k < 3; k++)
         if (nb[k] != POLYC__NONE) {
@@ -156,7 +156,7 @@ int polyc__hill_climb(polyc__opt *o, int32_t v)
     if (V[v].line == POLYC__NONE || (V[v].prev == POLYC__NONE && V[v].next == POLYC__NONE))
         return 0;
     float step = o->cfg->step_m, gamma = o->cfg->gamma;
-    float reach = 0.05f - step; /* the hash buckets cover this much movement */
+    float reach = POLYC__CLIMB_REACH_M - step; /* the hash buckets cover this much movement */
     float x0 = V[v].x, y0 = V[v].y, x = x0, y = y0;
     int32_t old[2] = {V[v].prev, V[v].next != POLYC__NONE ? v : POLYC__NONE};
     float xy[8];
@@ -168,7 +168,7 @@ int polyc__hill_climb(polyc__opt *o, int32_t v)
     double cur = polyc__local_current(o) + (double)gamma * local_angles(o, &pl, v, x, y);
     int moved = 0, last = -1;
     int optimum = 0, cut = 0; /* no better trial in the last round; some trial was beyond reach */
-    for (int it = 0; it < 64; it++) {
+    for (int it = 0; it < POLYC__CLIMB_STEPS; it++) {
         cut = 0;
         double best = cur;
         int best_d = -1;

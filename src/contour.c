@@ -8,12 +8,33 @@
 #include <stdint.h>
 #include <string.h>
 
+/* The list: each beam labels at most one cell (and an occupancy grid's
+ * occupied cells, limits.max_beams of them, one each). */
+int32_t *polyc__contour_list(polyc__arena *a, const polyc_limits *lim)
+{
+    return polyc__alloc(a, (size_t)lim->max_beams * 2 + 2, sizeof(int32_t));
+}
+
+/* while the beams are cast: a bit per directory entry */
+static uint32_t *busy_bits(polyc__arena *a, size_t dir_n)
+{
+    return polyc__alloc_zero(a, dir_n / 32 + 1, sizeof(uint32_t));
+}
+
+void polyc__contour_reserve(polyc__arena *a, const polyc_limits *lim)
+{
+    polyc__contour_list(a, lim);
+    size_t mark = a->used;
+    busy_bits(a, polyc__grid_dir_cap(lim));
+    a->used = mark;
+}
+
 size_t polyc__contour_bytes(const polyc_limits *lim)
 {
-    /* each beam labels at most one cell; and, while the beams are cast, a
-     * bit per directory entry */
-    return polyc__add(polyc__bytes((size_t)lim->max_beams * 2 + 2, sizeof(int32_t)),
-                      polyc__bytes(polyc__grid_dir_cap(lim) / 32 + 1, sizeof(uint32_t)));
+    polyc__arena a;
+    polyc__arena_counting(&a);
+    polyc__contour_reserve(&a, lim);
+    return a.peak;
 }
 
 /* Labels cell (ix, iy) once; 0 when the list is full. */
@@ -119,8 +140,7 @@ polyc_status polyc__contour_build(polyc_ctx *ctx)
 {
     polyc__grid *g = &ctx->grid;
     ctx->contour_count = 0;
-    ctx->contour_xy = polyc__alloc(&ctx->arena, (size_t)ctx->lim.max_beams * 2 + 2,
-                                   sizeof(int32_t));
+    ctx->contour_xy = polyc__contour_list(&ctx->arena, &ctx->lim);
     if (!ctx->contour_xy)
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the contour");
     /* m > threshold once per cell, as bits in the scratch marks */
@@ -138,7 +158,7 @@ polyc_status polyc__contour_build(polyc_ctx *ctx)
     }
     /* a bit per directory entry: the tile holds an occupied cell (scratch) */
     size_t mark = ctx->arena.used, dir_n = (size_t)g->tiles_x * (size_t)g->tiles_y;
-    uint32_t *busy = polyc__alloc_zero(&ctx->arena, dir_n / 32 + 1, sizeof(uint32_t));
+    uint32_t *busy = busy_bits(&ctx->arena, dir_n);
     if (!busy)
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the contour");
     for (size_t d = 0; g->dir && d < dir_n; d++)

@@ -17,7 +17,7 @@ static int intersect(const polyc__vertex *a, const polyc__vertex *b, const polyc
     float rx = b->x - a->x, ry = b->y - a->y, sx = d->x - c->x, sy = d->y - c->y;
     float den = rx * sy - ry * sx;
     float lr = sqrtf(rx * rx + ry * ry), ls = sqrtf(sx * sx + sy * sy);
-    if (fabsf(den) < 0.17f * lr * ls) /* less than 10 degrees apart */
+    if (fabsf(den) < POLYC__CORNER_SIN * lr * ls) /* less than 10 degrees apart */
         return 0;
     float t = ((c->x - a->x) * sy - (c->y - a->y) * sx) / den;
     *x = a->x + t * rx;
@@ -62,7 +62,7 @@ static int try_corner(polyc__opt *o, int32_t b, int32_t c, int k)
         if (nd != POLYC__NONE && nd != a)
             dangle += polyc__turn_cost(o, x, y, V[d].x, V[d].y, V[nd].x, V[nd].y);
     }
-    double dbic = (double)o->cfg->alpha * (derr + gamma * dangle) - (double)k * o->log_n;
+    double dbic = (double)o->cfg->alpha * (derr + gamma * dangle) - (double)k * o->d.log_n;
     if (dbic >= 0.0)
         return 0;
     float old_xy[4 * POLYC__EDIT_SEGS];

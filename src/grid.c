@@ -40,6 +40,13 @@ size_t polyc__grid_budget_bytes(const polyc_limits *lim)
     return polyc__add(polyc__bytes(tiles + 1, sizeof(polyc__tile)), dir);
 }
 
+/* The grid hands out its tiles by data, within its budget (the directory,
+ * its bits, the spill tile and the tiles): that budget is its reservation. */
+void polyc__grid_reserve(polyc__arena *a, const polyc_limits *lim)
+{
+    polyc__alloc(a, polyc__grid_budget_bytes(lim), 1);
+}
+
 int polyc__cell_occupied(const polyc__tile *t, int idx, float threshold)
 {
     unsigned h = t->hits[idx];
@@ -112,7 +119,7 @@ static float incidence_sin(const polyc_ctx *ctx, const polyc__scan *s, uint32_t 
         return 1.0f;
     /* middle point (r, 0) must lie within 3 cm + 2% of the chord */
     float off = fabsf(tx * (0.0f - ay) - ty * (r - ax)) / len;
-    if (off > 0.03f + 0.02f * r)
+    if (off > POLYC__SURFACE_OFF_M + POLYC__SURFACE_OFF_REL * r)
         return 1.0f;
     return fabsf(ty) / len;
 }
@@ -158,7 +165,7 @@ static int beam_fill(const polyc_ctx *ctx, const polyc__scan *s, uint32_t i, pol
         /* The last cell / sin(incidence) of a beam runs within a cell of the
          * surface it hits: a grazing beam would count misses in the wall's
          * own cells there. Misses stop before that stretch. */
-        float sn = polyc__maxf(incidence_sin(ctx, s, i, r, rot), 0.05f);
+        float sn = polyc__maxf(incidence_sin(ctx, s, i, r, rot), POLYC__INCIDENCE_SIN_MIN);
         float skip = polyc__minf(ctx->cfg.grazing_cells / sn, 0.5f * len);
         b->miss_end = len > 0.0f ? 1.0f - skip / len : 0.0f;
     }
@@ -279,20 +286,20 @@ polyc_status polyc__grid_build(polyc_ctx *ctx)
 {
     polyc__grid *g = &ctx->grid;
     memset(g, 0, sizeof *g);
-    if (!ctx->have_extent)
+    if (!ctx->ext.have)
         return POLYC_OK; /* no data: an empty grid */
     float cell = ctx->cfg.cell_m;
     double cell_d = (double)cell, ext = (double)ctx->cfg.max_extent_m;
     double pad = 2.0 * cell_d;
-    double w_m = ctx->ext_max_x - ctx->ext_min_x + 2.0 * pad;
-    double h_m = ctx->ext_max_y - ctx->ext_min_y + 2.0 * pad;
+    double w_m = ctx->ext.max_x - ctx->ext.min_x + 2.0 * pad;
+    double h_m = ctx->ext.max_y - ctx->ext.min_y + 2.0 * pad;
     if (w_m > ext || h_m > ext)
         return polyc__fail(ctx, POLYC_ERR_EXTENT,
                            "the data span more than config.max_extent_m (a far-away scan?)");
     g->cell_m = cell;
     g->inv_cell = 1.0f / cell;
-    g->origin_x_m = ctx->frame_x + ctx->ext_min_x - pad;
-    g->origin_y_m = ctx->frame_y + ctx->ext_min_y - pad;
+    g->origin_x_m = ctx->frame_x + ctx->ext.min_x - pad;
+    g->origin_y_m = ctx->frame_y + ctx->ext.min_y - pad;
     double wc = ceil(w_m / cell_d), hc = ceil(h_m / cell_d);
     if (wc > 2147483000.0 || hc > 2147483000.0)
         return polyc__fail(ctx, POLYC_ERR_EXTENT, "grid too large for 32-bit cell indices");

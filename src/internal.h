@@ -4,6 +4,7 @@
 #define POLYC_INTERNAL_H
 
 #include "polyc.h"
+#include "tunables.h"
 
 #ifndef POLYC_ASSERT
 #include <assert.h>
@@ -33,6 +34,8 @@ typedef struct polyc__arena {
 } polyc__arena;
 
 void *polyc__alloc(polyc__arena *a, size_t count, size_t elem_size);
+/* an arena that only counts (no block): what polyc_memory_size carves on */
+void polyc__arena_counting(polyc__arena *a);
 void *polyc__alloc_zero(polyc__arena *a, size_t count, size_t elem_size);
 /* size of count * elem_size rounded up to the arena alignment; 0 on overflow */
 size_t polyc__bytes(size_t count, size_t elem_size);
@@ -145,6 +148,7 @@ typedef struct polyc__hash {
  * p(turn angle | x, y) from corners between lines fitted in single scans.
  * The prior grid is the tile grid: one cell per 32 x 32 grid cells. */
 #define POLYC__ANGLE_BINS 18       /* 10 degree bins of the turn angle, 0..180 */
+#define POLYC__BINS_PER_RAD 5.729577951f /* 18 / pi: 10 degree bins */
 typedef struct polyc__prior {
     double origin_x, origin_y;     /* frame-relative lower-left corner */
     float cell_m, inv_cell;
@@ -171,8 +175,6 @@ typedef struct polyc__acc_learn {
     void *samples, *cells;         /* scratch */
     uint32_t n, cap;
 } polyc__acc_learn;
-/* bytes for a prior of `cells` cells: the weights and the scratch */
-size_t polyc__accuracy_bytes(const polyc_limits *lim, size_t cells);
 /* the weights (all 1), after the prior's cells are laid out; 0: no room */
 int polyc__accuracy_begin(polyc__acc_learn *L, polyc__prior *p, polyc__arena *a,
                           const polyc_limits *lim);
@@ -185,14 +187,24 @@ void polyc__accuracy_sample(polyc__acc_learn *L, float x, float y, float nx, flo
                             uint32_t scan, float res2, float density);
 /* pairs the samples up and sets the weights (alpha: the error term's) */
 void polyc__accuracy_finish(polyc__acc_learn *L, polyc__arena *a, float alpha);
+/* what polyc__accuracy_finish allocates at most (L->cap samples), on a
+ * counting arena */
+void polyc__accuracy_reserve_finish(polyc__acc_learn *L, polyc__arena *a);
 /* the weight at (x, y), frame metres; 1 outside the prior or without one */
 float polyc__accuracy_weight(const polyc__prior *p, float x, float y);
 
+/* the prior's allocations under the limits, on a counting arena; and their peak */
+void polyc__prior_reserve(polyc__arena *a, const polyc_limits *lim);
 size_t polyc__prior_bytes(const polyc_limits *lim);
 /* Learns the prior from the stored scans (needs the grid for its extent);
  * with `spare` bytes or more of the block free beyond what the later stages
  * are budgeted, also the table of smoothed counts (p->smooth). */
 polyc_status polyc__prior_build(polyc_ctx *ctx, polyc__prior *p, size_t spare);
+/* prior_learn.c: the counts from every scan, into p (laid out, rows handed
+ * out as cells get evidence); cache: cache_cap beams' endpoints (NULL: none);
+ * acc: the accuracy's samples (NULL: none) */
+void polyc__prior_learn(const polyc_ctx *ctx, polyc__prior *p, float *cache, uint32_t cache_cap,
+                        polyc__acc_learn *acc);
 /* p(turn | x, y) in [0, 1]; x, y frame-relative metres; turn in [0, pi]. */
 float polyc__prior_p(const polyc__prior *p, float x, float y, float turn_rad);
 /* The same for many turns at one place: its cell's smoothed counts. */
@@ -216,72 +228,26 @@ typedef struct polyc__spacing {
     uint32_t pose_count;
 } polyc__spacing;
 
-size_t polyc__spacing_bytes(const polyc_limits *lim);
+/* the table's allocation under the limits, on a counting arena */
+void polyc__spacing_reserve(polyc__arena *a, const polyc_limits *lim);
 polyc_status polyc__spacing_build(polyc_ctx *ctx, polyc__spacing *sp);
 /* metres between neighbouring endpoints near (x, y), frame-relative; a lower
  * bound, since the nearest pose is taken (0 without poses) */
 float polyc__spacing_at(const polyc__spacing *sp, float x, float y);
 
-typedef enum polyc__stage {
-    POLYC__STAGE_SCANS = 0,
-    POLYC__STAGE_GRID,
-    POLYC__STAGE_CONTOUR,
-    POLYC__STAGE_TRACE,
-    POLYC__STAGE_OPTIMIZED
-} polyc__stage;
 
-struct polyc_ctx {
-    uint32_t magic;
-    polyc_config cfg;
-    polyc_limits lim;
-    polyc__arena arena;
-    size_t scans_mark;             /* arena use after the fixed scan storage */
-    polyc__stage stage;
-    const char *error;
-    int32_t error_scan;
-
-    double frame_x, frame_y;       /* first pose: stored floats are relative to it */
-    int have_frame;
-    /* an occupancy grid (occupancy.c) instead of scans: stored floats are in
-     * its frame, whose corner is frame_x, frame_y and whose x axis points
-     * along (frame_cos, frame_sin); its grid and contour are input, kept
-     * below scans_mark */
-    int from_grid;
-    double frame_cos, frame_sin;
-    size_t base_mark;              /* arena use after polyc_init's scan storage */
-    polyc_config grid_cfg;         /* the optimiser's weights for it (optimize.c);
-                                      here, not on the optimiser's stack */
-    polyc__scan *scans;
-    float *ranges;
-    uint32_t scan_count, range_count;
-    double ext_min_x, ext_min_y, ext_max_x, ext_max_y; /* frame-relative extent */
-    int have_extent;
-
-    polyc__grid grid;
-    int32_t *contour_xy;           /* 2 per contour cell */
-    uint32_t contour_count;
-    size_t grid_mark;              /* arena use after the grid */
-    size_t contour_mark;           /* arena use after the contour */
-
-    polyc__store store;
-    polyc__flat flat;
-    int opt_result_valid;          /* the store holds a map to publish */
-    size_t trace_mark;             /* arena use after the initial polylines */
-
-    polyc__point *points;
-    uint32_t point_count;
-    double point_weight;           /* n of the BIC: every endpoint counts */
-
-    polyc_stats stats;
-};
-
-#define POLYC__MAGIC 0x706f6c79u   /* "poly" */
-
-/* errors: keep the first message of an operation */
-polyc_status polyc__fail(polyc_ctx *ctx, polyc_status st, const char *msg);
+/* config.c: a pose is usable (finite, within 10,000 km); the extent rule
+ * (the pose and every reflected endpoint, frame shifted by ox, oy) grows
+ * box[4] = min x, min y, max x, max y (have: it holds something) */
+int polyc__pose_ok(double x, double y, double th);
+void polyc__extent_add(const polyc_scan *s, double ox, double oy, double *box, int *have);
 
 /* grid.c */
+/* entries the grid's tile directory may have under the limits */
+size_t polyc__grid_dir_cap(const polyc_limits *lim);
 size_t polyc__grid_budget_bytes(const polyc_limits *lim);
+/* the budget, on a counting arena */
+void polyc__grid_reserve(polyc__arena *a, const polyc_limits *lim);
 polyc_status polyc__grid_build(polyc_ctx *ctx);
 polyc__tile *polyc__grid_tile(const polyc__grid *g, int32_t ix, int32_t iy);
 /* NULL for cells outside the grid or in tiles not stored (no beam ends in a
@@ -352,14 +318,22 @@ int polyc__occ_free_at(const polyc_ctx *ctx, float x, float y);
 #define POLYC__FACE_CELLS 4
 
 /* contour.c */
-/* entries the grid's tile directory may have under the limits */
-size_t polyc__grid_dir_cap(const polyc_limits *lim);
+/* the contour list (limits.max_beams + 1 cells) */
+int32_t *polyc__contour_list(polyc__arena *a, const polyc_limits *lim);
+/* the stage's allocations under the limits, on a counting arena; and their peak */
+void polyc__contour_reserve(polyc__arena *a, const polyc_limits *lim);
 size_t polyc__contour_bytes(const polyc_limits *lim);
 polyc_status polyc__contour_build(polyc_ctx *ctx);
 
 /* polyline.c */
-size_t polyc__store_bytes(const polyc_limits *lim);
-polyc_status polyc__store_init(polyc_ctx *ctx, polyc__store *s, int32_t v_cap);
+/* the store's vertex capacity: limits.max_vertices, or max_beams + 1024 */
+int32_t polyc__max_vertices(const polyc_limits *lim);
+/* lines a store (and its flat form) of v_cap vertices holds */
+int32_t polyc__line_cap(int32_t v_cap);
+/* the store's allocations under the limits, on a counting arena */
+void polyc__store_reserve(polyc__arena *a, const polyc_limits *lim);
+/* 0: no room */
+int polyc__store_init(polyc__arena *a, polyc__store *s, int32_t v_cap);
 void polyc__store_clear(polyc__store *s);
 int32_t polyc__line_new(polyc__store *s);
 void polyc__line_free(polyc__store *s, int32_t line);
@@ -370,26 +344,24 @@ void polyc__line_close(polyc__store *s, int32_t line);
 void polyc__line_reverse(polyc__store *s, int32_t line);
 int32_t polyc__line_cut(polyc__store *s, int32_t u, int *ok);
 void polyc__line_join(polyc__store *s, int32_t tail, int32_t head);
-size_t polyc__flat_bytes(const polyc_limits *lim);
-polyc_status polyc__flat_init(polyc_ctx *ctx, polyc__flat *f, uint32_t cap_lines, uint32_t cap_points);
+/* a flat form of v_cap vertices' allocations, on a counting arena */
+void polyc__flat_reserve(polyc__arena *a, int32_t v_cap);
+/* 0: no room */
+int polyc__flat_init(polyc__arena *a, polyc__flat *f, uint32_t cap_lines, uint32_t cap_points);
 void polyc__flat_from_store(polyc__flat *f, const polyc__store *s);
 polyc_status polyc__store_from_flat(polyc__store *s, const polyc__flat *f);
 
 /* trace.c */
 polyc_status polyc__trace_build(polyc_ctx *ctx);
+void polyc__trace_reserve(polyc__arena *a, const polyc_limits *lim);
 /* scan_chains.c: a single scan's initial polylines from its beam order */
-size_t polyc__chains_bytes(const polyc_limits *lim);
+void polyc__chains_reserve(polyc__arena *a, const polyc_limits *lim);
 polyc_status polyc__chains_build(polyc_ctx *ctx);
 
-/* points.c */
-size_t polyc__points_bytes(const polyc_limits *lim);
-polyc_status polyc__points_build(polyc_ctx *ctx);
-
 /* optimize.c */
-size_t polyc__optimizer_bytes(const polyc_config *cfg, const polyc_limits *lim);
+/* what the optimiser carves after the prior, on a counting arena */
+void polyc__optimizer_reserve(polyc__arena *a, const polyc_config *cfg, const polyc_limits *lim);
 polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *user);
 polyc_status polyc__score(polyc_ctx *ctx, double *bic, double *err);
-
-int32_t polyc__max_vertices(const polyc_limits *lim);
 
 #endif

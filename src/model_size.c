@@ -7,13 +7,25 @@
 
 #include <math.h>
 
+int polyc__size_carve(polyc__arena *a, polyc__size_scratch *sz, int32_t V)
+{
+    int ok = 1;
+    POLYC__CARVE(ok, a, sz->seg_sum, V);
+    POLYC__CARVE(ok, a, sz->seg_w, V);
+    POLYC__CARVE(ok, a, sz->seg_far_d, V);
+    POLYC__CARVE(ok, a, sz->seg_far, V);
+    sz->heap_cap = V + POLYC__HEAP_SPARE; /* a candidate that finds it full is not retried */
+    POLYC__CARVE(ok, a, sz->heap, sz->heap_cap);
+    return ok;
+}
+
 
 static void heap_push(polyc__opt *o, double delta, int32_t v)
 {
-    if (o->heap_n >= o->heap_cap)
+    if (o->size.heap_n >= o->size.heap_cap)
         return; /* full: the candidate is simply not retried */
-    polyc__heap_entry *h = o->heap;
-    int32_t i = o->heap_n++;
+    polyc__heap_entry *h = o->size.heap;
+    int32_t i = o->size.heap_n++;
     while (i > 0) {
         int32_t p = (i - 1) / 2;
         if (h[p].delta <= delta)
@@ -28,14 +40,14 @@ static void heap_push(polyc__opt *o, double delta, int32_t v)
 
 static polyc__heap_entry heap_pop(polyc__opt *o)
 {
-    polyc__heap_entry *h = o->heap;
-    polyc__heap_entry top = h[0], last = h[--o->heap_n];
+    polyc__heap_entry *h = o->size.heap;
+    polyc__heap_entry top = h[0], last = h[--o->size.heap_n];
     int32_t i = 0;
     for (;;) {
         int32_t c = 2 * i + 1;
-        if (c >= o->heap_n)
+        if (c >= o->size.heap_n)
             break;
-        if (c + 1 < o->heap_n && h[c + 1].delta < h[c].delta)
+        if (c + 1 < o->size.heap_n && h[c + 1].delta < h[c].delta)
             c++;
         if (last.delta <= h[c].delta)
             break;
@@ -104,9 +116,9 @@ double polyc__removal_delta_below(polyc__opt *o, int32_t v, double bound)
     }
     double alpha = (double)o->cfg->alpha;
     /* delta < bound  <=>  derr < limit */
-    double limit = isinf(bound) ? bound : (bound - dk * o->log_n) / alpha - gamma * dangle;
+    double limit = isinf(bound) ? bound : (bound - dk * o->d.log_n) / alpha - gamma * dangle;
     double derr = polyc__local_delta(o, old, n_old, xy, n_new, limit);
-    return alpha * (derr + gamma * dangle) + dk * o->log_n;
+    return alpha * (derr + gamma * dangle) + dk * o->d.log_n;
 }
 
 /* Candidates: the vertices edited at or after touch stamp `since` (0: all);
@@ -115,7 +127,7 @@ double polyc__removal_delta_below(polyc__opt *o, int32_t v, double bound)
 int polyc__op_remove_vertices(polyc__opt *o, uint32_t since)
 {
     polyc__store *s = o->s;
-    o->heap_n = 0;
+    o->size.heap_n = 0;
     for (int32_t v = 0; v < s->v_high; v++) {
         if (s->v[v].line == POLYC__NONE || o->v_touch[v] < since)
             continue;
@@ -124,14 +136,14 @@ int polyc__op_remove_vertices(polyc__opt *o, uint32_t since)
             heap_push(o, d, v);
     }
     int removed = 0;
-    while (o->heap_n > 0) {
+    while (o->size.heap_n > 0) {
         polyc__heap_entry e = heap_pop(o);
         if (s->v[e.v].line == POLYC__NONE)
             continue;
         double d = polyc__removal_delta_below(o, e.v, 0.0);
         if (d >= 0.0)
             continue;
-        if (o->heap_n > 0 && d > o->heap[0].delta + 1e-9) {
+        if (o->size.heap_n > 0 && d > o->size.heap[0].delta + 1e-9) {
             heap_push(o, d, e.v); /* no longer the best: back in line */
             continue;
         }
@@ -155,21 +167,21 @@ int polyc__op_remove_vertices(polyc__opt *o, uint32_t since)
 static void segment_stats(polyc__opt *o)
 {
     for (int32_t v = 0; v < o->s->v_high; v++) {
-        o->seg_sum[v] = 0.0f;
-        o->seg_w[v] = 0.0f;
-        o->seg_far[v] = POLYC__NONE;
-        o->seg_far_d[v] = -1.0f;
+        o->size.seg_sum[v] = 0.0f;
+        o->size.seg_w[v] = 0.0f;
+        o->size.seg_far[v] = POLYC__NONE;
+        o->size.seg_far_d[v] = -1.0f;
     }
-    for (int32_t i = 0; i < o->np; i++) {
-        int32_t sg = o->pt_seg[i];
+    for (int32_t i = 0; i < o->d.np; i++) {
+        int32_t sg = o->d.pt_seg[i];
         if (sg == POLYC__NONE)
             continue;
-        float w = o->pts[i].w, c = (float)o->pt_cost[i];
-        o->seg_sum[sg] += c;
-        o->seg_w[sg] += w;
-        if (c / w > o->seg_far_d[sg]) {
-            o->seg_far_d[sg] = c / w;
-            o->seg_far[sg] = i;
+        float w = o->d.pts[i].w, c = (float)o->d.pt_cost[i];
+        o->size.seg_sum[sg] += c;
+        o->size.seg_w[sg] += w;
+        if (c / w > o->size.seg_far_d[sg]) {
+            o->size.seg_far_d[sg] = c / w;
+            o->size.seg_far[sg] = i;
         }
     }
 }
@@ -189,10 +201,10 @@ int polyc__op_add_vertices(polyc__opt *o, int max_tries)
         double score[ADD_CANDIDATES];
         int nc = 0;
         for (int32_t v = 0; v < s->v_high; v++) {
-            if (s->v[v].line == POLYC__NONE || s->v[v].next == POLYC__NONE || o->seg_w[v] < 4.0f ||
-                o->seg_far[v] == POLYC__NONE)
+            if (s->v[v].line == POLYC__NONE || s->v[v].next == POLYC__NONE || o->size.seg_w[v] < 4.0f ||
+                o->size.seg_far[v] == POLYC__NONE)
                 continue;
-            double m = (double)(o->seg_sum[v] / o->seg_w[v]);
+            double m = (double)(o->size.seg_sum[v] / o->size.seg_w[v]);
             if (nc == ADD_CANDIDATES && m <= score[nc - 1])
                 continue;
             int k = nc < ADD_CANDIDATES ? nc++ : nc - 1;
@@ -210,21 +222,21 @@ int polyc__op_add_vertices(polyc__opt *o, int max_tries)
             if (s->v[u].line == POLYC__NONE || s->v[u].next == POLYC__NONE)
                 continue;
             int32_t w = s->v[u].next;
-            int32_t far = o->seg_far[u];
-            if (o->pt_seg[far] != u)
+            int32_t far = o->size.seg_far[u];
+            if (o->d.pt_seg[far] != u)
                 continue; /* stale after an earlier addition */
             float old_xy[4 * POLYC__EDIT_SEGS];
             int n_xy = o->rays.on ? polyc__edit_segments(o, &u, 1, old_xy) : 0;
             if (o->rays.on &&
-                (polyc__blocks_beams(&o->rays, s->v[u].x, s->v[u].y, o->pts[far].x, o->pts[far].y,
+                (polyc__blocks_beams(&o->rays, s->v[u].x, s->v[u].y, o->d.pts[far].x, o->d.pts[far].y,
                                      old_xy, n_xy) ||
-                 polyc__blocks_beams(&o->rays, o->pts[far].x, o->pts[far].y, s->v[w].x, s->v[w].y,
+                 polyc__blocks_beams(&o->rays, o->d.pts[far].x, o->d.pts[far].y, s->v[w].x, s->v[w].y,
                                      old_xy, n_xy)))
                 continue;
             double before = polyc__bic(o);
             float ux = s->v[u].x, uy = s->v[u].y, wx = s->v[w].x, wy = s->v[w].y;
             polyc__chg_begin(o);
-            int32_t v = polyc__op_insert_after(o, u, o->pts[far].x, o->pts[far].y);
+            int32_t v = polyc__op_insert_after(o, u, o->d.pts[far].x, o->d.pts[far].y);
             polyc__chg_commit(o);
             if (v == POLYC__NONE)
                 return added;

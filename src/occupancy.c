@@ -6,7 +6,7 @@
  * and the contour is every occupied cell that faces free space (faces_free;
  * docs/algorithm.md, "From an occupancy grid"). The caller's cells
  * are read during the call only. */
-#include "internal.h"
+#include "context.h"
 
 #include <math.h>
 #include <string.h>
@@ -144,7 +144,7 @@ polyc_status polyc_limits_for_grid(const polyc_config *config, const polyc_occup
     if (tiles * 4 + 64 < dir_n)
         tiles = (dir_n - 64 + 3) / 4;
     out->max_grid_cells = (uint32_t)(tiles * POLYC__TILE_CELLS);
-    out->max_vertices = (uint32_t)occupied + 1024u;
+    out->max_vertices = (uint32_t)occupied + POLYC__VERTEX_SPARE;
     out->max_points = (uint32_t)occupied;
     return POLYC_OK;
 }
@@ -257,7 +257,7 @@ static polyc_status fill(polyc_ctx *ctx, const polyc_occupancy_grid *grid, const
     /* the contour list after the tiles: each occupied cell labels itself at
      * most once, so limits.max_beams (the occupied cells) bounds it */
     ctx->contour_count = 0;
-    ctx->contour_xy = polyc__alloc(&ctx->arena, (size_t)ctx->lim.max_beams * 2 + 2, sizeof(int32_t));
+    ctx->contour_xy = polyc__contour_list(&ctx->arena, &ctx->lim);
     if (!ctx->contour_xy)
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the contour");
     /* a miss in each free cell of a stored tile (polyc_grid_cell reads it);
@@ -331,8 +331,8 @@ polyc_status polyc__occ_add(polyc_ctx *ctx, const polyc_occupancy_grid *grid)
     ctx->frame_x = grid->origin_x_m;
     ctx->frame_y = grid->origin_y_m;
     ctx->have_frame = 1;
-    ctx->frame_cos = cos(grid->origin_yaw_rad);
-    ctx->frame_sin = sin(grid->origin_yaw_rad);
+    ctx->frame_dir.cos = cos(grid->origin_yaw_rad);
+    ctx->frame_dir.sin = sin(grid->origin_yaw_rad);
     /* the grid and its contour are this context's input: stages restart
      * after them */
     ctx->scans_mark = ctx->grid_mark = ctx->contour_mark = ctx->arena.used;

@@ -3,188 +3,10 @@
  * found by repeating the operators (overlaps, merge, split, vertex moves,
  * zigzags, noise, vertex count) until `patience` iterations bring no better
  * BIC, or the iteration cap or the caller's progress callback stops it. */
-#include "optimize.h"
+#include "cost.h"
 
 #include <math.h>
 #include <string.h>
-
-#define ADJUST_ROUNDS 4
-#define ADD_ROUNDS 4
-#define ADDED_CAP 64
-#define RECOVER_GAIN 5e-3 /* an iteration this much below the last does not use up patience */
-
-
-/* No copy for a context of one scan: its trials list fewer than 8 points
- * nine times in ten (and its block is the embedded one). An occupancy
- * grid's limits have no scans (polyc_limits_for_grid) and get the copy. */
-static int32_t loc_soa_cap(const polyc_limits *lim)
-{
-    return lim->max_scans != 1 ? POLYC__LOC_SOA : 0;
-}
-
-size_t polyc__optimizer_bytes(const polyc_config *cfg, const polyc_limits *lim)
-{
-    size_t P = (size_t)polyc__points_bound(cfg, lim);
-    size_t V = (size_t)polyc__max_vertices(lim);
-    size_t NB = (size_t)polyc__hash_bucket_cap(lim);
-    size_t NE = (size_t)polyc__hash_entry_cap(lim);
-    size_t n = 0;
-    n = polyc__add(n, polyc__bytes(P * 2, sizeof(polyc__point))); /* sorted + unsorted */
-    if (lim->max_scans > 1) {
-        n = polyc__add(n, polyc__bytes(P * 2, 2 * sizeof(float))); /* pt_view, sorted + unsorted */
-        n = polyc__add(n, polyc__bytes(V, sizeof(float)));         /* seg_side */
-    }
-    n = polyc__add(n, polyc__bytes(P, sizeof(int32_t)));          /* pt_seg */
-    n = polyc__add(n, polyc__bytes(P, sizeof(double)));           /* pt_cost */
-    n = polyc__add(n, polyc__bytes(P, sizeof(int32_t)));          /* loc_pt */
-    n = polyc__add(n, polyc__bytes(P, sizeof(double)));           /* loc_base */
-    n = polyc__add(n, polyc__bytes(P, sizeof(int32_t)));          /* loc_seg */
-    n = polyc__add(n, polyc__bytes(P, sizeof(int32_t)));          /* agg_pt */
-    n = polyc__add(n, polyc__bytes(POLYC__CAND_MAX, sizeof(int32_t) + 4 * sizeof(float))); /* cand */
-    n = polyc__add(n, polyc__bytes((size_t)loc_soa_cap(lim), 7 * sizeof(double))); /* lsoa */
-    n = polyc__add(n, polyc__bytes(P + V, sizeof(float)));        /* split_t */
-    n = polyc__add(n, polyc__bytes(V, 3 * sizeof(float)));        /* trim_head, gap_head, gap_tail */
-    n = polyc__add(n, polyc__bytes(V + 1, sizeof(int32_t)));      /* split_off */
-    n = polyc__add(n, polyc__bytes(V / 4 + 64, 2 * sizeof(float) + 2 * sizeof(int32_t))); /* cuts */
-    n = polyc__add(n, polyc__bytes(V, sizeof(double) + 3 * sizeof(float))); /* acost, seg stats */
-    n = polyc__add(n, polyc__bytes(V, 6 * sizeof(int32_t) + 2));  /* marks, lists, seg_in, split_due */
-    n = polyc__add(n, polyc__bytes(V + 1024, sizeof(polyc__heap_entry)));
-    n = polyc__add(n, polyc__bytes(ADDED_CAP, sizeof(int32_t)));
-    n = polyc__add(n, polyc__bytes(NB, 4 * sizeof(int32_t)));     /* heads, starts, marks, list */
-    n = polyc__add(n, polyc__bytes(NE, sizeof(polyc__hash_entry)));
-    n = polyc__add(n, polyc__flat_bytes(lim));                    /* best model */
-    return polyc__add(n, 44 * 16);                                /* alignment slack */
-}
-
-#define ALLOC(ptr, count) \
-    do { if (!((ptr) = polyc__alloc(&ctx->arena, (size_t)(count), sizeof *(ptr)))) goto nomem; } while (0)
-
-/* An occupancy grid's data are cell centres, not noisy endpoints
- * (docs/algorithm.md, "From an occupancy grid"): its squared distances are
- * weighed as in 5 cm cells, alpha (GRID_CELL_M / r)^2 (alpha itself at 5 cm,
- * the maps ROS users keep: the sweep's occupancy maps 23 of 48 scenes on
- * target against 20 with alpha / 4; a room at 2.5, 5, 10 or 15 cm comes out
- * with its corner count of vertices); the search radius is at least
- * GRID_RADIUS_CELLS cells (at 5 cm, 2 cells lost pillars of the turtlebot3
- * map, at 15 cm 1 cell lost a box); and there is no angle prior (gamma 0:
- * learned from the grid's edges it cost more coverage than it saved
- * vertices). */
-#define GRID_CELL_M 0.05f
-#define GRID_RADIUS_CELLS 3.0f
-/* A grid's search: an iteration gains only if its BIC is lower by more
- * than GRID_GAIN of it, and noisy iterations count towards the patience. A
- * grid's data are exact cell centres: on the bench's 2,000 x 2,000-cell
- * maze the first iteration's map stayed the best through 12 more (its noise
- * a whole cell), and the search took 1.4 of the 1.5 s; with these rules 6
- * iterations, 0.85 s, the same map. */
-#define GRID_GAIN 2e-3
-
-static const polyc_config *grid_config(polyc_ctx *ctx)
-{
-    polyc_config *c = &ctx->grid_cfg;
-    float r = ctx->grid.cell_m, k = GRID_CELL_M / r;
-    *c = ctx->cfg;
-    c->alpha = ctx->cfg.alpha * k * k;
-    c->gamma = 0.0f;
-
-    if (c->search_radius_m < GRID_RADIUS_CELLS * r)
-        c->search_radius_m = GRID_RADIUS_CELLS * r;
-    return c;
-}
-
-/* Everything the optimiser needs, carved from the arena after the trace
- * (also the entry point of the optimiser's unit tests). */
-polyc_status polyc__opt_setup(polyc_ctx *ctx, polyc__opt *o)
-{
-    memset(o, 0, sizeof *o);
-    o->ctx = ctx;
-    o->cfg = ctx->from_grid ? grid_config(ctx) : &ctx->cfg;
-    o->s = &ctx->store;
-    o->R = o->cfg->search_radius_m;
-    o->R2 = o->R * o->R;
-    o->rng.state = ctx->cfg.seed;
-    int32_t V = o->s->v_cap;
-    polyc__rays_init(&o->rays, ctx);
-    /* what the optimiser will still take from the block after the prior */
-    size_t later = polyc__add(polyc__spacing_bytes(&ctx->lim),
-                              polyc__optimizer_bytes(&ctx->cfg, &ctx->lim));
-    polyc_status st = polyc__prior_build(ctx, &o->prior, later);
-    if (st != POLYC_OK)
-        return st;
-    if ((st = polyc__spacing_build(ctx, &o->spacing)) != POLYC_OK)
-        return st;
-    if ((st = polyc__hash_init(o)) != POLYC_OK)
-        return st;
-    if ((st = polyc__points_collect(o)) != POLYC_OK)
-        return st;
-    o->log_n = log(o->n > 1.0 ? o->n : 1.0);
-    int32_t P = o->np > 0 ? o->np : 1;
-    ALLOC(o->pt_seg, P);
-    ALLOC(o->pt_cost, P);
-    ALLOC(o->loc_pt, P);
-    ALLOC(o->loc_base, P);
-    ALLOC(o->loc_seg, P);
-    ALLOC(o->agg_pt, P);
-    ALLOC(o->cand_seg, POLYC__CAND_MAX);
-    ALLOC(o->cand_box, 4 * POLYC__CAND_MAX);
-    o->lsoa_cap = loc_soa_cap(&ctx->lim);
-    o->lsoa_n = -1;
-    if (o->lsoa_cap > 0) {
-        ALLOC(o->lsoa_x, o->lsoa_cap);
-        ALLOC(o->lsoa_y, o->lsoa_cap);
-        ALLOC(o->lsoa_w, o->lsoa_cap);
-        ALLOC(o->lsoa_cxx, o->lsoa_cap);
-        ALLOC(o->lsoa_cxy, o->lsoa_cap);
-        ALLOC(o->lsoa_cyy, o->lsoa_cap);
-        ALLOC(o->lsoa_c, o->lsoa_cap);
-    }
-    o->agg_cap = P;
-    ALLOC(o->split_t, P > V ? P : V);
-    ALLOC(o->trim_head, V);
-    ALLOC(o->gap_head, V);
-    ALLOC(o->gap_tail, V);
-    memset(o->gap_head, 0, (size_t)V * sizeof(float));
-    memset(o->gap_tail, 0, (size_t)V * sizeof(float));
-    ALLOC(o->split_off, V + 1);
-    /* cuts per pass (more wait for the next pass) */
-    ALLOC(o->cut_seg, V / 4 + 64);
-    ALLOC(o->cut_next, V / 4 + 64);
-    ALLOC(o->cut_t0, V / 4 + 64);
-    ALLOC(o->cut_t1, V / 4 + 64);
-    o->cut_cap = V / 4 + 64;
-    ALLOC(o->acost, V);
-    o->seg_side = NULL;
-    if (o->pt_view)
-        ALLOC(o->seg_side, V);
-    ALLOC(o->seg_sum, V);
-    ALLOC(o->seg_w, V);
-    ALLOC(o->seg_far_d, V);
-    ALLOC(o->seg_far, V);
-    ALLOC(o->seg_dead, V);
-    ALLOC(o->v_dirty, V);
-    ALLOC(o->dirty_list, V);
-    ALLOC(o->seg_in, V);
-    ALLOC(o->split_due, V);
-    ALLOC(o->v_work, V);
-    memset(o->v_work, 0, (size_t)V * sizeof(uint32_t));
-    ALLOC(o->v_touch, V);
-    memset(o->v_touch, 0, (size_t)V * sizeof(uint32_t));
-    ALLOC(o->heap, V + 1024); /* a candidate that finds it full is not retried */
-    o->heap_cap = V + 1024;
-    ALLOC(o->added, ADDED_CAP);
-    o->added_cap = ADDED_CAP;
-    o->dirty_cap = V;
-    memset(o->seg_dead, 0, (size_t)V * sizeof(uint32_t));
-    memset(o->v_dirty, 0, (size_t)V * sizeof(uint32_t));
-    memset(o->seg_in, 0, (size_t)V);
-    memset(o->split_due, 0, (size_t)V);
-    int32_t vcap = V;
-    if ((st = polyc__flat_init(ctx, &o->best, (uint32_t)(vcap / 2 + 16), (uint32_t)vcap)) != POLYC_OK)
-        return st;
-    return polyc__rebuild(o);
-nomem:
-    return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the optimiser");
-}
 
 static void fill_stats(polyc__opt *o)
 {
@@ -238,18 +60,59 @@ static polyc_status polish(polyc__opt *o, double best)
             return st;
         o->untangle_mark = o->zip_mark = 0;
     }
-    for (int k = 0; k < 8 && polyc__op_split(o) > 0; k++)
+    for (int k = 0; k < POLYC__POLISH_SPLITS && polyc__op_split(o) > 0; k++)
         ;
     polyc__op_trim_ends(o);
     uint32_t mark = ++o->touch_stamp;
     if (polyc__op_zip(o) > 0) {
         /* what is left of a zipped pair moves onto the data of both */
-        polyc__op_adjust(o, ADJUST_ROUNDS, mark);
+        polyc__op_adjust(o, POLYC__ADJUST_ROUNDS, mark);
         polyc__op_trim_ends(o);
         polyc__op_zip(o);
     }
     polyc__op_untangle(o);
     return POLYC_OK;
+}
+
+/* One iteration's operators after the noise, in their order; `since`: the
+ * stamp after which edits are looked at again (0: all), `climb`: the
+ * first climb's. Returns the stamp taken after the first climb. */
+static uint32_t operators(polyc__opt *o, uint32_t since, uint32_t climb)
+{
+    if (o->pol.restructure) {
+        polyc__op_overlaps(o);      /* A */
+        polyc__op_merge(o);         /* B */
+        polyc__op_split(o);         /* C */
+    }
+    polyc__op_remove_vertices(o, since); /* G: fewer vertices first, so that */
+    /* D moves what is left. A single scan's later iterations climb only
+     * what the previous one edited after its first climbs (removals,
+     * zigzags, corners, trims): the vertices those climbs left at an
+     * optimum stay there (on 200 freiburg-campus scans, with ends not
+     * climbed, climbing them again takes a sixth of the time and lowers
+     * the BIC by 0.15 %) */
+    polyc__op_adjust(o, POLYC__ADJUST_ROUNDS, climb);
+    uint32_t first = ++o->touch_stamp, mark = first;
+    polyc__op_zigzag(o);            /* E */
+    polyc__op_corners(o, since);    /* corners (not in the paper) */
+    polyc__op_remove_vertices(o, mark); /* G */
+    if (o->pol.add_vertices)
+        polyc__op_add_vertices(o, POLYC__ADD_ROUNDS); /* G, more vertices */
+    polyc__op_adjust(o, POLYC__ADJUST_ROUNDS, mark);
+    /* moves and additions can leave segments without data or hairpins:
+     * clean them before the model is judged, so the best one is clean */
+    for (int round = 0; round < POLYC__CLEAN_ROUNDS; round++) {
+        mark = ++o->touch_stamp;
+        if ((!o->pol.restructure ? 0 : polyc__op_split(o)) + polyc__op_zigzag(o) +
+                polyc__op_corners(o, since) == 0)
+            break;
+        polyc__op_adjust(o, POLYC__ADJUST_ROUNDS, mark);
+    }
+    polyc__op_trim_ends(o); /* moves could push ends past the data */
+    if (o->pol.restructure)
+        polyc__op_zip(o);   /* one piece of map per wall */
+    polyc__op_untangle(o);  /* last: the map judged has no crossing */
+    return first;
 }
 
 polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *user)
@@ -274,8 +137,8 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
          * could not correct it. Without noise, only what changed since the
          * previous iteration is adjusted and offered for removal again. */
         double noise = it > 0 && sigma >= 0.5 * (double)cfg->step_m ? sigma : 0.0;
-        if (o.rays.on)
-            noise = 0.0; /* single scan: see docs/algorithm.md */
+        if (!o.pol.noise)
+            noise = 0.0;
         if (noise > 0.0) {
             polyc__op_noise(&o, noise);
             o.untangle_mark = o.zip_mark = 0; /* every segment moved */
@@ -284,44 +147,10 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
         }
         uint32_t since = it == 0 || noise > 0.0 ? 0 : prev_start;
         prev_start = start;
-        if (!o.rays.on) {
-            /* a single scan's chains already join what its beam order
-             * joins: overlaps, merges and splits are its beams' business */
-            polyc__op_overlaps(&o);      /* A */
-            polyc__op_merge(&o);         /* B */
-            polyc__op_split(&o);         /* C */
-        }
-        polyc__op_remove_vertices(&o, since); /* G: fewer vertices first, so that */
-        /* D moves what is left. A single scan's later iterations climb only
-         * what the previous one edited after its first climbs (removals,
-         * zigzags, corners, trims): the vertices those climbs left at an
-         * optimum stay there (on 200 freiburg-campus scans, with ends not
-         * climbed, climbing them again takes a sixth of the time and
-         * lowers the BIC by 0.15 %) */
-        polyc__op_adjust(&o, ADJUST_ROUNDS, o.rays.on && it > 0 ? prev_mark : since);
-        uint32_t mark = ++o.touch_stamp;
-        prev_mark = mark;
-        polyc__op_zigzag(&o);            /* E */
-        polyc__op_corners(&o, since);    /* corners (not in the paper) */
-        polyc__op_remove_vertices(&o, mark); /* G */
-        if (!o.rays.on) /* a single scan's chains start with more than enough */
-            polyc__op_add_vertices(&o, ADD_ROUNDS); /* G, more vertices */
-        polyc__op_adjust(&o, ADJUST_ROUNDS, mark);
-        /* moves and additions can leave segments without data or hairpins:
-         * clean them before the model is judged, so the best one is clean */
-        for (int round = 0; round < 3; round++) {
-            mark = ++o.touch_stamp;
-            if ((o.rays.on ? 0 : polyc__op_split(&o)) + polyc__op_zigzag(&o) +
-                    polyc__op_corners(&o, since) == 0)
-                break;
-            polyc__op_adjust(&o, ADJUST_ROUNDS, mark);
-        }
-        polyc__op_trim_ends(&o); /* moves could push ends past the data */
-        if (!o.rays.on)
-            polyc__op_zip(&o);   /* one piece of map per wall */
-        polyc__op_untangle(&o);  /* last: the map judged has no crossing */
+        prev_mark = operators(&o, since, o.pol.climb_since_prev && it > 0 ? prev_mark : since);
         if (o.h.out_of_entries)
             return restore_best(&o, polyc__fail(ctx, POLYC_ERR_NOMEM, "spatial hash full"));
+        POLYC__CHECKS_ITERATION(&o);
         double bic = polyc__bic(&o);
         /* any better map is kept; a gain under one BIC unit (no evidence
          * either way) does not restart the patience: late iterations can
@@ -330,15 +159,12 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
          * on purpose, and a run of them all worse than iteration 0 stopped
          * infinite-corridor at iteration 5 with 5,766 vertices (3,793 when
          * the noise is allowed to decay) */
-        int gained = bic < best - (ctx->from_grid ? fmax(1.0, GRID_GAIN * fabs(best)) : 1.0);
+        int gained = bic < best - (o.pol.gain_share > 0.0 ? fmax(1.0, o.pol.gain_share * fabs(best)) : 1.0);
         /* Nor do iterations that are still coming down from the noise by
-         * more than RECOVER_GAIN of the BIC each: where the points of a band
-         * weigh less (accuracy.c) the climb back is slower, and belgioioso's
-         * search stopped at iteration 0's map (958 vertices) while each
-         * iteration still gained 1-2 % (757 vertices when it may go on) */
-        int recovering = !ctx->from_grid && it > 0 && bic < prev_bic - RECOVER_GAIN * fabs(prev_bic);
+         * more than POLYC__RECOVER_GAIN of the BIC each (tunables.h) */
+        int recovering = o.pol.recover && it > 0 && bic < prev_bic - POLYC__RECOVER_GAIN * fabs(prev_bic);
         prev_bic = bic;
-        quiet = gained ? 0 : ((noise > 0.0 && !ctx->from_grid) || recovering ? quiet : quiet + 1);
+        quiet = gained ? 0 : ((noise > 0.0 && o.pol.noise_spares_patience) || recovering ? quiet : quiet + 1);
         if (bic < best - 1e-9 * fabs(best)) {
             best = bic;
             polyc__flat_from_store(&o.best, o.s);
@@ -364,14 +190,14 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
          * and of what the previous one edited: one that edited nothing is
          * followed by copies of itself, so the patience would run out on
          * the same best map. */
-        int noisy_later = !o.rays.on && sigma >= 0.5 * (double)cfg->step_m;
+        int noisy_later = o.pol.noise && sigma >= 0.5 * (double)cfg->step_m;
         if (!noisy_later && !edited_since(&o, start))
             break;
         /* A single scan has no noise either: an iteration that gained less
          * than one BIC unit leaves so little edited that the next ones gain
          * nothing measurable (the 130 bench scans: 4 vertices more in
          * all, the same f and ray RMSE, 4 % fewer instructions) */
-        if (o.rays.on && !gained)
+        if (o.pol.stop_without_gain && !gained)
             break;
     }
     ctx->stats.iterations = it < cfg->max_iterations ? it + (result == POLYC_OK) : it;
@@ -381,7 +207,7 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
     ctx->opt_result_valid = 1;
     if ((st = polyc__rebuild(&o)) != POLYC_OK)
         return st;
-    if (!o.rays.on && result == POLYC_OK && (st = polish(&o, best)) != POLYC_OK)
+    if (o.pol.restructure && result == POLYC_OK && (st = polish(&o, best)) != POLYC_OK)
         return st;
     fill_stats(&o);
     return result;

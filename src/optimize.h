@@ -3,7 +3,7 @@
 #ifndef POLYC_OPTIMIZE_H
 #define POLYC_OPTIMIZE_H
 
-#include "internal.h"
+#include "context.h"
 
 typedef struct polyc__heap_entry {
     double delta;                  /* change of the BIC if the vertex goes */
@@ -22,41 +22,8 @@ typedef struct polyc__rays {
     double own_m;                  /* a return this near a segment's line is its own */
 } polyc__rays;
 
-typedef struct polyc__opt {
-    polyc_ctx *ctx;
-    const polyc_config *cfg;       /* ctx->cfg, or ctx->grid_cfg for an occupancy grid */
-    polyc__store *s;
-
-    /* data: weighted points sorted by hash bucket, and their assignment */
-    polyc__point *pts;
-    float *pt_view;                /* per point: the sum of unit vectors from its endpoints
-                                    * towards their sensors (NULL: not known, grids and
-                                    * single scans) */
-    int32_t np;
-    float *seg_side;               /* per vertex: its segment's side (topology.c, band zip) */
-    int32_t *pt_seg;               /* nearest segment (its start vertex) or NONE */
-    double *pt_cost;               /* capped cost of the point's endpoints */
-    double n, log_n;               /* BIC's n: every endpoint */
-    float R, R2;                   /* search radius: the cost of a point is capped at w R^2 */
-    float point_span_m;            /* side of the block a weighted point stands for */
-    float support_m;               /* a point supports the map this near it: POLYC__SUPPORT_M,
-                                    * or a point's span where that is wider (grids) */
-
-    /* model terms, kept incrementally */
-    double err;                    /* sum of pt_cost */
-    double angle;                  /* sum over vertices of (1 - p(turn | x, y)) */
-    double *acost;                 /* per vertex: 1 - p */
-    polyc__prior prior;
-    polyc__spacing spacing;        /* expected point spacing: the split scale */
-    polyc__rays rays;              /* single-scan mode: the beams' free space */
-
-    polyc__hash h;
-    uint8_t *seg_in;               /* per vertex: its segment is in the hash */
-    uint8_t *split_due;            /* per vertex: its segment or its points changed
-                                    * since op_split last looked at it */
-    int32_t cur_seg;               /* segment being entered or removed */
-
-    /* one change (a batch of edits) being recorded */
+/* The books of one change (a batch of edits) being recorded (score.c). */
+typedef struct polyc__change {
     uint32_t epoch;
     uint32_t *seg_dead;            /* per vertex: == epoch when its segment changed */
     uint32_t *v_dirty;             /* per vertex: == epoch when its angle is pending */
@@ -66,8 +33,10 @@ typedef struct polyc__opt {
     uint32_t *bucket_mark;         /* per bucket: == epoch when listed */
     int32_t *bucket_list, bucket_n;
     int32_t added_cap, dirty_cap;
+} polyc__change;
 
-    /* local evaluation scratch */
+/* Trial evaluation's scratch (score.c; read by adjust.c and trial_costs.c). */
+typedef struct polyc__eval_scratch {
     int32_t *loc_pt;               /* points near the edited segments */
     double *loc_base;              /* their cost without the edited segments */
     int32_t *loc_seg;              /* and the segment giving it */
@@ -95,9 +64,11 @@ typedef struct polyc__opt {
     int agg_on;                    /* 0: no aggregation prepared */
     int agg_moving_b[2];           /* the moving end is the segment's b */
     double agg_ax[2], agg_ay[2], agg_m[2][3];
+} polyc__eval_scratch;
 
-    /* split scratch: per segment offsets, positions of its points (of the
-     * segments split_due only) */
+/* Split and end trimming's scratch (operators.c): per segment offsets,
+ * positions of its points (of the segments split_due only). */
+typedef struct polyc__split_scratch {
     int32_t *split_off;
     float *split_t;
     int32_t *cut_seg, *cut_next, cut_cap;
@@ -105,12 +76,80 @@ typedef struct polyc__opt {
     float *trim_head;              /* end trimming: farthest point from the head side */
     float *gap_head, *gap_tail;    /* per segment: its ends' distance to its nearest data
                                     * (split, valid while it is not split_due) */
+} polyc__split_scratch;
 
-    /* model size scratch: per segment sums, farthest point; removal heap */
+/* Vertex removal's scratch (model_size.c): per segment sums, farthest
+ * point; the removal heap. */
+typedef struct polyc__size_scratch {
     float *seg_sum, *seg_w, *seg_far_d;
     int32_t *seg_far;
     polyc__heap_entry *heap;
     int32_t heap_n, heap_cap;
+} polyc__size_scratch;
+
+/* The data: weighted points sorted by hash bucket (points.c), and their
+ * assignment to the model (score.c). */
+typedef struct polyc__data {
+    polyc__point *pts;
+    float *pt_view;                /* per point: the sum of unit vectors from its endpoints
+                                    * towards their sensors (NULL: not known, grids and
+                                    * single scans) */
+    int32_t np;
+    int32_t *pt_seg;               /* nearest segment (its start vertex) or NONE */
+    double *pt_cost;               /* capped cost of the point's endpoints */
+    double n, log_n;               /* BIC's n: every endpoint */
+    float point_span_m;            /* side of the block a weighted point stands for */
+    float support_m;               /* a point supports the map this near it: POLYC__SUPPORT_M,
+                                    * or a point's span where that is wider (grids) */
+} polyc__data;
+
+/* What the search does for the kind of input (polyc__input_kind), decided
+ * once in polyc__opt_setup; the loop (optimize.c) reads it. */
+typedef struct polyc__policy {
+    /* an occupancy grid: an iteration gains only if the BIC falls by more
+     * than gain_share of it (0: by one unit) */
+    double gain_share;
+    /* flags (bytes: the policy rides on the optimiser's stack). A single scan's chains already join what its beam order joins: no
+     * overlaps, merges, splits or zips (A, B, C), nor the polish of the
+     * best map; they start with more than enough vertices: no additions
+     * (G); and no noise (F, docs/algorithm.md) */
+    uint8_t restructure, add_vertices, noise;
+    /* a single scan's later iterations climb only what the previous one
+     * edited after its first climbs, and it stops after an iteration
+     * without gain */
+    uint8_t climb_since_prev, stop_without_gain;
+    /* an occupancy grid: noisy iterations and ones still recovering from
+     * the noise do not spare the patience; a gap in the data is cut only as
+     * far as the grid has free cells along it (split.c) */
+    uint8_t noise_spares_patience, recover, gaps_free_only;
+} polyc__policy;
+
+/* The optimiser's long-lived state: the model and its terms, the spatial
+ * index, the books of the current change and the stamps; each operator
+ * group's working state is its own struct, carved by its file. */
+typedef struct polyc__opt {
+    polyc_ctx *ctx;
+    const polyc_config *cfg;       /* ctx->cfg, or ctx->grid_cfg for an occupancy grid */
+    polyc__store *s;
+    polyc__policy pol;
+    float R, R2;                   /* search radius: the cost of a point is capped at w R^2 */
+
+    polyc__data d;
+    float *seg_side;               /* per vertex: its segment's side (topology.c, band zip) */
+
+    /* model terms, kept incrementally */
+    double err;                    /* sum of pt_cost */
+    double angle;                  /* sum over vertices of (1 - p(turn | x, y)) */
+    double *acost;                 /* per vertex: 1 - p */
+    polyc__prior prior;
+    polyc__spacing spacing;        /* expected point spacing: the split scale */
+    polyc__rays rays;              /* single-scan mode: the beams' free space */
+
+    polyc__hash h;
+    uint8_t *seg_in;               /* per vertex: its segment is in the hash */
+    uint8_t *split_due;            /* per vertex: its segment or its points changed
+                                    * since op_split last looked at it */
+    polyc__change chg;
 
     uint32_t *v_work;              /* per vertex: == round stamp when to be climbed */
     uint32_t work_stamp;
@@ -120,10 +159,46 @@ typedef struct polyc__opt {
                                     * edited since is looked at again */
     polyc__rng rng;
     polyc__flat best;
-    double noise_m;
+
+    polyc__eval_scratch ev;
+    polyc__split_scratch split;
+    polyc__size_scratch size;
 } polyc__opt;
 
 #define POLYC__CAND_MAX 48
+
+/* topology.c, zip.c */
+/* Does segment sg share vertex a or b (NONE: a new point)? */
+inline int polyc__touches(const polyc__store *s, int32_t sg, int32_t a, int32_t b)
+{
+    int32_t e = s->v[sg].next;
+    return (a != POLYC__NONE && (sg == a || e == a)) || (b != POLYC__NONE && (sg == b || e == b));
+}
+/* Whether segment v (live) was edited since the touch stamp `since`: a
+ * crossing or a doubly covered stretch that is new has a new or moved
+ * segment on one side, so a pass needs to look only at those. */
+inline int polyc__edited_since(const polyc__opt *o, int32_t v, uint32_t since)
+{
+    return o->v_touch[v] >= since || o->v_touch[o->s->v[v].next] >= since;
+}
+
+
+/* ok &= carving count elements of *ptr from arena a (the carve functions:
+ * each group's scratch is carved by its own file, on the block or on the
+ * size query's counting arena) */
+#define POLYC__CARVE(ok, a, ptr, count) \
+    ((ok) &= ((ptr) = polyc__alloc((a), (size_t)(count), sizeof *(ptr))) != NULL)
+#define POLYC__CARVE_ZERO(ok, a, ptr, count) \
+    ((ok) &= ((ptr) = polyc__alloc_zero((a), (size_t)(count), sizeof *(ptr))) != NULL)
+/* score.c: the books of a change for V vertices; trial evaluation's scratch
+ * for P points (lsoa_cap: listed points copied by field, 0 for none) */
+int polyc__change_carve(polyc__arena *a, polyc__change *c, int32_t V);
+/* change.c: lists the buckets a segment's points can be in for rescoring */
+void polyc__chg_mark_region(polyc__opt *o, int32_t seg);
+int polyc__eval_carve(polyc__arena *a, polyc__eval_scratch *ev, int32_t P, int32_t lsoa_cap);
+/* operators.c: split and trim scratch; model_size.c: vertex removal's */
+int polyc__split_carve(polyc__arena *a, polyc__split_scratch *sp, int32_t P, int32_t V);
+int polyc__size_carve(polyc__arena *a, polyc__size_scratch *sz, int32_t V);
 /* a data point supports the stretch of map within this distance of it:
  * splits and end trimming count only such points (not in the paper) */
 #define POLYC__SUPPORT_M 0.05f
@@ -141,26 +216,42 @@ int32_t polyc__points_bound(const polyc_config *cfg, const polyc_limits *lim);
 /* whether the points carry the direction they were seen from (pt_view) */
 int polyc__points_viewed(const polyc_ctx *ctx);
 polyc_status polyc__points_collect(polyc__opt *o);
+/* the points' allocations under the limits, on a counting arena */
+void polyc__points_reserve(polyc__arena *a, const polyc_config *cfg, const polyc_limits *lim);
 
 /* spatial_hash.c */
 int32_t polyc__hash_bucket_cap(const polyc_limits *lim);
 int32_t polyc__hash_entry_cap(const polyc_limits *lim);
 polyc_status polyc__hash_init(polyc__opt *o);
+/* the hash's allocations under the limits, on a counting arena */
+void polyc__hash_reserve(polyc__arena *a, polyc__opt *o, const polyc_limits *lim);
 int polyc__hash_insert(polyc__opt *o, int32_t seg);
 void polyc__hash_remove(polyc__opt *o, int32_t seg);
 void polyc__hash_clear(polyc__opt *o);
 int32_t polyc__bucket_of(const polyc__hash *h, float x, float y);
 /* the column and row of the bucket holding (x, y), clamped to the hash */
-static inline void polyc__bucket_xy(const polyc__hash *h, float x, float y, int32_t *ix, int32_t *iy)
+inline void polyc__bucket_xy(const polyc__hash *h, float x, float y, int32_t *ix, int32_t *iy)
 {
     float fx = (x - h->origin_x) * h->inv_bucket, fy = (y - h->origin_y) * h->inv_bucket;
     *ix = fx < 0.0f ? 0 : (fx >= (float)h->bx ? h->bx - 1 : (int32_t)fx);
     *iy = fy < 0.0f ? 0 : (fy >= (float)h->by ? h->by - 1 : (int32_t)fy);
 }
-/* calls fn for every bucket the segment a-b crosses */
-typedef void (*polyc__bucket_fn)(polyc__opt *o, int32_t bucket);
+/* The 3 x 3 buckets around bucket (bx, by) that lie in the hash, row by
+ * row, into out; returns their count (the one bucket walk of the library). */
+inline int polyc__buckets_around(const polyc__hash *h, int32_t bx, int32_t by, int32_t out[9])
+{
+    int32_t x0 = bx > 0 ? bx - 1 : 0, x1 = bx + 1 < h->bx ? bx + 1 : h->bx - 1;
+    int32_t y0 = by > 0 ? by - 1 : 0, y1 = by + 1 < h->by ? by + 1 : h->by - 1;
+    int n = 0;
+    for (int32_t y = y0; y <= y1; y++)
+        for (int32_t x = x0; x <= x1; x++)
+            out[n++] = y * h->bx + x;
+    return n;
+}
+/* calls fn(o, user, bucket) for every bucket the segment a-b crosses */
+typedef void (*polyc__bucket_fn)(polyc__opt *o, void *user, int32_t bucket);
 void polyc__segment_buckets(polyc__opt *o, float ax, float ay, float bx, float by,
-                            polyc__bucket_fn fn);
+                            polyc__bucket_fn fn, void *user);
 /* lists in o->bucket_list, once per epoch (o->bucket_mark), every bucket
  * within one bucket of the segment a-b: those whose points it can reach */
 void polyc__segment_region(polyc__opt *o, float ax, float ay, float bx, float by);
@@ -175,8 +266,6 @@ typedef struct polyc__seg_pre {
 void polyc__trial_costs_min(const polyc__opt *o, const polyc__seg_pre *q, double *c);
 
 /* score.c */
-double polyc__cost(const polyc__point *p, float ax, float ay, float bx, float by);
-double polyc__cost_seg(const polyc__opt *o, const polyc__point *p, int32_t seg);
 /* nearest segment within reach, skipping up to n_skip segments */
 double polyc__nearest(const polyc__opt *o, int32_t pi, const int32_t *skip, int n_skip,
                       int32_t *seg);
@@ -210,6 +299,7 @@ void polyc__op_remove(polyc__opt *o, int32_t v);
 int32_t polyc__op_insert_after(polyc__opt *o, int32_t u, float x, float y);
 void polyc__op_cut(polyc__opt *o, int32_t u);                 /* cut link u -> next */
 int polyc__op_link(polyc__opt *o, int32_t tail, int32_t head); /* join or close */
+void polyc__op_reverse(polyc__opt *o, int32_t l);              /* reverse polyline l */
 /* one edit as a change of its own (begin, edit, commit) */
 void polyc__apply_remove(polyc__opt *o, int32_t v);
 void polyc__apply_move(polyc__opt *o, int32_t v, float x, float y);
@@ -234,7 +324,7 @@ int polyc__op_remove_vertices(polyc__opt *o, uint32_t since);
  * some value >= bound (INFINITY: always exact) */
 double polyc__removal_delta_below(polyc__opt *o, int32_t v, double bound);
 /* Squared distance from (px, py) to segment a-b. */
-static inline float polyc__seg_dist2(float px, float py, float ax, float ay, float bx, float by)
+inline float polyc__seg_dist2(float px, float py, float ax, float ay, float bx, float by)
 {
     float dx = bx - ax, dy = by - ay, mx = px - ax, my = py - ay;
     float l2 = dx * dx + dy * dy;

@@ -274,19 +274,38 @@ int32_t polyc__points_bound(const polyc_config *cfg, const polyc_limits *lim)
     return b > 0x3fffffffu ? 0x3fffffff : (int32_t)b;
 }
 
+/* The points and, with `viewed`, where they were seen from: a pair of
+ * arrays of cap entries (the sorted ones first, the unsorted after them). */
+static int points_carve(polyc__arena *a, int32_t cap, int viewed, polyc__point **pts, float **view)
+{
+    *pts = polyc__alloc(a, (size_t)cap, sizeof(polyc__point));
+    *view = viewed ? polyc__alloc(a, (size_t)cap, 2 * sizeof(float)) : NULL;
+    return *pts && (!viewed || *view);
+}
+
+void polyc__points_reserve(polyc__arena *a, const polyc_config *cfg, const polyc_limits *lim)
+{
+    polyc__point *pts;
+    float *view;
+    int32_t cap = polyc__points_bound(cfg, lim);
+    points_carve(a, cap, lim->max_scans > 1, &pts, &view);
+    size_t mark = a->used;
+    points_carve(a, cap, lim->max_scans > 1, &pts, &view);
+    a->used = mark;
+}
+
 polyc_status polyc__points_collect(polyc__opt *o)
 {
     polyc_ctx *ctx = o->ctx;
     int32_t cap = polyc__points_bound(o->cfg, &ctx->lim);
-    /* final array first, the unsorted one after it (released at the end) */
-    o->pts = polyc__alloc(&ctx->arena, (size_t)cap, sizeof(polyc__point));
-    /* where the endpoints were seen from: scans (more than one) only */
+    /* final array first, the unsorted one after it (released at the end);
+     * where the endpoints were seen from: scans (more than one) only */
     int viewed = polyc__points_viewed(ctx);
-    o->pt_view = viewed ? polyc__alloc(&ctx->arena, (size_t)cap, 2 * sizeof(float)) : NULL;
+    int ok = points_carve(&ctx->arena, cap, viewed, &o->d.pts, &o->d.pt_view);
     size_t mark = ctx->arena.used;
-    polyc__point *tmp = polyc__alloc(&ctx->arena, (size_t)cap, sizeof(polyc__point));
-    float *tmp_view = viewed ? polyc__alloc(&ctx->arena, (size_t)cap, 2 * sizeof(float)) : NULL;
-    if (!o->pts || !tmp || (viewed && (!o->pt_view || !tmp_view)))
+    polyc__point *tmp;
+    float *tmp_view;
+    if (!ok || !points_carve(&ctx->arena, cap, viewed, &tmp, &tmp_view))
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the data points");
     int32_t n = 0;
     /* one scan: a point per return, whose beam the ends are set by (a
@@ -320,25 +339,24 @@ polyc_status polyc__points_collect(polyc__opt *o)
     for (int32_t i = 0; i < n; i++) {
         int32_t b = polyc__bucket_of(h, tmp[i].x, tmp[i].y);
         uint32_t at = h->pt_start[b]++;
-        o->pts[at] = tmp[i];
+        o->d.pts[at] = tmp[i];
         if (tmp_view) {
-            o->pt_view[2 * at] = tmp_view[2 * i];
-            o->pt_view[2 * at + 1] = tmp_view[2 * i + 1];
+            o->d.pt_view[2 * at] = tmp_view[2 * i];
+            o->d.pt_view[2 * at + 1] = tmp_view[2 * i + 1];
         }
     }
     for (int32_t b = nb; b > 0; b--)
         h->pt_start[b] = h->pt_start[b - 1];
     h->pt_start[0] = 0;
     ctx->arena.used = mark;
-    o->np = n;
-    o->n = total;
+    o->d.np = n;
+    o->d.n = total;
     /* the span of one weighted point: gaps between points shorter than it
      * say nothing (split) */
-    o->point_span_m = ctx->from_grid ? ctx->grid.cell_m
+    o->d.point_span_m = ctx->from_grid ? ctx->grid.cell_m
                       : exact        ? 0.0f
                                      : ctx->grid.cell_m * (float)BLOCK_SIDE;
-    o->support_m = polyc__maxf(POLYC__SUPPORT_M, o->point_span_m);
-    ctx->point_weight = total;
+    o->d.support_m = polyc__maxf(POLYC__SUPPORT_M, o->d.point_span_m);
     ctx->stats.data_points = (uint64_t)total;
     ctx->stats.weighted_points = (uint32_t)n;
     return POLYC_OK;

@@ -8,36 +8,40 @@
 
 int32_t polyc__max_vertices(const polyc_limits *lim)
 {
-    uint64_t v = lim->max_vertices ? lim->max_vertices : (uint64_t)lim->max_beams + 1024u;
+    uint64_t v = lim->max_vertices ? lim->max_vertices : (uint64_t)lim->max_beams + POLYC__VERTEX_SPARE;
     if (v > 0x3fffffffu)
         v = 0x3fffffffu;
     return (int32_t)v;
 }
 
-static int32_t max_lines(int32_t v_cap)
+int32_t polyc__line_cap(int32_t v_cap)
 {
     return v_cap / 2 + 16;
 }
 
-size_t polyc__store_bytes(const polyc_limits *lim)
-{
-    int32_t v = polyc__max_vertices(lim);
-    return polyc__add(polyc__bytes((size_t)v, sizeof(polyc__vertex)),
-                      polyc__bytes((size_t)max_lines(v), sizeof(polyc__line)));
-}
-
-polyc_status polyc__store_init(polyc_ctx *ctx, polyc__store *s, int32_t v_cap)
+static int store_carve(polyc__arena *a, polyc__store *s, int32_t v_cap)
 {
     memset(s, 0, sizeof *s);
     s->v_cap = v_cap;
-    s->l_cap = max_lines(v_cap);
-    s->v = polyc__alloc(&ctx->arena, (size_t)s->v_cap, sizeof(polyc__vertex));
-    s->l = polyc__alloc(&ctx->arena, (size_t)s->l_cap, sizeof(polyc__line));
-    if (!s->v || !s->l)
-        return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the polylines");
+    s->l_cap = polyc__line_cap(v_cap);
+    s->v = polyc__alloc(a, (size_t)s->v_cap, sizeof(polyc__vertex));
+    s->l = polyc__alloc(a, (size_t)s->l_cap, sizeof(polyc__line));
+    return s->v && s->l;
+}
+
+void polyc__store_reserve(polyc__arena *a, const polyc_limits *lim)
+{
+    polyc__store s;
+    store_carve(a, &s, polyc__max_vertices(lim));
+}
+
+int polyc__store_init(polyc__arena *a, polyc__store *s, int32_t v_cap)
+{
+    if (!store_carve(a, s, v_cap))
+        return 0;
     s->v_free = POLYC__NONE;
     s->l_free = POLYC__NONE;
-    return POLYC_OK;
+    return 1;
 }
 
 void polyc__store_clear(polyc__store *s)
@@ -202,27 +206,29 @@ void polyc__line_reverse(polyc__store *s, int32_t l)
 
 /* ---- flattened form ---- */
 
-size_t polyc__flat_bytes(const polyc_limits *lim)
-{
-    int32_t v = polyc__max_vertices(lim);
-    size_t lines = (size_t)max_lines(v);
-    size_t b = polyc__bytes((size_t)v * 2, sizeof(float));
-    b = polyc__add(b, polyc__bytes(lines + 1, sizeof(uint32_t)));
-    return polyc__add(b, polyc__bytes(lines, 1));
-}
-
-polyc_status polyc__flat_init(polyc_ctx *ctx, polyc__flat *f, uint32_t cap_lines, uint32_t cap_points)
+static int flat_carve(polyc__arena *a, polyc__flat *f, uint32_t cap_lines, uint32_t cap_points)
 {
     memset(f, 0, sizeof *f);
-    f->xy = polyc__alloc(&ctx->arena, (size_t)cap_points * 2, sizeof(float));
-    f->start = polyc__alloc(&ctx->arena, (size_t)cap_lines + 1, sizeof(uint32_t));
-    f->closed = polyc__alloc(&ctx->arena, cap_lines, 1);
-    if (!f->xy || !f->start || !f->closed)
-        return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the result polylines");
+    f->xy = polyc__alloc(a, (size_t)cap_points * 2, sizeof(float));
+    f->start = polyc__alloc(a, (size_t)cap_lines + 1, sizeof(uint32_t));
+    f->closed = polyc__alloc(a, cap_lines, 1);
+    return f->xy && f->start && f->closed;
+}
+
+void polyc__flat_reserve(polyc__arena *a, int32_t v_cap)
+{
+    polyc__flat f;
+    flat_carve(a, &f, (uint32_t)polyc__line_cap(v_cap), (uint32_t)v_cap);
+}
+
+int polyc__flat_init(polyc__arena *a, polyc__flat *f, uint32_t cap_lines, uint32_t cap_points)
+{
+    if (!flat_carve(a, f, cap_lines, cap_points))
+        return 0;
     f->cap_lines = cap_lines;
     f->cap_points = cap_points;
     f->start[0] = 0;
-    return POLYC_OK;
+    return 1;
 }
 
 void polyc__flat_from_store(polyc__flat *f, const polyc__store *s)

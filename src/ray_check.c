@@ -16,7 +16,7 @@
 
 void polyc__rays_init(polyc__rays *rays, const polyc_ctx *ctx)
 {
-    rays->on = ctx->scan_count == 1 && !(ctx->cfg.flags & POLYC_FLAG_GRID_TRACE);
+    rays->on = polyc__input_kind(ctx) == POLYC__INPUT_ONE_SCAN;
     if (!rays->on)
         return;
     const polyc__scan *s = &ctx->scans[0];

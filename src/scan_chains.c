@@ -13,9 +13,15 @@
  * front of the link between two endpoints (posts of a railing, a chair in
  * front of a wall) do not break it: several chains can be open at once, and
  * an endpoint joins the most recent one it links to. */
-#include "internal.h"
+#include "scan_chains.h"
 
 #include <math.h>
+
+/* the external definitions of scan_chains.h's inline functions (C99: used
+ * where a caller does not inline them, as at -Os) */
+extern inline float polyc__seg_dist2f(const float *p, const float *a, const float *b);
+extern inline int polyc__chain_has_point(const chains *c, int32_t i);
+extern inline int polyc__chain_member(const chains *c, int32_t i);
 
 #define LAMBDA_RAD 0.1745f   /* 10 degrees: flatter surfaces count as jumps */
 #define GRAZING_REACH 4.0f  /* ... times farther if the chain goes straight on */
@@ -25,202 +31,29 @@
 
 #define MAX_OPEN (MAX_SKIP + 1) /* chains whose last hit is that recent */
 
-typedef struct chains {
-    polyc_ctx *ctx;
-    float *xy;                 /* every beam's endpoint; NaN without a hit */
-    const float *range;        /* every beam's range */
-    uint8_t *chain_of;         /* per beam: its chain's slot, 0 none */
-    uint8_t cur;               /* the slot of the chain being emitted */
-    uint8_t *keep;             /* per beam: a vertex of the simplified chain */
-    float *cost;               /* per kept inner vertex: the BIC change of dropping it */
-    float ox, oy;              /* the scan's origin */
-    float step;                /* |angle step| */
-    float tol;                 /* simplification tolerance */
-    float alpha, log_n;        /* the BIC's weight of the error; log of the returns */
-} chains;
 
-size_t polyc__chains_bytes(const polyc_limits *lim)
+/* the scratch for a scan of n beams */
+static int chains_carve(polyc__arena *a, chains *c, int32_t n)
 {
-    size_t n = polyc__add(polyc__bytes((size_t)lim->max_beams + 1, 3 * sizeof(float)),
-                          polyc__bytes((size_t)lim->max_beams + 1, 1));
-    return polyc__add(n, polyc__bytes((size_t)lim->max_beams + 1, 1));
+    c->xy = polyc__alloc(a, (size_t)n + 1, 2 * sizeof(float));
+    c->keep = polyc__alloc(a, (size_t)n + 1, 1);
+    c->cost = polyc__alloc(a, (size_t)n + 1, sizeof(float));
+    c->chain_of = polyc__alloc(a, (size_t)n + 1, 1);
+    return c->xy && c->keep && c->cost && c->chain_of;
+}
+
+void polyc__chains_reserve(polyc__arena *a, const polyc_limits *lim)
+{
+    chains c;
+    polyc__store_reserve(a, lim);
+    size_t after_store = a->used;
+    chains_carve(a, &c, (int32_t)lim->max_beams);
+    a->used = after_store;
 }
 
 static int is_hit(const polyc__scan *s, float r)
 {
     return r == r && r >= s->min_m && r < s->max_m;
-}
-
-static float seg_dist2(const float *p, const float *a, const float *b)
-{
-    float dx = b[0] - a[0], dy = b[1] - a[1], l2 = dx * dx + dy * dy;
-    float t = l2 > 0.0f ? ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2 : 0.0f;
-    t = t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
-    float ex = a[0] + t * dx - p[0], ey = a[1] + t * dy - p[1];
-    return ex * ex + ey * ey;
-}
-
-static int has_point(const chains *c, int32_t i)
-{
-    return c->xy[2 * i] == c->xy[2 * i];
-}
-
-/* beam i has a hit of the chain being emitted */
-static int member(const chains *c, int32_t i)
-{
-    return c->chain_of[i] == c->cur;
-}
-
-/* Douglas-Peucker over the hits of beams [a, b], both hits: marks vertices
- * in c->keep. Without a stack (fixed memory): each pass splits every span
- * whose farthest point is beyond the tolerance, until none is. */
-static void simplify(chains *c, int32_t a, int32_t b)
-{
-    for (int32_t i = a; i <= b; i++)
-        c->keep[i] = 0;
-    c->keep[a] = c->keep[b] = 1;
-    float tol2 = c->tol * c->tol;
-    int split = 1;
-    while (split) {
-        split = 0;
-        int32_t i = a;
-        while (i < b) {
-            int32_t j = i + 1, far = -1;
-            float worst = tol2;
-            while (!c->keep[j])
-                j++;
-            for (int32_t k = i + 1; k < j; k++) {
-                if (!member(c, k))
-                    continue;
-                float d = seg_dist2(&c->xy[2 * k], &c->xy[2 * i], &c->xy[2 * j]);
-                if (d > worst) {
-                    worst = d;
-                    far = k;
-                }
-            }
-            if (far >= 0) {
-                c->keep[far] = 1;
-                split = 1;
-            }
-            i = j;
-        }
-    }
-}
-
-/* The line fitted (total least squares) to the hits of beams [i, j]: the
- * sum of their squared distances to it is the scatter's smaller eigenvalue,
- * from one pass of sums taken about the first hit. */
-typedef struct span_fit {
-    double x0, y0, n, sx, sy, xx, xy, yy; /* xx, xy, yy: central */
-} span_fit;
-
-static double span_error(const chains *c, int32_t i, int32_t j, span_fit *f)
-{
-    f->x0 = (double)c->xy[2 * i];
-    f->y0 = (double)c->xy[2 * i + 1];
-    double n = 0.0, sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0, syy = 0.0;
-    for (int32_t k = i; k <= j; k++)
-        if (member(c, k)) {
-            double x = (double)c->xy[2 * k] - f->x0, y = (double)c->xy[2 * k + 1] - f->y0;
-            n += 1.0;
-            sx += x;
-            sy += y;
-            sxx += x * x;
-            sxy += x * y;
-            syy += y * y;
-        }
-    f->n = n;
-    f->sx = sx;
-    f->sy = sy;
-    f->xx = sxx - sx * sx / n;
-    f->xy = sxy - sx * sy / n;
-    f->yy = syy - sy * sy / n;
-    double half = 0.5 * (f->xx - f->yy), r = sqrt(half * half + f->xy * f->xy);
-    double e = 0.5 * (f->xx + f->yy) - r;
-    return e > 0.0 ? e : 0.0;
-}
-
-/* The largest distance of a hit of beams [i, j] to their fitted line f
- * along its own beam, squared: a segment on that line stands that far in
- * front of or behind the return (at most 20 times its distance across). */
-static double along_worst2(const chains *c, int32_t i, int32_t j, const span_fit *f)
-{
-    double a = 0.5 * atan2(2.0 * f->xy, f->xx - f->yy), nx = -sin(a), ny = cos(a);
-    double cx = f->x0 + f->sx / f->n, cy = f->y0 + f->sy / f->n, worst = 0.0;
-    for (int32_t k = i; k <= j; k++)
-        if (member(c, k)) {
-            double x = (double)c->xy[2 * k], y = (double)c->xy[2 * k + 1];
-            double d = (x - cx) * nx + (y - cy) * ny;
-            double bx = x - (double)c->ox, by = y - (double)c->oy, b2 = bx * bx + by * by;
-            double cosb = bx * nx + by * ny; /* times the range */
-            double e = d * d * b2 / (cosb * cosb > 0.0025 * b2 ? cosb * cosb : 0.0025 * b2);
-            worst = e > worst ? e : worst;
-        }
-    return worst;
-}
-
-static int32_t kept_after(const chains *c, int32_t j)
-{
-    do
-        j++;
-    while (!c->keep[j]);
-    return j;
-}
-
-static int32_t kept_before(const chains *c, int32_t j)
-{
-    do
-        j--;
-    while (!c->keep[j]);
-    return j;
-}
-
-/* The BIC change of dropping kept vertex j, whose kept neighbours are i and
- * k: alpha times the error the line over [i, k] adds to the lines over
- * [i, j] and [j, k], less the log n a vertex costs; +inf if that line
- * would stand more than the ray tolerance from a return along its beam. */
-static float drop_cost(const chains *c, int32_t i, int32_t j, int32_t k)
-{
-    span_fit merged, part;
-    double gain = span_error(c, i, k, &merged) - span_error(c, i, j, &part) -
-                  span_error(c, j, k, &part);
-    gain = (double)c->alpha * gain - (double)c->log_n;
-    double limit = POLYC__RAY_TOLERANCE_M;
-    if (gain < 0.0 && along_worst2(c, i, k, &merged) > limit * limit)
-        return INFINITY;
-    return (float)gain;
-}
-
-/* Bottom-up over the vertices Douglas-Peucker kept on beams [a, b]: drops
- * the one whose line pair the BIC pays least for, while dropping lowers
- * the BIC and the merged line keeps every return within the ray tolerance
- * along its beam. Douglas-Peucker alone keeps a vertex wherever the range
- * noise puts a return a cell off the chord, and the search's removals (one
- * vertex at a time, the chord of its neighbours, the beams as constraints)
- * leave many of them: from this start the 130 bench scans end with a
- * lower BIC, fewer vertices, and in less time (docs/performance.md). */
-static void merge_spans(chains *c, int32_t a, int32_t b)
-{
-    int32_t inner = 0;
-    for (int32_t j = kept_after(c, a); j < b; j = kept_after(c, j)) {
-        c->cost[j] = drop_cost(c, kept_before(c, j), j, kept_after(c, j));
-        inner++;
-    }
-    while (inner > 0) {
-        int32_t best = -1;
-        for (int32_t j = kept_after(c, a); j < b; j = kept_after(c, j))
-            if (best < 0 || c->cost[j] < c->cost[best])
-                best = j;
-        if (!(c->cost[best] < 0.0f))
-            break;
-        int32_t i = kept_before(c, best), k = kept_after(c, best);
-        c->keep[best] = 0;
-        inner--;
-        if (i > a)
-            c->cost[i] = drop_cost(c, kept_before(c, i), i, k);
-        if (k < b)
-            c->cost[k] = drop_cost(c, i, k, kept_after(c, k));
-    }
 }
 
 static float dist2(const chains *c, int32_t i, int32_t j)
@@ -269,7 +102,7 @@ static void fit(const chains *c, int32_t i, int32_t j, fitted *f)
 {
     float sx = 0.0f, sy = 0.0f, n = 0.0f;
     for (int32_t k = i; k <= j; k++)
-        if (member(c, k)) {
+        if (polyc__chain_member(c, k)) {
             sx += c->xy[2 * k];
             sy += c->xy[2 * k + 1];
             n += 1.0f;
@@ -278,7 +111,7 @@ static void fit(const chains *c, int32_t i, int32_t j, fitted *f)
     f->cy = sy / n;
     float xx = 0.0f, xy = 0.0f, yy = 0.0f;
     for (int32_t k = i; k <= j; k++)
-        if (member(c, k)) {
+        if (polyc__chain_member(c, k)) {
             float ex = c->xy[2 * k] - f->cx, ey = c->xy[2 * k + 1] - f->cy;
             xx += ex * ex;
             xy += ex * ey;
@@ -294,7 +127,7 @@ static void fit(const chains *c, int32_t i, int32_t j, fitted *f)
     by /= r;
     float lo = INFINITY, hi = -INFINITY, across = 0.0f, span = 2.0f * c->ctx->cfg.cell_m;
     for (int32_t k = i; k <= j; k++)
-        if (member(c, k)) {
+        if (polyc__chain_member(c, k)) {
             float ex = c->xy[2 * k] - c->ox, ey = c->xy[2 * k + 1] - c->oy;
             float along = ex * bx + ey * by, side = fabsf(ey * bx - ex * by);
             lo = polyc__minf(lo, along);
@@ -319,7 +152,7 @@ static void project(const fitted *f, const float *p, float *x, float *y)
 static int meet(const fitted *f, const fitted *g, float *x, float *y)
 {
     float den = f->dx * g->dy - f->dy * g->dx;
-    if (fabsf(den) < 0.17f)
+    if (fabsf(den) < POLYC__CORNER_SIN)
         return 0;
     float t = ((g->cx - f->cx) * g->dy - (g->cy - f->cy) * g->dx) / den;
     *x = f->cx + t * f->dx;
@@ -415,8 +248,8 @@ static polyc_status emit(chains *c, int32_t a, int32_t b)
         polyc_status st = append(c, line, x + dy * h, y - dx * h);
         return st != POLYC_OK ? st : append(c, line, x - dy * h, y + dx * h);
     }
-    simplify(c, a, b);
-    merge_spans(c, a, b);
+    polyc__chain_simplify(c, a, b);
+    polyc__chain_merge_spans(c, a, b);
     fitted before, after;
     int32_t i = a, j = a + 1;
     while (!c->keep[j])
@@ -476,7 +309,7 @@ static int links(const chains *c, const open_chain *h, int32_t i, int32_t n)
     float dx = c->xy[2 * i] - lx, dy = c->xy[2 * i + 1] - ly;
     int missing = 0, occluders = 0;
     for (int32_t k = last + 1; k < i; k++) {
-        if (!has_point(c, k)) {
+        if (!polyc__chain_has_point(c, k)) {
             missing++;
             continue;
         }
@@ -506,7 +339,7 @@ static int links(const chains *c, const open_chain *h, int32_t i, int32_t n)
     /* a wall seen at a grazing angle: three points in a line, the chain's
      * last two or the two with the next hit */
     int32_t next = i + 1;
-    while (next < n && next - i <= MAX_SKIP && !has_point(c, next))
+    while (next < n && next - i <= MAX_SKIP && !polyc__chain_has_point(c, next))
         next++;
     return (h->prev >= 0 && straight(c, h->prev, last, i)) ||
            (next < n && next - i <= MAX_SKIP && straight(c, last, i, next) &&
@@ -515,19 +348,17 @@ static int links(const chains *c, const open_chain *h, int32_t i, int32_t n)
 
 polyc_status polyc__chains_build(polyc_ctx *ctx)
 {
-    polyc_status st = polyc__store_init(ctx, &ctx->store, polyc__max_vertices(&ctx->lim));
-    if (st != POLYC_OK || ctx->scan_count == 0)
-        return st;
+    if (!polyc__store_init(&ctx->arena, &ctx->store, polyc__max_vertices(&ctx->lim)))
+        return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the polylines");
+    if (ctx->scan_count == 0)
+        return POLYC_OK;
+    polyc_status st;
     size_t after_store = ctx->arena.used; /* scratch released at the end */
     const polyc__scan *s = &ctx->scans[0];
     int32_t n = (int32_t)s->count;
     chains c;
     c.ctx = ctx;
-    c.xy = polyc__alloc(&ctx->arena, (size_t)n + 1, 2 * sizeof(float));
-    c.keep = polyc__alloc(&ctx->arena, (size_t)n + 1, 1);
-    c.cost = polyc__alloc(&ctx->arena, (size_t)n + 1, sizeof(float));
-    c.chain_of = polyc__alloc(&ctx->arena, (size_t)n + 1, 1);
-    if (!c.xy || !c.keep || !c.cost || !c.chain_of)
+    if (!chains_carve(&ctx->arena, &c, n))
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the scan's chains");
     c.ox = s->x_m;
     c.oy = s->y_m;
@@ -564,7 +395,7 @@ polyc_status polyc__chains_build(polyc_ctx *ctx)
                 slots_used &= ~(1u << (open[k].slot - 1));
                 open[k--] = open[--n_open];
             }
-        if (i == n || !has_point(&c, i))
+        if (i == n || !polyc__chain_has_point(&c, i))
             continue;
         /* the open chain with the most recent last hit that i links to */
         int join = -1;

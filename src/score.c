@@ -1,48 +1,42 @@
-/* score.c - the BIC (paper eqs. 2, 3, 5) and its incremental bookkeeping.
- * Takes: data points, polylines, the spatial hash, the angle prior. Gives:
- * each point's nearest segment and capped cost, the model's error and angle
- * terms, updated after an edit by rescoring only the points near the
- * segments that changed; and a read-only local evaluation for trial moves. */
-#include "optimize.h"
+/* score.c - trial evaluation: the nearest segment to a point (below a
+ * bound), and a read-only local evaluation of trial edits: the points near
+ * the segments an edit would change are listed once with their cost
+ * without those segments, and each trial prices only them (trial_costs.c
+ * in batches). Takes: the optimiser state. Gives: the change of the error
+ * a trial would make, exactly or bounded (removal candidates). */
+#include "trial.h"
 
 #include <math.h>
 
-/* Sum of squared distances of a weighted point's endpoints to segment a-b,
- * all of them taken to fall in the region (interior or end) of their mean. */
-double polyc__cost(const polyc__point *p, float ax, float ay, float bx, float by)
+/* the external definitions of trial.h's inline functions (C99: used
+ * where a caller does not inline them, as at -Os) */
+extern inline void polyc__seg_prepare(polyc__seg_pre *q, const float *xy);
+extern inline double polyc__seg_pre_cost(const polyc__seg_pre *q, const polyc__point *p);
+extern inline polyc__old_set polyc__old_set_of(const int32_t *old, int n_old);
+extern inline int polyc__is_old(const polyc__old_set *s, int32_t seg);
+
+int polyc__eval_carve(polyc__arena *a, polyc__eval_scratch *ev, int32_t P, int32_t lsoa_cap)
 {
-    double dx = (double)bx - (double)ax, dy = (double)by - (double)ay;
-    double mx = (double)p->x - (double)ax, my = (double)p->y - (double)ay;
-    double l2 = dx * dx + dy * dy;
-    double trace = (double)p->cxx + (double)p->cyy;
-    double t = l2 > 1e-18 ? (mx * dx + my * dy) / l2 : 0.0;
-    if (t <= 0.0)
-        return (double)p->w * (mx * mx + my * my) + trace;
-    if (t >= 1.0) {
-        double ex = (double)p->x - (double)bx, ey = (double)p->y - (double)by;
-        return (double)p->w * (ex * ex + ey * ey) + trace;
+    int ok = 1;
+    POLYC__CARVE(ok, a, ev->loc_pt, P);
+    POLYC__CARVE(ok, a, ev->loc_base, P);
+    POLYC__CARVE(ok, a, ev->loc_seg, P);
+    POLYC__CARVE(ok, a, ev->agg_pt, P);
+    ev->agg_cap = P;
+    POLYC__CARVE(ok, a, ev->cand_seg, POLYC__CAND_MAX);
+    POLYC__CARVE(ok, a, ev->cand_box, 4 * POLYC__CAND_MAX);
+    ev->lsoa_cap = lsoa_cap;
+    ev->lsoa_n = -1;
+    if (lsoa_cap > 0) {
+        POLYC__CARVE(ok, a, ev->lsoa_x, lsoa_cap);
+        POLYC__CARVE(ok, a, ev->lsoa_y, lsoa_cap);
+        POLYC__CARVE(ok, a, ev->lsoa_w, lsoa_cap);
+        POLYC__CARVE(ok, a, ev->lsoa_cxx, lsoa_cap);
+        POLYC__CARVE(ok, a, ev->lsoa_cxy, lsoa_cap);
+        POLYC__CARVE(ok, a, ev->lsoa_cyy, lsoa_cap);
+        POLYC__CARVE(ok, a, ev->lsoa_c, lsoa_cap);
     }
-    /* w (n.m)^2 + n'Cn with n = (-dy, dx) / |d|: one division, no root.
-     * C, central moments summed in float, can be a rounding error short of
-     * positive semi-definite (cxy^2 > cxx cyy): n'Cn then dips below 0 for
-     * a point whose endpoints lie on a line, and a map's error could be
-     * -1e-12 (found by fuzz_library). A sum of squares is never negative. */
-    double cross = dx * my - dy * mx;
-    double c = ((double)p->w * cross * cross + dy * dy * (double)p->cxx -
-                2.0 * dx * dy * (double)p->cxy + dx * dx * (double)p->cyy) / l2;
-    return c > 0.0 ? c : 0.0;
-}
-
-double polyc__cost_seg(const polyc__opt *o, const polyc__point *p, int32_t seg)
-{
-    const polyc__vertex *a = &o->s->v[seg];
-    const polyc__vertex *b = &o->s->v[a->next];
-    return polyc__cost(p, a->x, a->y, b->x, b->y);
-}
-
-static double cap_of(const polyc__opt *o, const polyc__point *p)
-{
-    return (double)p->w * (double)o->R2;
+    return ok;
 }
 
 /* The nearest segment costing less than `start` (NONE and `start` if there
@@ -50,13 +44,13 @@ static double cap_of(const polyc__opt *o, const polyc__point *p)
  * only if it is nearer than the best cost so far allows: a segment is
  * entered in every bucket it crosses, so one within distance D of the point
  * crosses a bucket within D of it, and its cost is at least w D^2. */
-static double nearest_below(const polyc__opt *o, int32_t pi, const int32_t *skip, int n_skip,
+double polyc__nearest_below(const polyc__opt *o, int32_t pi, const int32_t *skip, int n_skip,
                             double start, int32_t *seg)
 {
     static const int8_t ORDER[9][2] = {{0, 0}, {-1, 0}, {1, 0}, {0, -1}, {0, 1},
                                        {-1, -1}, {1, -1}, {-1, 1}, {1, 1}};
     const polyc__hash *h = &o->h;
-    const polyc__point *p = &o->pts[pi];
+    const polyc__point *p = &o->d.pts[pi];
     double best = start, w = (double)p->w;
     int32_t best_seg = POLYC__NONE;
     int32_t bx, by;
@@ -108,175 +102,10 @@ static double nearest_below(const polyc__opt *o, int32_t pi, const int32_t *skip
 double polyc__nearest(const polyc__opt *o, int32_t pi, const int32_t *skip, int n_skip,
                       int32_t *seg)
 {
-    return nearest_below(o, pi, skip, n_skip, cap_of(o, &o->pts[pi]), seg);
-}
-
-/* 1 - p(turn | x, y) at v; open ends have no angle. */
-double polyc__vertex_angle_cost(const polyc__opt *o, int32_t v)
-{
-    if (o->cfg->gamma <= 0.0f)
-        return 0.0;
-    const polyc__vertex *c = &o->s->v[v];
-    if (c->prev == POLYC__NONE || c->next == POLYC__NONE)
-        return 0.0;
-    const polyc__vertex *a = &o->s->v[c->prev], *b = &o->s->v[c->next];
-    return polyc__turn_cost(o, a->x, a->y, c->x, c->y, b->x, b->y);
-}
-
-double polyc__bic(const polyc__opt *o)
-{
-    return (double)o->cfg->alpha * (o->err + (double)o->cfg->gamma * o->angle) +
-           (double)o->s->v_live * o->log_n;
-}
-
-polyc_status polyc__rebuild(polyc__opt *o)
-{
-    polyc__store *s = o->s;
-    polyc__hash_clear(o);
-    o->angle = 0.0;
-    for (int32_t v = 0; v < s->v_high; v++) {
-        o->acost[v] = 0.0;
-        if (s->v[v].line == POLYC__NONE)
-            continue;
-        if (s->v[v].next != POLYC__NONE && !polyc__hash_insert(o, v))
-            return polyc__fail(o->ctx, POLYC_ERR_NOMEM, "spatial hash full");
-        o->acost[v] = polyc__vertex_angle_cost(o, v);
-        o->angle += o->acost[v];
-    }
-    o->err = 0.0;
-    for (int32_t i = 0; i < o->np; i++) {
-        o->pt_cost[i] = polyc__nearest(o, i, NULL, 0, &o->pt_seg[i]);
-        o->err += o->pt_cost[i];
-    }
-    return POLYC_OK;
-}
-
-/* ---- recording a change ---- */
-
-static void mark_segment_region(polyc__opt *o, int32_t seg)
-{
-    const polyc__vertex *a = &o->s->v[seg];
-    const polyc__vertex *b = &o->s->v[a->next];
-    polyc__segment_region(o, a->x, a->y, b->x, b->y);
-}
-
-void polyc__chg_begin(polyc__opt *o)
-{
-    o->epoch++;
-    o->bucket_n = 0;
-    o->added_n = 0;
-    o->added_overflow = 0;
-    o->dirty_n = 0;
-}
-
-void polyc__chg_seg_out(polyc__opt *o, int32_t seg)
-{
-    if (seg == POLYC__NONE || !o->seg_in[seg])
-        return;
-    mark_segment_region(o, seg);
-    polyc__hash_remove(o, seg);
-    o->seg_dead[seg] = o->epoch;
-}
-
-int polyc__chg_seg_in(polyc__opt *o, int32_t seg)
-{
-    if (seg == POLYC__NONE || o->seg_in[seg] || o->s->v[seg].next == POLYC__NONE)
-        return 1;
-    int ok = polyc__hash_insert(o, seg);
-    mark_segment_region(o, seg);
-    if (o->added_n < o->added_cap)
-        o->added[o->added_n++] = seg;
-    else
-        o->added_overflow = 1; /* too many to compare: full queries in the region */
-    return ok;
-}
-
-void polyc__chg_dirty(polyc__opt *o, int32_t v)
-{
-    if (v == POLYC__NONE)
-        return;
-    o->v_touch[v] = o->touch_stamp;
-    if (o->v_dirty[v] == o->epoch || o->dirty_n >= o->dirty_cap)
-        return;
-    o->v_dirty[v] = o->epoch;
-    o->angle -= o->acost[v];
-    o->acost[v] = 0.0;
-    o->dirty_list[o->dirty_n++] = v;
-}
-
-void polyc__chg_commit(polyc__opt *o)
-{
-    const polyc__hash *h = &o->h;
-    for (int32_t k = 0; k < o->bucket_n; k++) {
-        int32_t b = o->bucket_list[k];
-        for (uint32_t i = h->pt_start[b]; i < h->pt_start[b + 1]; i++) {
-            double old = o->pt_cost[i], c;
-            int32_t seg = o->pt_seg[i];
-            if (o->added_overflow || (seg != POLYC__NONE && o->seg_dead[seg] == o->epoch)) {
-                c = polyc__nearest(o, (int32_t)i, NULL, 0, &seg);
-            } else {
-                c = old;
-                for (int32_t a = 0; a < o->added_n; a++) {
-                    int32_t sg = o->added[a];
-                    if (!o->seg_in[sg])
-                        continue;
-                    double ca = polyc__cost_seg(o, &o->pts[i], sg);
-                    if (ca < c) {
-                        c = ca;
-                        seg = sg;
-                    }
-                }
-            }
-            o->pt_cost[i] = c;
-            polyc__split_due_pt(o, o->pt_seg[i], seg);
-            o->pt_seg[i] = seg;
-            o->err += c - old;
-        }
-    }
-    for (int32_t k = 0; k < o->dirty_n; k++) {
-        int32_t v = o->dirty_list[k];
-        if (o->s->v[v].line == POLYC__NONE)
-            continue;
-        o->acost[v] = polyc__vertex_angle_cost(o, v);
-        o->angle += o->acost[v];
-    }
-    o->bucket_n = o->added_n = o->dirty_n = 0;
+    return polyc__nearest_below(o, pi, skip, n_skip, polyc__point_cap(o, &o->d.pts[pi]), seg);
 }
 
 /* ---- local evaluation (read-only) ---- */
-
-static void seg_prepare(polyc__seg_pre *q, const float *xy)
-{
-    q->ax = (double)xy[0];
-    q->ay = (double)xy[1];
-    q->bx = (double)xy[2];
-    q->by = (double)xy[3];
-    q->dx = q->bx - q->ax;
-    q->dy = q->by - q->ay;
-    double l2 = q->dx * q->dx + q->dy * q->dy;
-    q->inv_l2 = l2 > 1e-18 ? 1.0 / l2 : 0.0;
-    double inv = l2 > 1e-18 ? 1.0 / sqrt(l2) : 0.0;
-    q->nx = -q->dy * inv;
-    q->ny = q->dx * inv;
-}
-
-/* Same value as polyc__cost, without the per-call divisions. */
-static double seg_cost(const polyc__seg_pre *q, const polyc__point *p)
-{
-    double mx = (double)p->x - q->ax, my = (double)p->y - q->ay;
-    double t = (mx * q->dx + my * q->dy) * q->inv_l2;
-    if (t <= 0.0 || q->inv_l2 == 0.0)
-        return (double)p->w * (mx * mx + my * my) + ((double)p->cxx + (double)p->cyy);
-    if (t >= 1.0) {
-        double ex = (double)p->x - q->bx, ey = (double)p->y - q->by;
-        return (double)p->w * (ex * ex + ey * ey) + ((double)p->cxx + (double)p->cyy);
-    }
-    double d = q->nx * mx + q->ny * my;
-    double c = (double)p->w * d * d + (q->nx * q->nx * (double)p->cxx +
-                                       2.0 * q->nx * q->ny * (double)p->cxy +
-                                       q->ny * q->ny * (double)p->cyy);
-    return c > 0.0 ? c : 0.0; /* as polyc__cost */
-}
 
 /* A segment's start, direction and squared length, for point_seg_dist. */
 typedef struct seg_span {
@@ -341,59 +170,57 @@ static void gather_start(polyc__opt *o, const int32_t *old, int n_old)
     /* a new epoch: the region's bucket marks are not needed any more (the
      * region is listed), and seg_dead (compared with the epoch of a change,
      * which starts a new one) marks the segments met */
-    o->cand_stamp = ++o->epoch;
-    o->cand_src = POLYC__NONE;
-    o->cand_n = 0;
+    o->ev.cand_stamp = ++o->chg.epoch;
+    o->ev.cand_src = POLYC__NONE;
+    o->ev.cand_n = 0;
     for (int j = 0; j < n_old; j++)
         if (old[j] != POLYC__NONE)
-            o->seg_dead[old[j]] = o->cand_stamp;
+            o->chg.seg_dead[old[j]] = o->ev.cand_stamp;
 }
 
 static void gather_around(polyc__opt *o, int32_t b)
 {
     const polyc__hash *h = &o->h;
-    const uint32_t stamp = o->cand_stamp;
-    if (b == o->cand_src)
+    const uint32_t stamp = o->ev.cand_stamp;
+    if (b == o->ev.cand_src)
         return; /* the points come bucket by bucket */
-    o->cand_src = b;
-    int32_t bx = b % h->bx, by = b / h->bx;
-    int32_t x0 = bx > 0 ? bx - 1 : 0, x1 = bx + 1 < h->bx ? bx + 1 : h->bx - 1;
-    int32_t y0 = by > 0 ? by - 1 : 0, y1 = by + 1 < h->by ? by + 1 : h->by - 1;
-    for (int32_t y = y0; y <= y1; y++)
-        for (int32_t x = x0; x <= x1; x++) {
-            int32_t nb = y * h->bx + x;
-            if (o->bucket_mark[nb] == stamp)
+    o->ev.cand_src = b;
+    int32_t around[9];
+    int n = polyc__buckets_around(h, b % h->bx, b / h->bx, around);
+    for (int i = 0; i < n; i++) {
+        int32_t nb = around[i];
+        if (o->chg.bucket_mark[nb] == stamp)
+            continue;
+        o->chg.bucket_mark[nb] = stamp;
+        for (int32_t e = h->seg_head[nb]; e != POLYC__NONE; e = h->entries[e].next) {
+            int32_t sg = h->entries[e].seg;
+            if (o->chg.seg_dead[sg] == stamp)
                 continue;
-            o->bucket_mark[nb] = stamp;
-            for (int32_t e = h->seg_head[nb]; e != POLYC__NONE; e = h->entries[e].next) {
-                int32_t sg = h->entries[e].seg;
-                if (o->seg_dead[sg] == stamp)
-                    continue;
-                o->seg_dead[sg] = stamp;
-                if (o->cand_n == POLYC__CAND_MAX) {
-                    o->cand_n = POLYC__CAND_MAX + 1; /* too many: the hash is queried */
-                    return;
-                }
-                const polyc__vertex *a = &o->s->v[sg], *c = &o->s->v[a->next];
-                float *box = o->cand_box + 4 * o->cand_n;
-                box[0] = polyc__minf(a->x, c->x);
-                box[1] = polyc__minf(a->y, c->y);
-                box[2] = polyc__maxf(a->x, c->x);
-                box[3] = polyc__maxf(a->y, c->y);
-                o->cand_seg[o->cand_n++] = sg;
+            o->chg.seg_dead[sg] = stamp;
+            if (o->ev.cand_n == POLYC__CAND_MAX) {
+                o->ev.cand_n = POLYC__CAND_MAX + 1; /* too many: the hash is queried */
+                return;
             }
+            const polyc__vertex *a = &o->s->v[sg], *c = &o->s->v[a->next];
+            float *box = o->ev.cand_box + 4 * o->ev.cand_n;
+            box[0] = polyc__minf(a->x, c->x);
+            box[1] = polyc__minf(a->y, c->y);
+            box[2] = polyc__maxf(a->x, c->x);
+            box[3] = polyc__maxf(a->y, c->y);
+            o->ev.cand_seg[o->ev.cand_n++] = sg;
         }
+    }
 }
 
 /* nearest_below over the gathered candidates: the same segments it would
  * look at, and a box test instead of the bucket walk. */
 static double nearest_candidate(const polyc__opt *o, int32_t pi, double start, int32_t *seg)
 {
-    const polyc__point *p = &o->pts[pi];
+    const polyc__point *p = &o->d.pts[pi];
     double best = start, w = (double)p->w;
     int32_t best_seg = POLYC__NONE;
-    for (int32_t k = 0; k < o->cand_n; k++) {
-        const float *box = o->cand_box + 4 * k;
+    for (int32_t k = 0; k < o->ev.cand_n; k++) {
+        const float *box = o->ev.cand_box + 4 * k;
         /* distance to the box, a lower bound of the segment's: differences
          * of floats are exact in double, so the bound is never too high */
         double px = (double)p->x, py = (double)p->y;
@@ -403,10 +230,10 @@ static double nearest_candidate(const polyc__opt *o, int32_t pi, double start, i
         gy = gy > 0.0 ? gy : 0.0;
         if (0.999 * w * (gx * gx + gy * gy) >= best)
             continue;
-        double c = polyc__cost_seg(o, p, o->cand_seg[k]);
+        double c = polyc__cost_seg(o, p, o->ev.cand_seg[k]);
         if (c < best) {
             best = c;
-            best_seg = o->cand_seg[k];
+            best_seg = o->ev.cand_seg[k];
         }
     }
     *seg = best_seg;
@@ -415,31 +242,46 @@ static double nearest_candidate(const polyc__opt *o, int32_t pi, double start, i
 
 /* The old segments of an edit, for the test every listed point makes: the
  * first two compared directly (a climb has two), the rest in a loop. */
-typedef struct old_set {
-    int32_t a, b;
-    const int32_t *rest;
-    int n_rest;
-} old_set;
-
-static old_set old_set_of(const int32_t *old, int n_old)
+/* The aggregation of a move (prepare): on when moving the shared end of at
+ * most two segments; each segment's fixed end. */
+static void agg_begin(polyc__eval_scratch *ev, int move, const float *seg_xy, int n_new, float mx,
+                      float my)
 {
-    old_set s;
-    s.a = n_old > 0 ? old[0] : POLYC__NONE;
-    s.b = n_old > 1 ? old[1] : POLYC__NONE;
-    s.rest = n_old > 2 ? old + 2 : old; /* never past the caller's array */
-    s.n_rest = n_old > 2 ? n_old - 2 : 0;
-    return s;
+    ev->agg_on = move && n_new <= 2;
+    ev->agg_n[0] = ev->agg_n[1] = 0;
+    for (int j = 0; j < 2; j++) {
+        ev->agg_m[j][0] = ev->agg_m[j][1] = ev->agg_m[j][2] = 0.0;
+        ev->agg_moving_b[j] = 0;
+        ev->agg_ax[j] = ev->agg_ay[j] = 0.0;
+    }
+    if (ev->agg_on)
+        for (int j = 0; j < n_new; j++) {
+            const float *q = seg_xy + 4 * j;
+            int b = q[2] == mx && q[3] == my;
+            ev->agg_moving_b[j] = b;
+            ev->agg_ax[j] = (double)(b ? q[0] : q[2]);
+            ev->agg_ay[j] = (double)(b ? q[1] : q[3]);
+        }
 }
 
-/* whether the point's segment seg (NONE: none) is one of them */
-static int is_old(const old_set *s, int32_t seg)
+/* The listed points again, by field (trial_costs.c) */
+static void copy_listed(polyc__opt *o)
 {
-    if (seg == POLYC__NONE)
-        return 0;
-    int hit = seg == s->a || seg == s->b;
-    for (int j = 0; j < s->n_rest; j++)
-        hit |= seg == s->rest[j];
-    return hit;
+    o->ev.lsoa_n = -1;
+    /* for a few points (most of a single scan's trials) the copy costs
+     * more than it saves */
+    if (o->ev.loc_n >= 8 && o->ev.loc_n <= o->ev.lsoa_cap) {
+        for (int32_t k = 0; k < o->ev.loc_n; k++) {
+            const polyc__point *p = &o->d.pts[o->ev.loc_pt[k]];
+            o->ev.lsoa_x[k] = (double)p->x;
+            o->ev.lsoa_y[k] = (double)p->y;
+            o->ev.lsoa_w[k] = (double)p->w;
+            o->ev.lsoa_cxx[k] = (double)p->cxx;
+            o->ev.lsoa_cxy[k] = (double)p->cxy;
+            o->ev.lsoa_cyy[k] = (double)p->cyy;
+        }
+        o->ev.lsoa_n = o->ev.loc_n;
+    }
 }
 
 /* Collects the points near the `old` segments and the candidate geometry,
@@ -453,49 +295,35 @@ static void prepare(polyc__opt *o, const int32_t *old, int n_old, const float *s
                     float reach, int move, float mx, float my)
 {
     const polyc__hash *h = &o->h;
-    const old_set olds = old_set_of(old, n_old);
+    const polyc__old_set olds = polyc__old_set_of(old, n_old);
     seg_span span[4];
     POLYC_ASSERT(n_new <= 4);
     for (int j = 0; j < n_new; j++)
         span[j] = seg_span_of(seg_xy + 4 * j);
-    o->epoch++;
-    o->bucket_n = 0;
+    o->chg.epoch++;
+    o->chg.bucket_n = 0;
     for (int k = 0; k < n_old; k++)
         if (old[k] != POLYC__NONE)
-            mark_segment_region(o, old[k]);
+            polyc__chg_mark_region(o, old[k]);
     /* moving: the candidates start where the old segments are, and their
      * moves stay within the buckets' margin */
     for (int k = 0; k < n_new && !move; k++) {
         const float *q = seg_xy + 4 * k;
         polyc__segment_region(o, q[0], q[1], q[2], q[3]);
     }
-    o->cand_n = -1;
-    o->loc_n = 0;
-    o->loc_fixed = 0.0;
-    o->loc_fixed_cur = 0.0;
-    o->agg_on = move && n_new <= 2;
-    o->agg_n[0] = o->agg_n[1] = 0;
-    for (int j = 0; j < 2; j++) {
-        o->agg_m[j][0] = o->agg_m[j][1] = o->agg_m[j][2] = 0.0;
-        o->agg_moving_b[j] = 0;
-        o->agg_ax[j] = o->agg_ay[j] = 0.0;
-    }
-    if (o->agg_on)
-        for (int j = 0; j < n_new; j++) {
-            const float *q = seg_xy + 4 * j;
-            int b = q[2] == mx && q[3] == my;
-            o->agg_moving_b[j] = b;
-            o->agg_ax[j] = (double)(b ? q[0] : q[2]);
-            o->agg_ay[j] = (double)(b ? q[1] : q[3]);
-        }
-    for (int32_t k = 0; k < o->bucket_n; k++) {
-        int32_t b = o->bucket_list[k];
+    o->ev.cand_n = -1;
+    o->ev.loc_n = 0;
+    o->ev.loc_fixed = 0.0;
+    o->ev.loc_fixed_cur = 0.0;
+    agg_begin(&o->ev, move, seg_xy, n_new, mx, my);
+    for (int32_t k = 0; k < o->chg.bucket_n; k++) {
+        int32_t b = o->chg.bucket_list[k];
         for (uint32_t i = h->pt_start[b]; i < h->pt_start[b + 1]; i++) {
-            int32_t seg = o->pt_seg[i];
-            int hit = is_old(&olds, seg);
+            int32_t seg = o->d.pt_seg[i];
+            int hit = polyc__is_old(&olds, seg);
             int32_t base_seg = seg;
-            double base = o->pt_cost[i];
-            const polyc__point *p = &o->pts[i];
+            double base = o->d.pt_cost[i];
+            const polyc__point *p = &o->d.pts[i];
             double d[2] = {1e30, 1e30};
             if (reach > 0.0f) {
                 double dmin = 1e30;
@@ -508,26 +336,26 @@ static void prepare(polyc__opt *o, const int32_t *old, int n_old, const float *s
                 }
                 dmin -= (double)reach;
                 if (!hit && dmin > 0.0 && base <= (double)p->w * dmin * dmin) {
-                    o->loc_fixed += base;
-                    o->loc_fixed_cur += o->pt_cost[i];
+                    o->ev.loc_fixed += base;
+                    o->ev.loc_fixed_cur += o->d.pt_cost[i];
                     continue;
                 }
             }
             int j = n_new == 2 && d[1] < d[0];
-            double bound = o->agg_on ? stay_bound(p, o->agg_ax[j], o->agg_ay[j], (double)mx,
+            double bound = o->ev.agg_on ? stay_bound(p, o->ev.agg_ax[j], o->ev.agg_ay[j], (double)mx,
                                                   (double)my, (double)reach, d[j], d[1 - j])
                                      : 0.0;
             if (hit) {
                 /* without the old segments: a query within the bound is
                  * enough to tell that the point stays (most do) */
-                double cap = cap_of(o, p), start = bound > 0.0 && bound < cap ? bound : cap;
-                if (o->cand_n < 0)
+                double cap = polyc__point_cap(o, p), start = bound > 0.0 && bound < cap ? bound : cap;
+                if (o->ev.cand_n < 0)
                     gather_start(o, old, n_old);
-                if (o->cand_n >= 0 && o->cand_n <= POLYC__CAND_MAX)
+                if (o->ev.cand_n >= 0 && o->ev.cand_n <= POLYC__CAND_MAX)
                     gather_around(o, b);
-                base = o->cand_n >= 0 && o->cand_n <= POLYC__CAND_MAX
+                base = o->ev.cand_n >= 0 && o->ev.cand_n <= POLYC__CAND_MAX
                            ? nearest_candidate(o, (int32_t)i, start, &base_seg)
-                           : nearest_below(o, (int32_t)i, old, n_old, start, &base_seg);
+                           : polyc__nearest_below(o, (int32_t)i, old, n_old, start, &base_seg);
                 if (base_seg != POLYC__NONE)
                     bound = 0.0;
                 else if (bound > 0.0 && bound < cap)
@@ -538,39 +366,25 @@ static void prepare(polyc__opt *o, const int32_t *old, int n_old, const float *s
                 bound = 0.0;
             }
             if (bound > 0.0) {
-                double dx = (double)p->x - o->agg_ax[j], dy = (double)p->y - o->agg_ay[j];
+                double dx = (double)p->x - o->ev.agg_ax[j], dy = (double)p->y - o->ev.agg_ay[j];
                 double w = (double)p->w;
-                o->agg_m[j][0] += w * dx * dx + (double)p->cxx;
-                o->agg_m[j][1] += w * dx * dy + (double)p->cxy;
-                o->agg_m[j][2] += w * dy * dy + (double)p->cyy;
-                int32_t slot = j == 0 ? o->agg_n[0] : o->agg_cap - 1 - o->agg_n[1];
-                o->agg_pt[slot] = (int32_t)i;
-                o->agg_n[j]++;
-                o->loc_fixed_cur += o->pt_cost[i];
+                o->ev.agg_m[j][0] += w * dx * dx + (double)p->cxx;
+                o->ev.agg_m[j][1] += w * dx * dy + (double)p->cxy;
+                o->ev.agg_m[j][2] += w * dy * dy + (double)p->cyy;
+                int32_t slot = j == 0 ? o->ev.agg_n[0] : o->ev.agg_cap - 1 - o->ev.agg_n[1];
+                o->ev.agg_pt[slot] = (int32_t)i;
+                o->ev.agg_n[j]++;
+                o->ev.loc_fixed_cur += o->d.pt_cost[i];
                 continue;
             }
-            o->loc_pt[o->loc_n] = (int32_t)i;
-            o->loc_base[o->loc_n] = base;
-            o->loc_seg[o->loc_n] = base_seg;
-            o->loc_n++;
+            o->ev.loc_pt[o->ev.loc_n] = (int32_t)i;
+            o->ev.loc_base[o->ev.loc_n] = base;
+            o->ev.loc_seg[o->ev.loc_n] = base_seg;
+            o->ev.loc_n++;
         }
     }
-    o->bucket_n = 0;
-    o->lsoa_n = -1;
-    /* for a few points (most of a single scan's trials) the copy costs
-     * more than it saves */
-    if (o->loc_n >= 8 && o->loc_n <= o->lsoa_cap) {
-        for (int32_t k = 0; k < o->loc_n; k++) {
-            const polyc__point *p = &o->pts[o->loc_pt[k]];
-            o->lsoa_x[k] = (double)p->x;
-            o->lsoa_y[k] = (double)p->y;
-            o->lsoa_w[k] = (double)p->w;
-            o->lsoa_cxx[k] = (double)p->cxx;
-            o->lsoa_cxy[k] = (double)p->cxy;
-            o->lsoa_cyy[k] = (double)p->cyy;
-        }
-        o->lsoa_n = o->loc_n;
-    }
+    o->chg.bucket_n = 0;
+    copy_listed(o);
 }
 
 void polyc__local_prepare(polyc__opt *o, const int32_t *old, int n_old, const float *seg_xy,
@@ -590,34 +404,34 @@ double polyc__local_eval(const polyc__opt *o, const float *seg_xy, int n_new)
     polyc__seg_pre q[4];
     POLYC_ASSERT(n_new <= 4);
     for (int j = 0; j < n_new; j++)
-        seg_prepare(&q[j], seg_xy + 4 * j);
-    double sum = o->loc_fixed;
-    if (o->agg_on)
+        polyc__seg_prepare(&q[j], seg_xy + 4 * j);
+    double sum = o->ev.loc_fixed;
+    if (o->ev.agg_on)
         for (int j = 0; j < n_new; j++) {
-            if (o->agg_n[j] == 0)
+            if (o->ev.agg_n[j] == 0)
                 continue;
             /* n'Mn with n the unit normal of the segment from its fixed end */
-            const float *e = seg_xy + 4 * j + (o->agg_moving_b[j] ? 2 : 0);
-            double ux = (double)e[0] - o->agg_ax[j], uy = (double)e[1] - o->agg_ay[j];
-            const double *m = o->agg_m[j];
+            const float *e = seg_xy + 4 * j + (o->ev.agg_moving_b[j] ? 2 : 0);
+            double ux = (double)e[0] - o->ev.agg_ax[j], uy = (double)e[1] - o->ev.agg_ay[j];
+            const double *m = o->ev.agg_m[j];
             sum += (m[0] * uy * uy - 2.0 * m[1] * ux * uy + m[2] * ux * ux) / (ux * ux + uy * uy);
         }
-    if (o->lsoa_n == o->loc_n) {
-        double *c = o->lsoa_c;
-        for (int32_t k = 0; k < o->loc_n; k++)
-            c[k] = o->loc_base[k];
+    if (o->ev.lsoa_n == o->ev.loc_n) {
+        double *c = o->ev.lsoa_c;
+        for (int32_t k = 0; k < o->ev.loc_n; k++)
+            c[k] = o->ev.loc_base[k];
         for (int j = 0; j < n_new; j++)
             polyc__trial_costs_min(o, &q[j], c);
         /* summed in the order of the scalar loop below: the same bits */
-        for (int32_t k = 0; k < o->loc_n; k++)
+        for (int32_t k = 0; k < o->ev.loc_n; k++)
             sum += c[k];
         return sum;
     }
-    for (int32_t k = 0; k < o->loc_n; k++) {
-        const polyc__point *p = &o->pts[o->loc_pt[k]];
-        double c = o->loc_base[k];
+    for (int32_t k = 0; k < o->ev.loc_n; k++) {
+        const polyc__point *p = &o->d.pts[o->ev.loc_pt[k]];
+        double c = o->ev.loc_base[k];
         for (int j = 0; j < n_new; j++) {
-            double cj = seg_cost(&q[j], p);
+            double cj = polyc__seg_pre_cost(&q[j], p);
             if (cj < c)
                 c = cj;
         }
@@ -628,103 +442,8 @@ double polyc__local_eval(const polyc__opt *o, const float *seg_xy, int n_new)
 
 double polyc__local_current(const polyc__opt *o)
 {
-    double sum = o->loc_fixed_cur;
-    for (int32_t k = 0; k < o->loc_n; k++)
-        sum += o->pt_cost[o->loc_pt[k]];
+    double sum = o->ev.loc_fixed_cur;
+    for (int32_t k = 0; k < o->ev.loc_n; k++)
+        sum += o->d.pt_cost[o->ev.loc_pt[k]];
     return sum;
-}
-
-/* ---- bounded change of the error (removal candidates) ---- */
-
-/* Max-heap on loc_base (the most a pending point can add) over loc_pt. */
-static void pend_sift(polyc__opt *o, int32_t i, int32_t n)
-{
-    double key = o->loc_base[i];
-    int32_t pt = o->loc_pt[i];
-    for (;;) {
-        int32_t c = 2 * i + 1;
-        if (c >= n)
-            break;
-        if (c + 1 < n && o->loc_base[c + 1] > o->loc_base[c])
-            c++;
-        if (o->loc_base[c] <= key)
-            break;
-        o->loc_base[i] = o->loc_base[c];
-        o->loc_pt[i] = o->loc_pt[c];
-        i = c;
-    }
-    o->loc_base[i] = key;
-    o->loc_pt[i] = pt;
-}
-
-/* The change of the error when the `old` segments are replaced by seg_xy,
- * exact when it is below `limit`; otherwise some value >= limit (enough to
- * reject a removal). A point whose nearest segment goes needs a nearest
- * query, unless a new segment serves it at least as well as now; the rest
- * can only lose (their new cost is at least their current one), so they are
- * queried largest possible loss first, and the queries stop as soon as the
- * sure losses reach the limit. Most vertices worth keeping are settled by
- * the few points at their corner. */
-double polyc__local_delta(polyc__opt *o, const int32_t *old, int n_old, const float *seg_xy,
-                          int n_new, double limit)
-{
-    const polyc__hash *h = &o->h;
-    const old_set olds = old_set_of(old, n_old);
-    polyc__seg_pre q[4];
-    POLYC_ASSERT(n_new <= 4);
-    for (int j = 0; j < n_new; j++)
-        seg_prepare(&q[j], seg_xy + 4 * j);
-    o->epoch++;
-    o->bucket_n = 0;
-    for (int k = 0; k < n_old; k++)
-        if (old[k] != POLYC__NONE)
-            mark_segment_region(o, old[k]);
-    for (int k = 0; k < n_new; k++) {
-        const float *s = seg_xy + 4 * k;
-        polyc__segment_region(o, s[0], s[1], s[2], s[3]);
-    }
-    double sure = 0.0; /* exact part so far; pending points add >= 0 each */
-    int32_t n = 0;
-    o->lsoa_n = -1; /* loc_pt and loc_base are a heap here */
-    for (int32_t k = 0; k < o->bucket_n; k++) {
-        int32_t b = o->bucket_list[k];
-        for (uint32_t i = h->pt_start[b]; i < h->pt_start[b + 1]; i++) {
-            const polyc__point *p = &o->pts[i];
-            double cur = o->pt_cost[i], c = 1e300;
-            for (int j = 0; j < n_new; j++) {
-                double cj = seg_cost(&q[j], p);
-                if (cj < c)
-                    c = cj;
-            }
-            int32_t seg = o->pt_seg[i];
-            int hit = is_old(&olds, seg);
-            if (!hit || c <= cur) {
-                /* not hit: its cost without the old segments is cur; hit
-                 * with c <= cur: no other segment beats c (all are >= cur) */
-                sure += (c < cur ? c : cur) - cur;
-                continue;
-            }
-            double cap = cap_of(o, p);
-            o->loc_pt[n] = (int32_t)i;
-            o->loc_base[n] = (c < cap ? c : cap) - cur;
-            n++;
-        }
-    }
-    o->bucket_n = 0;
-    for (int32_t i = n / 2 - 1; i >= 0; i--)
-        pend_sift(o, i, n);
-    while (n > 0 && sure < limit) {
-        int32_t i = o->loc_pt[0];
-        double most = o->loc_base[0];
-        /* only a segment cheaper than the new one matters: a query within
-         * that cost (usually the point's own bucket) */
-        sure += nearest_below(o, i, old, n_old, most + o->pt_cost[i], NULL) - o->pt_cost[i];
-        n--;
-        if (n > 0) {
-            o->loc_base[0] = o->loc_base[n];
-            o->loc_pt[0] = o->loc_pt[n];
-            pend_sift(o, 0, n);
-        }
-    }
-    return sure;
 }

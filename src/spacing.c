@@ -7,16 +7,21 @@
  * distance is measured to each pose when asked. The table's two passes
  * over every tile of the extent would take 5-6 % of a freiburg-campus
  * scan's time (13,000 tiles for its 80 m returns), for a handful of queries. */
-#include "internal.h"
+#include "context.h"
 
 #include <math.h>
 
 #define DIRECT_POSES 4u
 
-size_t polyc__spacing_bytes(const polyc_limits *lim)
+/* a distance per tile of the grid's directory */
+static float *dist_table(polyc__arena *a, size_t tiles)
 {
-    size_t tiles = ((size_t)lim->max_grid_cells + POLYC__TILE_CELLS - 1) / POLYC__TILE_CELLS;
-    return polyc__bytes(tiles * 4 + 64, sizeof(float));
+    return polyc__alloc(a, tiles, sizeof(float));
+}
+
+void polyc__spacing_reserve(polyc__arena *a, const polyc_limits *lim)
+{
+    dist_table(a, polyc__grid_dir_cap(lim));
 }
 
 polyc_status polyc__spacing_build(polyc_ctx *ctx, polyc__spacing *sp)
@@ -44,7 +49,7 @@ polyc_status polyc__spacing_build(polyc_ctx *ctx, polyc__spacing *sp)
         sp->pose_count = ctx->scan_count;
         return POLYC_OK;
     }
-    sp->dist = polyc__alloc(&ctx->arena, n, sizeof(float));
+    sp->dist = dist_table(&ctx->arena, n);
     if (!sp->dist)
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the spacing field");
     for (size_t i = 0; i < n; i++)

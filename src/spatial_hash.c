@@ -7,6 +7,12 @@
 #include "optimize.h"
 #include "walk.h"
 
+/* the external definitions of optimize.h's inline functions (C99: used
+ * where a caller does not inline them, as at -Os) */
+extern inline int polyc__buckets_around(const polyc__hash *h, int32_t bx, int32_t by, int32_t out[9]);
+extern inline void polyc__bucket_xy(const polyc__hash *h, float x, float y, int32_t *ix, int32_t *iy);
+extern inline float polyc__seg_dist2(float px, float py, float ax, float ay, float bx, float by);
+
 #include <math.h>
 #include <string.h>
 
@@ -34,6 +40,24 @@ int32_t polyc__hash_entry_cap(const polyc_limits *lim)
     return cap > 0x3fffffff ? 0x3fffffff : (int32_t)cap;
 }
 
+/* nb buckets' lists, marks and point ranges, and the entries */
+static int hash_carve(polyc__arena *a, polyc__opt *o, size_t nb, int32_t entry_cap)
+{
+    polyc__hash *h = &o->h;
+    h->seg_head = polyc__alloc(a, nb, sizeof(int32_t));
+    h->pt_start = polyc__alloc(a, nb + 1, sizeof(uint32_t));
+    h->entry_cap = entry_cap;
+    h->entries = polyc__alloc(a, (size_t)h->entry_cap, sizeof(polyc__hash_entry));
+    o->chg.bucket_mark = polyc__alloc_zero(a, nb, sizeof(uint32_t));
+    o->chg.bucket_list = polyc__alloc(a, nb, sizeof(int32_t));
+    return h->seg_head && h->pt_start && h->entries && o->chg.bucket_mark && o->chg.bucket_list;
+}
+
+void polyc__hash_reserve(polyc__arena *a, polyc__opt *o, const polyc_limits *lim)
+{
+    hash_carve(a, o, (size_t)polyc__hash_bucket_cap(lim), polyc__hash_entry_cap(lim));
+}
+
 polyc_status polyc__hash_init(polyc__opt *o)
 {
     polyc_ctx *ctx = o->ctx;
@@ -44,7 +68,7 @@ polyc_status polyc__hash_init(polyc__opt *o)
     float w_m = (float)g->width * g->cell_m + 2.0f * HASH_MARGIN_M;
     float h_m = (float)g->height * g->cell_m + 2.0f * HASH_MARGIN_M;
     /* at least the search radius plus the reach of one hill-climbing round */
-    float b = o->R + 0.05f;
+    float b = o->R + POLYC__CLIMB_REACH_M;
     while ((double)ceilf(w_m / b) * (double)ceilf(h_m / b) > (double)cap)
         b *= 1.25f;
     h->bucket_m = b;
@@ -54,13 +78,7 @@ polyc_status polyc__hash_init(polyc__opt *o)
     h->origin_x = (float)(g->origin_x_m - ctx->frame_x) - HASH_MARGIN_M;
     h->origin_y = (float)(g->origin_y_m - ctx->frame_y) - HASH_MARGIN_M;
     size_t nb = (size_t)h->bx * (size_t)h->by;
-    h->seg_head = polyc__alloc(&ctx->arena, nb, sizeof(int32_t));
-    h->pt_start = polyc__alloc(&ctx->arena, nb + 1, sizeof(uint32_t));
-    h->entry_cap = polyc__hash_entry_cap(&ctx->lim);
-    h->entries = polyc__alloc(&ctx->arena, (size_t)h->entry_cap, sizeof(polyc__hash_entry));
-    o->bucket_mark = polyc__alloc_zero(&ctx->arena, nb, sizeof(uint32_t));
-    o->bucket_list = polyc__alloc(&ctx->arena, nb, sizeof(int32_t));
-    if (!h->seg_head || !h->pt_start || !h->entries || !o->bucket_mark || !o->bucket_list)
+    if (!hash_carve(&ctx->arena, o, nb, polyc__hash_entry_cap(&ctx->lim)))
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the spatial hash");
     polyc__hash_clear(o);
     return POLYC_OK;
@@ -165,7 +183,7 @@ static int path_next(path_walk *p, int32_t *ix, int32_t *iy)
 }
 
 void polyc__segment_buckets(polyc__opt *o, float ax, float ay, float bx, float by,
-                            polyc__bucket_fn fn)
+                            polyc__bucket_fn fn, void *user)
 {
     const polyc__hash *h = &o->h;
     path_walk p;
@@ -173,33 +191,31 @@ void polyc__segment_buckets(polyc__opt *o, float ax, float ay, float bx, float b
     if (!path_begin(h, ax, ay, bx, by, &p))
         return;
     while (path_next(&p, &ix, &iy))
-        fn(o, clampi(iy, h->by - 1) * h->bx + clampi(ix, h->bx - 1));
+        fn(o, user, clampi(iy, h->by - 1) * h->bx + clampi(ix, h->bx - 1));
 }
 
 void polyc__segment_region(polyc__opt *o, float ax, float ay, float bx, float by)
 {
     const polyc__hash *h = &o->h;
-    const uint32_t epoch = o->epoch;
+    const uint32_t epoch = o->chg.epoch;
     path_walk p;
-    int32_t ix, iy;
+    int32_t ix, iy, around[9];
     if (!path_begin(h, ax, ay, bx, by, &p))
         return;
-    while (path_next(&p, &ix, &iy))
-        for (int32_t y = iy - 1; y <= iy + 1; y++) {
-            if (y < 0 || y >= h->by)
+    while (path_next(&p, &ix, &iy)) {
+        int n = polyc__buckets_around(h, ix, iy, around);
+        for (int i = 0; i < n; i++) {
+            int32_t k = around[i];
+            if (o->chg.bucket_mark[k] == epoch)
                 continue;
-            for (int32_t x = ix - 1; x <= ix + 1; x++) {
-                int32_t k = y * h->bx + x;
-                if (x < 0 || x >= h->bx || o->bucket_mark[k] == epoch)
-                    continue;
-                o->bucket_mark[k] = epoch;
-                o->bucket_list[o->bucket_n++] = k;
-            }
+            o->chg.bucket_mark[k] = epoch;
+            o->chg.bucket_list[o->chg.bucket_n++] = k;
         }
+    }
 }
 
-/* The bucket callbacks get the segment id through o->cur_seg. */
-static void insert_in_bucket(polyc__opt *o, int32_t bucket)
+/* The bucket callbacks get the segment id as their user pointer. */
+static void insert_in_bucket(polyc__opt *o, void *user, int32_t bucket)
 {
     polyc__hash *h = &o->h;
     int32_t e = h->entry_free;
@@ -211,19 +227,20 @@ static void insert_in_bucket(polyc__opt *o, int32_t bucket)
         h->out_of_entries = 1;
         return;
     }
-    h->entries[e].seg = o->cur_seg;
+    h->entries[e].seg = *(const int32_t *)user;
     h->entries[e].next = h->seg_head[bucket];
     h->seg_head[bucket] = e;
     h->entry_live++;
 }
 
-static void remove_from_bucket(polyc__opt *o, int32_t bucket)
+static void remove_from_bucket(polyc__opt *o, void *user, int32_t bucket)
 {
     polyc__hash *h = &o->h;
+    const int32_t seg = *(const int32_t *)user;
     int32_t *link = &h->seg_head[bucket];
     while (*link != POLYC__NONE) {
         int32_t e = *link;
-        if (h->entries[e].seg == o->cur_seg) {
+        if (h->entries[e].seg == seg) {
             *link = h->entries[e].next;
             h->entries[e].next = h->entry_free;
             h->entry_free = e;
@@ -238,8 +255,7 @@ int polyc__hash_insert(polyc__opt *o, int32_t seg)
 {
     const polyc__vertex *a = &o->s->v[seg];
     const polyc__vertex *b = &o->s->v[a->next];
-    o->cur_seg = seg;
-    polyc__segment_buckets(o, a->x, a->y, b->x, b->y, insert_in_bucket);
+    polyc__segment_buckets(o, a->x, a->y, b->x, b->y, insert_in_bucket, &seg);
     o->seg_in[seg] = 1;
     o->split_due[seg] = 1; /* every new or moved segment comes in here */
     return !o->h.out_of_entries;
@@ -249,7 +265,6 @@ void polyc__hash_remove(polyc__opt *o, int32_t seg)
 {
     const polyc__vertex *a = &o->s->v[seg];
     const polyc__vertex *b = &o->s->v[a->next];
-    o->cur_seg = seg;
-    polyc__segment_buckets(o, a->x, a->y, b->x, b->y, remove_from_bucket);
+    polyc__segment_buckets(o, a->x, a->y, b->x, b->y, remove_from_bucket, &seg);
     o->seg_in[seg] = 0;
 }

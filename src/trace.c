@@ -2,7 +2,7 @@
  * Takes: contour cells (8-connected), thinned to one cell. Gives: polylines
  * in the store, started at contour endpoints, then the remaining cycles; points whose removal
  * leaves the polyline's length unchanged (collinear, in cell units) dropped. */
-#include "internal.h"
+#include "context.h"
 
 #include <math.h>
 #include <string.h>
@@ -63,7 +63,7 @@ static int32_t link_radius(const tracer *tr, int32_t ix, int32_t iy)
     const polyc__grid *g = tr->g;
     float x = (float)(tr->ox + ((double)ix + 0.5) * (double)g->cell_m);
     float y = (float)(tr->oy + ((double)iy + 0.5) * (double)g->cell_m);
-    float cells = 2.5f * polyc__spacing_at(&tr->spacing, x, y) * g->inv_cell;
+    float cells = POLYC__GAP_SPACINGS * polyc__spacing_at(&tr->spacing, x, y) * g->inv_cell;
     int32_t r = cells > (float)tr->link_max ? tr->link_max : (int32_t)cells;
     return r > tr->link ? r : tr->link;
 }
@@ -294,17 +294,32 @@ static int adjacent(const int32_t *a, const int32_t *b, int32_t link)
     return dx * dx + dy * dy <= (link > 1 ? link * link : 2);
 }
 
+/* the walk's cells: the contour's and one more */
+static int32_t *walk_cells(polyc__arena *a, uint32_t cap)
+{
+    return polyc__alloc(a, (size_t)cap * 2, sizeof(int32_t));
+}
+
+void polyc__trace_reserve(polyc__arena *a, const polyc_limits *lim)
+{
+    polyc__store_reserve(a, lim);
+    size_t after_store = a->used;
+    walk_cells(a, lim->max_beams + 2); /* the contour list holds max_beams + 1 */
+    polyc__spacing_reserve(a, lim);
+    a->used = after_store;
+}
+
 polyc_status polyc__trace_build(polyc_ctx *ctx)
 {
     const polyc__grid *g = &ctx->grid;
-    polyc_status st = polyc__store_init(ctx, &ctx->store, polyc__max_vertices(&ctx->lim));
-    if (st != POLYC_OK)
-        return st;
+    if (!polyc__store_init(&ctx->arena, &ctx->store, polyc__max_vertices(&ctx->lim)))
+        return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the polylines");
+    polyc_status st;
     size_t after_store = ctx->arena.used; /* the walk scratch is released at the end */
     walk w;
     w.cap = ctx->contour_count + 1;
     w.n = 0;
-    w.xy = polyc__alloc(&ctx->arena, (size_t)w.cap * 2, sizeof(int32_t));
+    w.xy = walk_cells(&ctx->arena, w.cap);
     if (!w.xy)
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for tracing");
     for (uint32_t k = 0; k < g->tile_count; k++)

@@ -11,13 +11,13 @@
  * operation, selected instead of branched to. */
 void polyc__trial_costs_min(const polyc__opt *o, const polyc__seg_pre *q, double *restrict c)
 {
-    const double *restrict X = o->lsoa_x, *restrict Y = o->lsoa_y, *restrict W = o->lsoa_w;
-    const double *restrict XX = o->lsoa_cxx, *restrict XY = o->lsoa_cxy, *restrict YY = o->lsoa_cyy;
+    const double *restrict X = o->ev.lsoa_x, *restrict Y = o->ev.lsoa_y, *restrict W = o->ev.lsoa_w;
+    const double *restrict XX = o->ev.lsoa_cxx, *restrict XY = o->ev.lsoa_cxy, *restrict YY = o->ev.lsoa_cyy;
     const double ax = q->ax, ay = q->ay, bx = q->bx, by = q->by, dx = q->dx, dy = q->dy;
     const double il2 = q->inv_l2, nx = q->nx, ny = q->ny;
     const double nxx = nx * nx, nxy2 = 2.0 * nx * ny, nyy = ny * ny;
     const int point_like = il2 == 0.0;
-    const int32_t n = o->lsoa_n;
+    const int32_t n = o->ev.lsoa_n;
     for (int32_t k = 0; k < n; k++) {
         double px = X[k], py = Y[k], w = W[k], cxx = XX[k], cyy = YY[k];
         double mx = px - ax, my = py - ay;

@@ -12,7 +12,7 @@
 #ifndef POLYC_WALK_H
 #define POLYC_WALK_H
 
-#include "internal.h"
+#include "context.h"
 
 #include <math.h>
 #include <string.h>

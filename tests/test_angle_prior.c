@@ -12,7 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "internal.h"
+#include "context.h"
 
 #define PI_D 3.14159265358979323846
 #define BEAMS 180

@@ -1,0 +1,111 @@
+/* context.h - the context: the state that lives from polyc_init to the
+ * block's release (configuration, limits, arena, scans, grid, contour,
+ * polylines, result, statistics, first error). api.c runs the stages on it;
+ * a stage reads the parts it needs and leaves its working state in its own
+ * structs (the optimiser's in polyc__opt, optimize.h). */
+#ifndef POLYC_CONTEXT_H
+#define POLYC_CONTEXT_H
+
+#include "internal.h"
+
+typedef enum polyc__stage {
+    POLYC__STAGE_SCANS = 0,
+    POLYC__STAGE_GRID,
+    POLYC__STAGE_CONTOUR,
+    POLYC__STAGE_TRACE,
+    POLYC__STAGE_OPTIMIZED
+} polyc__stage;
+
+/* the first error of an operation: its static message and, for one met in
+ * a scan, that scan's index (-1: none) */
+typedef struct polyc__error {
+    const char *msg;
+    int32_t scan;
+} polyc__error;
+
+/* a direction, as its cosine and sine */
+typedef struct polyc__turn {
+    double cos, sin;
+} polyc__turn;
+
+/* a box, with whether it holds anything yet */
+typedef struct polyc__extent {
+    double min_x, min_y, max_x, max_y;
+    int have;
+} polyc__extent;
+
+struct polyc_ctx {
+    uint32_t magic;
+    polyc_config cfg;
+    polyc_limits lim;
+    polyc__arena arena;
+    size_t scans_mark;             /* arena use after the fixed scan storage */
+    polyc__stage stage;
+    polyc__error err;
+
+    double frame_x, frame_y;       /* first pose: stored floats are relative to it */
+    int have_frame;
+    /* an occupancy grid (occupancy.c) instead of scans: stored floats are in
+     * its frame, whose corner is frame_x, frame_y and whose x axis points
+     * along frame_dir; its grid and contour are input, kept
+     * below scans_mark */
+    int from_grid;
+    polyc__turn frame_dir;
+    size_t base_mark;              /* arena use after polyc_init's scan storage */
+    polyc_config grid_cfg;         /* the optimiser's weights for it (optimize.c);
+                                      here, not on the optimiser's stack */
+    polyc__scan *scans;
+    float *ranges;
+    uint32_t scan_count, range_count;
+    polyc__extent ext;             /* frame-relative extent of the scans */
+
+    polyc__grid grid;
+    int32_t *contour_xy;           /* 2 per contour cell */
+    uint32_t contour_count;
+    size_t grid_mark;              /* arena use after the grid */
+    size_t contour_mark;           /* arena use after the contour */
+
+    polyc__store store;
+    polyc__flat flat;
+    int opt_result_valid;          /* the store holds a map to publish */
+    size_t trace_mark;             /* arena use after the initial polylines */
+
+
+    polyc_stats stats;
+};
+
+#define POLYC__MAGIC 0x706f6c79u   /* "poly" */
+/* While the progress callback runs, the context is lent to the optimiser:
+ * its magic reads POLYC__MAGIC_BUSY and every entry point refuses it with
+ * POLYC_ERR_BUSY (api.c, guarded_progress). */
+#define POLYC__MAGIC_BUSY 0x62757379u /* "busy" */
+/* POLYC_OK for a context an entry point may use (api.c) */
+polyc_status polyc__check_ctx(const polyc_ctx *ctx);
+
+/* The kind of input, decided here once: an occupancy grid, a single scan
+ * (mapped from its beam order, scan_chains.c, and checked against its
+ * beams, ray_check.c; unless POLYC_FLAG_GRID_TRACE asks for the grid's
+ * trace) or scans. */
+typedef enum polyc__input {
+    POLYC__INPUT_SCANS = 0,
+    POLYC__INPUT_ONE_SCAN,
+    POLYC__INPUT_GRID
+} polyc__input;
+static inline polyc__input polyc__input_kind(const polyc_ctx *ctx)
+{
+    if (ctx->from_grid)
+        return POLYC__INPUT_GRID;
+    return ctx->scan_count == 1 && !(ctx->cfg.flags & POLYC_FLAG_GRID_TRACE) ? POLYC__INPUT_ONE_SCAN
+                                                                              : POLYC__INPUT_SCANS;
+}
+
+/* errors: keep the first message of an operation (C99 inline: its external
+ * definition is in api.c) */
+inline polyc_status polyc__fail(polyc_ctx *ctx, polyc_status st, const char *msg)
+{
+    if (ctx && !ctx->err.msg)
+        ctx->err.msg = msg;
+    return st;
+}
+
+#endif

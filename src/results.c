@@ -1,0 +1,103 @@
+/* results.c - the entry points that read a context's results: the
+ * polylines, the statistics, the grid and the last error. Takes: a context
+ * after its stages. Gives: read-only views and copies (the polylines stay
+ * the context's until its next stage or reset). */
+#include "context.h"
+
+#include <string.h>
+
+uint32_t polyc_polyline_count(const polyc_ctx *ctx)
+{
+    if (polyc__check_ctx(ctx) != POLYC_OK || ctx->stage < POLYC__STAGE_TRACE)
+        return 0;
+    return ctx->flat.count;
+}
+
+polyc_status polyc_get_polyline(const polyc_ctx *ctx, uint32_t index, polyc_polyline *out)
+{
+    polyc_status cst = polyc__check_ctx(ctx);
+    if (cst != POLYC_OK || !out)
+        return cst != POLYC_OK ? cst : POLYC_ERR_NULL;
+    if (ctx->stage < POLYC__STAGE_TRACE)
+        return POLYC_ERR_STATE;
+    if (index >= ctx->flat.count)
+        return POLYC_ERR_RANGE;
+    uint32_t a = ctx->flat.start[index];
+    out->xy_m = ctx->flat.xy + 2 * a;
+    out->point_count = ctx->flat.start[index + 1] - a;
+    out->closed = ctx->flat.closed[index];
+    return POLYC_OK;
+}
+
+polyc_status polyc_copy_polyline(const polyc_ctx *ctx, uint32_t index, float *xy_m,
+                                 uint32_t capacity, uint32_t *count, uint32_t *closed)
+{
+    polyc_polyline pl;
+    polyc_status st = polyc_get_polyline(ctx, index, &pl);
+    if (st != POLYC_OK)
+        return st;
+    if (count)
+        *count = pl.point_count;
+    if (closed)
+        *closed = pl.closed;
+    if (xy_m) {
+        if (capacity < pl.point_count)
+            return POLYC_ERR_NOMEM;
+        memcpy(xy_m, pl.xy_m, (size_t)pl.point_count * 2 * sizeof(float));
+    }
+    return POLYC_OK;
+}
+
+polyc_status polyc_get_stats(const polyc_ctx *ctx, polyc_stats *out)
+{
+    polyc_status cst = polyc__check_ctx(ctx);
+    if (cst != POLYC_OK || !out)
+        return cst != POLYC_OK ? cst : POLYC_ERR_NULL;
+    *out = ctx->stats;
+    return POLYC_OK;
+}
+
+polyc_status polyc_grid_info(const polyc_ctx *ctx, double *origin_x_m, double *origin_y_m,
+                             float *cell_m, uint32_t *width, uint32_t *height)
+{
+    polyc_status cst = polyc__check_ctx(ctx);
+    if (cst != POLYC_OK)
+        return cst;
+    if (ctx->stage < POLYC__STAGE_GRID)
+        return POLYC_ERR_STATE;
+    if (origin_x_m) *origin_x_m = ctx->grid.origin_x_m;
+    if (origin_y_m) *origin_y_m = ctx->grid.origin_y_m;
+    if (cell_m) *cell_m = ctx->grid.cell_m;
+    if (width) *width = (uint32_t)ctx->grid.width;
+    if (height) *height = (uint32_t)ctx->grid.height;
+    return POLYC_OK;
+}
+
+polyc_status polyc_grid_cell(const polyc_ctx *ctx, uint32_t ix, uint32_t iy, uint32_t *hits,
+                             uint32_t *misses, uint32_t *contour)
+{
+    polyc_status cst = polyc__check_ctx(ctx);
+    if (cst != POLYC_OK)
+        return cst;
+    if (ctx->stage < POLYC__STAGE_GRID)
+        return POLYC_ERR_STATE;
+    if (ix >= (uint32_t)ctx->grid.width || iy >= (uint32_t)ctx->grid.height)
+        return POLYC_ERR_RANGE;
+    const polyc__tile *t = polyc__grid_tile(&ctx->grid, (int32_t)ix, (int32_t)iy);
+    int idx = polyc__cell_index((int32_t)ix, (int32_t)iy);
+    if (hits) *hits = t ? t->hits[idx] : 0;
+    if (misses) *misses = t ? t->misses[idx] : 0;
+    if (contour)
+        *contour = t && ctx->stage >= POLYC__STAGE_CONTOUR ? (t->contour[iy & 31] >> (ix & 31)) & 1u : 0;
+    return POLYC_OK;
+}
+
+const char *polyc_last_error(const polyc_ctx *ctx)
+{
+    polyc_status cst = polyc__check_ctx(ctx);
+    if (cst == POLYC_ERR_BUSY)
+        return "called from inside the progress callback";
+    if (cst != POLYC_OK)
+        return "invalid context";
+    return ctx->err.msg ? ctx->err.msg : "";
+}

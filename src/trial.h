@@ -1,0 +1,78 @@
+/* trial.h - what the trial evaluation (score.c) and the bounded removal
+ * delta (delta.c) share: a segment prepared for many
+ * cost queries (the same value as polyc__cost without its divisions), the
+ * set of segments an edit takes out, and the nearest segment below a bound. */
+#ifndef POLYC_TRIAL_H
+#define POLYC_TRIAL_H
+
+#include "cost.h"
+
+#include <math.h>
+
+inline void polyc__seg_prepare(polyc__seg_pre *q, const float *xy)
+{
+    q->ax = (double)xy[0];
+    q->ay = (double)xy[1];
+    q->bx = (double)xy[2];
+    q->by = (double)xy[3];
+    q->dx = q->bx - q->ax;
+    q->dy = q->by - q->ay;
+    double l2 = q->dx * q->dx + q->dy * q->dy;
+    q->inv_l2 = l2 > 1e-18 ? 1.0 / l2 : 0.0;
+    double inv = l2 > 1e-18 ? 1.0 / sqrt(l2) : 0.0;
+    q->nx = -q->dy * inv;
+    q->ny = q->dx * inv;
+}
+
+/* Same value as polyc__cost, without the per-call divisions. */
+inline double polyc__seg_pre_cost(const polyc__seg_pre *q, const polyc__point *p)
+{
+    double mx = (double)p->x - q->ax, my = (double)p->y - q->ay;
+    double t = (mx * q->dx + my * q->dy) * q->inv_l2;
+    if (t <= 0.0 || q->inv_l2 == 0.0)
+        return (double)p->w * (mx * mx + my * my) + ((double)p->cxx + (double)p->cyy);
+    if (t >= 1.0) {
+        double ex = (double)p->x - q->bx, ey = (double)p->y - q->by;
+        return (double)p->w * (ex * ex + ey * ey) + ((double)p->cxx + (double)p->cyy);
+    }
+    double d = q->nx * mx + q->ny * my;
+    double c = (double)p->w * d * d + (q->nx * q->nx * (double)p->cxx +
+                                       2.0 * q->nx * q->ny * (double)p->cxy +
+                                       q->ny * q->ny * (double)p->cyy);
+    return c > 0.0 ? c : 0.0; /* as polyc__cost */
+}
+
+
+typedef struct polyc__old_set {
+    int32_t a, b;
+    const int32_t *rest;
+    int n_rest;
+} polyc__old_set;
+
+inline polyc__old_set polyc__old_set_of(const int32_t *old, int n_old)
+{
+    polyc__old_set s;
+    s.a = n_old > 0 ? old[0] : POLYC__NONE;
+    s.b = n_old > 1 ? old[1] : POLYC__NONE;
+    s.rest = n_old > 2 ? old + 2 : old; /* never past the caller's array */
+    s.n_rest = n_old > 2 ? n_old - 2 : 0;
+    return s;
+}
+
+/* whether the point's segment seg (NONE: none) is one of them */
+inline int polyc__is_old(const polyc__old_set *s, int32_t seg)
+{
+    if (seg == POLYC__NONE)
+        return 0;
+    int hit = seg == s->a || seg == s->b;
+    for (int j = 0; j < s->n_rest; j++)
+        hit |= seg == s->rest[j];
+    return hit;
+}
+
+/* The nearest segment costing less than `start`, skipping `skip` (NONE
+ * and `start` if there is none); score.c. */
+double polyc__nearest_below(const polyc__opt *o, int32_t pi, const int32_t *skip, int n_skip,
+                            double start, int32_t *seg);
+
+#endif
