@@ -297,38 +297,35 @@ static polyc_status need_stage(polyc_ctx *ctx, polyc__stage want)
     return st;
 }
 
-polyc_status polyc_build_grid(polyc_ctx *ctx)
+/* An explicit call of a stage: redone from the stage before it (`from`,
+ * an occupancy grid's contour: its input), the results after it dropped,
+ * then run up to `want`. */
+static polyc_status redo_stage(polyc_ctx *ctx, polyc__stage from, polyc__stage want)
 {
     polyc_status cst = polyc__check_ctx(ctx);
     if (cst != POLYC_OK)
         return cst;
     ctx->err.msg = NULL;
-    /* explicit call: rebuild (an occupancy grid's is its input: the results
-     * after it are dropped) */
-    ctx->stage = ctx->from_grid ? POLYC__STAGE_CONTOUR : POLYC__STAGE_SCANS;
-    return need_stage(ctx, POLYC__STAGE_GRID);
+    if (ctx->from_grid && from < POLYC__STAGE_CONTOUR)
+        from = POLYC__STAGE_CONTOUR;
+    if (ctx->stage > from || want == POLYC__STAGE_GRID)
+        ctx->stage = from; /* the grid is always built again */
+    return need_stage(ctx, want);
+}
+
+polyc_status polyc_build_grid(polyc_ctx *ctx)
+{
+    return redo_stage(ctx, POLYC__STAGE_SCANS, POLYC__STAGE_GRID);
 }
 
 polyc_status polyc_extract_contour(polyc_ctx *ctx)
 {
-    polyc_status cst = polyc__check_ctx(ctx);
-    if (cst != POLYC_OK)
-        return cst;
-    ctx->err.msg = NULL;
-    if (ctx->stage >= POLYC__STAGE_CONTOUR)
-        ctx->stage = ctx->from_grid ? POLYC__STAGE_CONTOUR : POLYC__STAGE_GRID;
-    return need_stage(ctx, POLYC__STAGE_CONTOUR);
+    return redo_stage(ctx, POLYC__STAGE_GRID, POLYC__STAGE_CONTOUR);
 }
 
 polyc_status polyc_trace(polyc_ctx *ctx)
 {
-    polyc_status cst = polyc__check_ctx(ctx);
-    if (cst != POLYC_OK)
-        return cst;
-    ctx->err.msg = NULL;
-    if (ctx->stage >= POLYC__STAGE_TRACE)
-        ctx->stage = POLYC__STAGE_CONTOUR;
-    return need_stage(ctx, POLYC__STAGE_TRACE);
+    return redo_stage(ctx, POLYC__STAGE_CONTOUR, POLYC__STAGE_TRACE);
 }
 
 /* The caller's callback, with the context marked busy while it runs: a

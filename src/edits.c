@@ -16,24 +16,17 @@ static int32_t next_of(const polyc__opt *o, int32_t v)
     return o->s->v[v].next;
 }
 
-/* Every segment and vertex angle of a polyline out of the score. */
-static void line_out(polyc__opt *o, int32_t l)
+/* Every segment and vertex angle of a polyline out of the score (in 0),
+ * or back in (in 1). */
+static void line_books(polyc__opt *o, int32_t l, int in)
 {
     const polyc__line *ln = &o->s->l[l];
     int32_t v = ln->head;
     for (int32_t k = 0; k < ln->count; k++) {
-        polyc__chg_seg_out(o, v);
-        polyc__chg_dirty(o, v);
-        v = next_of(o, v);
-    }
-}
-
-static void line_in(polyc__opt *o, int32_t l)
-{
-    const polyc__line *ln = &o->s->l[l];
-    int32_t v = ln->head;
-    for (int32_t k = 0; k < ln->count; k++) {
-        polyc__chg_seg_in(o, v);
+        if (in)
+            polyc__chg_seg_in(o, v);
+        else
+            polyc__chg_seg_out(o, v);
         polyc__chg_dirty(o, v);
         v = next_of(o, v);
     }
@@ -59,9 +52,9 @@ void polyc__op_remove(polyc__opt *o, int32_t v)
     polyc__store *s = o->s;
     int32_t l = s->v[v].line;
     if (s->l[l].closed && s->l[l].count <= 3) {
-        line_out(o, l); /* the polyline opens: every link may change */
+        line_books(o, l, 0); /* the polyline opens: every link may change */
         polyc__vertex_remove(s, v);
-        line_in(o, l);
+        line_books(o, l, 1);
         return;
     }
     int32_t p = prev_of(o, v), n = next_of(o, v);
@@ -134,9 +127,9 @@ void polyc__op_cut(polyc__opt *o, int32_t u)
 
 void polyc__op_reverse(polyc__opt *o, int32_t l)
 {
-    line_out(o, l);
+    line_books(o, l, 0);
     polyc__line_reverse(o->s, l);
-    line_in(o, l);
+    line_books(o, l, 1);
 }
 
 /* Links two open ends: tail of one polyline to head of another (or closes). */
