@@ -28,7 +28,7 @@ static int opt_carve(polyc__arena *a, polyc__opt *o, int32_t P, int32_t V, int v
     POLYC__CARVE(ok, a, o->acost, V);
     o->seg_side = NULL;
     if (viewed)
-        POLYC__CARVE(ok, a, o->seg_side, V);
+        POLYC__CARVE(ok, a, o->seg_side, 2 * (size_t)V);
     POLYC__CARVE(ok, a, o->seg_in, V);
     POLYC__CARVE(ok, a, o->split_due, V);
     POLYC__CARVE(ok, a, o->v_work, V);

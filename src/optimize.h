@@ -135,7 +135,7 @@ typedef struct polyc__opt {
     float R, R2;                   /* search radius: the cost of a point is capped at w R^2 */
 
     polyc__data d;
-    float *seg_side;               /* per vertex: its segment's side (topology.c, band zip) */
+    float *seg_side;               /* 2 per vertex: what its segment is seen from (zip.c) */
 
     /* model terms, kept incrementally */
     double err;                    /* sum of pt_cost */

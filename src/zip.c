@@ -58,26 +58,25 @@ static int covered(const polyc__opt *o, float x, float y, int32_t a, int32_t b, 
     return nearest_other(o, x, y, a, b, &d2) != POLYC__NONE && d2 <= lim2;
 }
 
-/* The side each segment is seen from, into seg_side: the sum over the
- * endpoints within SIDE_REACH_M whose nearest segment it is of the vectors
- * to their sensors along its left normal (> 0: seen from the left; as
- * docs/evaluation.md's band15 gives a segment its side). Valid for the
- * segments not edited since zip_mark. */
+/* What each segment is seen from, into seg_side (x, y per vertex): the sum
+ * of the vectors to their sensors of the endpoints within SIDE_REACH_M
+ * whose nearest segment it is (a point's own cost says how near: its mean
+ * squared distance). Along the segment's left normal it gives its side
+ * (> 0: seen from the left; as docs/evaluation.md's band15 gives a segment
+ * its side). Valid for the segments not edited since zip_mark. */
 static void find_sides(polyc__opt *o)
 {
     const polyc__store *s = o->s;
     float *side = o->seg_side;
+    const double reach2 = (double)SIDE_REACH_M * (double)SIDE_REACH_M;
     for (int32_t v = 0; v < s->v_high; v++)
-        side[v] = 0.0f;
+        side[2 * v] = side[2 * v + 1] = 0.0f;
     for (int32_t i = 0; i < o->d.np; i++) {
         int32_t sg = o->d.pt_seg[i];
-        if (sg == POLYC__NONE || s->v[sg].next == POLYC__NONE)
+        if (sg == POLYC__NONE || o->d.pt_cost[i] > reach2 * (double)o->d.pts[i].w)
             continue;
-        const polyc__vertex *a = &s->v[sg], *b = &s->v[a->next];
-        const polyc__point *p = &o->d.pts[i];
-        if (polyc__seg_dist2(p->x, p->y, a->x, a->y, b->x, b->y) > SIDE_REACH_M * SIDE_REACH_M)
-            continue;
-        side[sg] += o->d.pt_view[2 * i] * (a->y - b->y) + o->d.pt_view[2 * i + 1] * (b->x - a->x);
+        side[2 * sg] += o->d.pt_view[2 * i];
+        side[2 * sg + 1] += o->d.pt_view[2 * i + 1];
     }
 }
 
@@ -87,7 +86,7 @@ static int seen_normal(const polyc__opt *o, int32_t sg, float *nx, float *ny)
 {
     const polyc__vertex *a = &o->s->v[sg], *b = &o->s->v[a->next];
     float dx = b->x - a->x, dy = b->y - a->y, len = sqrtf(dx * dx + dy * dy);
-    float side = o->seg_side[sg];
+    float side = -o->seg_side[2 * sg] * dy + o->seg_side[2 * sg + 1] * dx;
     if (!(len > 0.0f) || side == 0.0f || polyc__edited_since(o, sg, o->zip_mark))
         return 0;
     float sign = side > 0.0f ? 1.0f : -1.0f;
