@@ -89,16 +89,25 @@ int polyc__accuracy_scratch(polyc__acc_learn *L, polyc__arena *a, const polyc_li
     return L->samples && L->cells;
 }
 
+/* The prior cell holding (x, y) (frame metres); 0 outside the prior. */
+static int cell_at(const polyc__prior *p, float x, float y, uint32_t *cell)
+{
+    float fx = (x - (float)p->origin_x) * p->inv_cell, fy = (y - (float)p->origin_y) * p->inv_cell;
+    if (!(fx >= 0.0f && fy >= 0.0f && fx < (float)p->w && fy < (float)p->h))
+        return 0;
+    *cell = (uint32_t)((int32_t)fy * p->w + (int32_t)fx);
+    return 1;
+}
+
 void polyc__accuracy_sample(polyc__acc_learn *L, float x, float y, float nx, float ny,
                             uint32_t scan, float res2, float density)
 {
     const polyc__prior *p = L->p;
     if (!p || !L->samples || L->n >= L->cap)
         return;
-    float fx = (x - (float)p->origin_x) * p->inv_cell, fy = (y - (float)p->origin_y) * p->inv_cell;
-    if (!(fx >= 0.0f && fy >= 0.0f && fx < (float)p->w && fy < (float)p->h))
+    uint32_t cell;
+    if (!cell_at(p, x, y, &cell))
         return;
-    uint32_t cell = (uint32_t)((int32_t)fy * p->w + (int32_t)fx);
     acc_sample *s = &((acc_sample *)L->samples)[L->n++];
     s->x = x;
     s->y = y;
@@ -190,10 +199,6 @@ void polyc__accuracy_finish(polyc__acc_learn *L, polyc__arena *a, float alpha)
 
 float polyc__accuracy_weight(const polyc__prior *p, float x, float y)
 {
-    if (!p->weight)
-        return 1.0f;
-    float fx = (x - (float)p->origin_x) * p->inv_cell, fy = (y - (float)p->origin_y) * p->inv_cell;
-    if (!(fx >= 0.0f && fy >= 0.0f && fx < (float)p->w && fy < (float)p->h))
-        return 1.0f;
-    return p->weight[(size_t)((int32_t)fy * p->w + (int32_t)fx)];
+    uint32_t cell;
+    return p->weight && cell_at(p, x, y, &cell) ? p->weight[cell] : 1.0f;
 }

@@ -32,14 +32,21 @@ static void line_books(polyc__opt *o, int32_t l, int in)
     }
 }
 
-void polyc__op_move(polyc__opt *o, int32_t v, float x, float y)
+/* The two segments at v out of the score, the angles at v and its
+ * neighbours p and n pending: before v moves or goes. */
+static void around_out(polyc__opt *o, int32_t p, int32_t v, int32_t n)
 {
-    int32_t p = prev_of(o, v), n = next_of(o, v);
     polyc__chg_seg_out(o, p);
     polyc__chg_seg_out(o, v);
     polyc__chg_dirty(o, p);
     polyc__chg_dirty(o, v);
     polyc__chg_dirty(o, n);
+}
+
+void polyc__op_move(polyc__opt *o, int32_t v, float x, float y)
+{
+    int32_t p = prev_of(o, v), n = next_of(o, v);
+    around_out(o, p, v, n);
     o->s->v[v].x = x;
     o->s->v[v].y = y;
     polyc__chg_seg_in(o, p);
@@ -58,11 +65,7 @@ void polyc__op_remove(polyc__opt *o, int32_t v)
         return;
     }
     int32_t p = prev_of(o, v), n = next_of(o, v);
-    polyc__chg_seg_out(o, p);
-    polyc__chg_seg_out(o, v);
-    polyc__chg_dirty(o, p);
-    polyc__chg_dirty(o, v);
-    polyc__chg_dirty(o, n);
+    around_out(o, p, v, n);
     polyc__vertex_remove(s, v);
     if (s->l[l].count == 1) {
         int32_t last = s->l[l].head;

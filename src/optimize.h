@@ -91,9 +91,9 @@ typedef struct polyc__size_scratch {
  * assignment to the model (score.c). */
 typedef struct polyc__data {
     polyc__point *pts;
-    float *pt_view;                /* per point: the sum of unit vectors from its endpoints
-                                    * towards their sensors (NULL: not known, grids and
-                                    * single scans) */
+    float *pt_view;                /* per point: the sum of the vectors from its endpoints
+                                    * to their sensors, metres (NULL: not known, grids
+                                    * and single scans) */
     int32_t np;
     int32_t *pt_seg;               /* nearest segment (its start vertex) or NONE */
     double *pt_cost;               /* capped cost of the point's endpoints */

@@ -26,28 +26,10 @@ typedef struct built {
     void *block;
 } built;
 
-static void dump_map(const polyc_ctx *ctx)
-{
-    (void)0;
-    if (!getenv("BAND_DUMP"))
-        return;
-    uint32_t count = polyc_polyline_count(ctx);
-    for (uint32_t i = 0; i < count; i++) {
-        polyc_polyline pl;
-        polyc_get_polyline(ctx, i, &pl);
-        print_message("line %u%s:", i, pl.closed ? " closed" : "");
-        for (uint32_t j = 0; j < pl.point_count; j++)
-            print_message(" %.3f,%.3f", (double)pl.xy_m[2 * j], (double)pl.xy_m[2 * j + 1]);
-        print_message("\n");
-    }
-}
-
 static void build(const scansim_scene *sc, built *b)
 {
     polyc_config cfg;
     polyc_config_default(&cfg);
-    if (getenv("BAND_ALPHA"))
-        cfg.alpha = (float)atof(getenv("BAND_ALPHA"));
     polyc_limits lim;
     assert_int_equal(polyc_limits_for_scans(&cfg, sc->scans, sc->scan_count, &lim), POLYC_OK);
     size_t bytes = polyc_memory_size(&cfg, &lim);
@@ -58,7 +40,6 @@ static void build(const scansim_scene *sc, built *b)
     for (uint32_t i = 0; i < sc->scan_count; i++)
         assert_int_equal(polyc_add_scan(b->ctx, &sc->scans[i]), POLYC_OK);
     assert_int_equal(polyc_build(b->ctx, NULL, NULL), POLYC_OK);
-    dump_map(b->ctx);
 }
 
 static void free_map(built *b)
