@@ -311,6 +311,118 @@ POLYC_API polyc_status polyc_grid_info(const polyc_ctx *ctx, double *origin_x_m,
 POLYC_API polyc_status polyc_grid_cell(const polyc_ctx *ctx, uint32_t ix, uint32_t iy,
                                        uint32_t *hits, uint32_t *misses, uint32_t *contour);
 
+/* ---- Online mapping: the map kept up to date as scans arrive ----
+ *
+ * An online context accumulates each scan into its grid, its data and its
+ * angle prior as the scan is added, and keeps the map between calls: an
+ * update re-optimises, within a work budget, the regions the new scans
+ * changed (nearest the latest pose and oldest first) and leaves the rest.
+ * Between updates the map is a valid map of the scans so far (no crossing,
+ * no doubled wall). Memory grows with the mapped area, not with the number
+ * of scans: the block is sized from an area (a square centred on the first
+ * scan's pose) and from bounds on cells, vertices and data cells. The
+ * results (polyc_polyline_count, polyc_get_polyline, polyc_get_stats) read
+ * the map as the last update or finish left it. docs/api.md, "Online". */
+typedef struct polyc_online_limits {
+    double area_m;             /* side of the square the map may span, centred
+                                  on the first scan's pose */
+    uint32_t max_grid_cells;   /* grid cells stored (tiles of 32 x 32 cells where
+                                  some beam ended in a hit) */
+    uint32_t max_vertices;     /* polyline vertices of the map */
+    uint32_t max_points;       /* grid cells holding endpoints (each keeps their
+                                  sums); also bounds the weighted data points */
+    uint32_t max_scan_beams;   /* beams in one scan */
+    uint32_t keep_scans;       /* scans kept for pose corrections (0: none) */
+    uint32_t keep_beams;       /* beams of the kept scans, in all */
+    uint32_t reserved;         /* must be 0 */
+} polyc_online_limits;
+
+/* What an update or finish did and where the map stands. */
+typedef struct polyc_online_report {
+    uint64_t version;          /* the map's version (0: no update yet); every
+                                  update that changes the map adds one */
+    uint64_t work;             /* work units this call spent */
+    uint32_t scans;            /* scans added so far */
+    uint32_t pending_scans;    /* scans added since the last update */
+    uint32_t backlog_tiles;    /* changed regions (tiles) not yet re-optimised */
+    uint32_t changed;          /* polylines this call added, modified or removed */
+    uint32_t polylines;
+    uint32_t vertices;
+    double bic;                /* BIC of the map against the data so far */
+} polyc_online_report;
+
+/* One entry of polyc_online_changes. */
+typedef struct polyc_change {
+    uint32_t id;               /* the polyline's id (polyc_polyline_id) */
+    uint32_t kind;             /* POLYC_CHANGE_* */
+    uint64_t version;          /* the version that made this change */
+} polyc_change;
+#define POLYC_CHANGE_ADDED 1u
+#define POLYC_CHANGE_MODIFIED 2u
+#define POLYC_CHANGE_REMOVED 3u
+
+/* The default work budget of an update: about 5 ms of one core of the
+ * bench machine (docs/performance.md). A unit is one weighted data point
+ * taken into a re-optimised region (docs/api.md). */
+#define POLYC_ONLINE_WORK_DEFAULT 4000u
+
+/* Limits for an area of side area_m (metres) and scans of up to
+ * max_scan_beams beams, keeping no scans: the grid cells of the whole
+ * square, and vertices and data cells for a usual building in it. Pure. */
+POLYC_API polyc_status polyc_online_limits_for_area(const polyc_config *config, double area_m,
+                                                    uint32_t max_scan_beams,
+                                                    polyc_online_limits *out);
+/* Bytes needed for an online context; 0 if config or limits are invalid. */
+POLYC_API size_t polyc_online_memory_size(const polyc_config *config,
+                                          const polyc_online_limits *limits);
+/* Places an online context in `block`, as polyc_init does. The batch calls
+ * (polyc_add_scan, polyc_build, ...) refuse it with POLYC_ERR_STATE. */
+POLYC_API polyc_status polyc_online_init(void *block, size_t size, const polyc_config *config,
+                                         const polyc_online_limits *limits, polyc_ctx **out);
+/* Adds one scan to the grid, the data and the prior (a few hundred
+ * microseconds for 180 beams); the map changes only at the next update.
+ * keep != 0 keeps the scan for polyc_online_correct (POLYC_ERR_LIMIT when
+ * keep_scans or keep_beams are used up; the scan is then not added).
+ * *scan_id (may be NULL) gets its number: 0 for the first scan added.
+ * POLYC_ERR_EXTENT when an endpoint or the pose lies outside the area
+ * (nothing is added), POLYC_ERR_LIMIT when the scan has more than
+ * max_scan_beams beams, POLYC_ERR_NOMEM when the grid or data cells are
+ * used up (the scan is added up to the beam that ran out). */
+POLYC_API polyc_status polyc_online_add_scan(polyc_ctx *ctx, const polyc_scan *scan, int keep,
+                                             uint32_t *scan_id);
+/* Re-optimises what the scans added or corrected since the last update
+ * changed, spending at most about `work` units (POLYC_ONLINE_WORK_DEFAULT;
+ * 0 is POLYC_ERR_CONFIG); what does not fit stays in the backlog for the
+ * next update. The same scans and budgets give the same map. Before any
+ * scan: POLYC_ERR_STATE. out may be NULL. */
+POLYC_API polyc_status polyc_online_update(polyc_ctx *ctx, uint64_t work,
+                                           polyc_online_report *out);
+/* Converges the map as a batch build would: the backlog, then the full
+ * search (noise, patience) from the current map. Scans may be added after
+ * it; progress as for polyc_optimize. */
+POLYC_API polyc_status polyc_online_finish(polyc_ctx *ctx, polyc_progress_fn progress, void *user,
+                                           polyc_online_report *out);
+/* Gives kept scan `scan_id` a new pose (after a loop closure): its hits,
+ * misses and data leave the grid exactly and come back at the new pose;
+ * the regions both poses saw are re-optimised by the next updates.
+ * POLYC_ERR_RANGE for a scan that is not kept (or unknown). */
+POLYC_API polyc_status polyc_online_correct(polyc_ctx *ctx, uint32_t scan_id, double pose_x_m,
+                                            double pose_y_m, double pose_theta_rad);
+/* The polylines added, modified or removed by the versions after `since`,
+ * one entry per polyline (its latest change), ids ascending: up to `cap`
+ * into out (may be NULL with cap 0), the number there are into *count.
+ * POLYC_ERR_RANGE when removals that old are no longer remembered (the
+ * caller then reads the whole map again). */
+POLYC_API polyc_status polyc_online_changes(const polyc_ctx *ctx, uint64_t since,
+                                            polyc_change *out, uint32_t cap, uint32_t *count);
+/* The id of polyline `index` of the current map: it stays the same while
+ * that polyline lives (moves, added or removed vertices), on online and
+ * batch contexts alike; a polyline split or merged keeps its id on one
+ * part. Ids start at 1 and are not reused. */
+POLYC_API polyc_status polyc_polyline_id(const polyc_ctx *ctx, uint32_t index, uint32_t *id);
+/* The online context's map version (0 for a batch context). */
+POLYC_API uint64_t polyc_online_version(const polyc_ctx *ctx);
+
 /* The static message of the first error of the last failed call ("" if the
  * last call succeeded); for a rejected scan it says what was wrong with it,
  * and the scan is the one that polyc_add_scan was given. */
