@@ -539,7 +539,7 @@ class _Interrupts:
 class _Progress:
     """The C callback around fn(dict of polyc_iteration): a true result
     stops. An exception in fn is kept, stops the optimiser and is raised
-    again by Context._run; so is a Ctrl-C (_Interrupts), for which the
+    again by _Block._run; so is a Ctrl-C (_Interrupts), for which the
     callback runs even without fn."""
 
     def __init__(self, fn, ctx, interrupts):
@@ -567,31 +567,12 @@ class _Progress:
             return 1
 
 
-class Context:
-    """A libpolyc context in a block this object owns.
-
-    limits: dict or (max_scans, max_beams, max_grid_cells, max_vertices[, max_points]);
-    memory_bytes: block size (default: polyc_memory_size); other keywords
-    override polyc_config fields (cell_m=0.05, max_iterations=0, seed=3, ...).
-    Its methods may not be called from inside its own progress callback
-    (PolycError POLYC_ERR_BUSY)."""
-
-    def __init__(self, limits, memory_bytes=None, **config):
-        self._busy = False
-        self._ctx = ctypes.c_void_p()
-        self._cfg = _config(config)
-        self._lim = _limits(limits)
-        need = _lib.polyc_memory_size(ctypes.byref(self._cfg), ctypes.byref(self._lim))
-        if need == 0:
-            raise PolycError(ERR_CONFIG, "memory size", "the limits are too large for size_t")
-        size = need if memory_bytes is None else _int_field("memory_bytes", memory_bytes, _u64)
-        if size < need:
-            raise PolycError(ERR_NOMEM, "init", "%d bytes given, polyc_memory_size says %d "
-                             "are needed" % (size, need))
-        self.memory_size = need
-        self._block = ctypes.create_string_buffer(size)
-        self._check(_lib.polyc_init(self._block, size, ctypes.byref(self._cfg),
-                                    ctypes.byref(self._lim), ctypes.byref(self._ctx)), "init")
+class _Block:
+    """What a context in a block of its own does, batch or online: refuse
+    calls from its own progress callback, raise the library's errors, run
+    the optimiser with a progress callback, copy the map out."""
+    _busy = False
+    _ctx = None
 
     def _enter(self, what):
         if self._busy:
@@ -616,6 +597,48 @@ class Context:
             error, cb.error = cb.error, None
             raise error
         self._check(status, what)
+
+    def _copy_polylines(self):
+        out = []
+        for i in range(_lib.polyc_polyline_count(self._ctx)):
+            pl = _Polyline()
+            self._check(_lib.polyc_get_polyline(self._ctx, i, ctypes.byref(pl)), "get polyline")
+            raw = array("f")
+            raw.frombytes(ctypes.string_at(pl.xy_m, 8 * pl.point_count))
+            out.append(Polyline(Points(array("d", map(_shortest, raw))), bool(pl.closed)))
+        return out
+
+    def _get_stats(self):
+        s = _Stats()
+        self._check(_lib.polyc_get_stats(self._ctx, ctypes.byref(s)), "stats")
+        return {n: getattr(s, n) for n, _ in _Stats._fields_ if n != "reserved"}
+
+
+class Context(_Block):
+    """A libpolyc context in a block this object owns.
+
+    limits: dict or (max_scans, max_beams, max_grid_cells, max_vertices[, max_points]);
+    memory_bytes: block size (default: polyc_memory_size); other keywords
+    override polyc_config fields (cell_m=0.05, max_iterations=0, seed=3, ...).
+    Its methods may not be called from inside its own progress callback
+    (PolycError POLYC_ERR_BUSY)."""
+
+    def __init__(self, limits, memory_bytes=None, **config):
+        self._busy = False
+        self._ctx = ctypes.c_void_p()
+        self._cfg = _config(config)
+        self._lim = _limits(limits)
+        need = _lib.polyc_memory_size(ctypes.byref(self._cfg), ctypes.byref(self._lim))
+        if need == 0:
+            raise PolycError(ERR_CONFIG, "memory size", "the limits are too large for size_t")
+        size = need if memory_bytes is None else _int_field("memory_bytes", memory_bytes, _u64)
+        if size < need:
+            raise PolycError(ERR_NOMEM, "init", "%d bytes given, polyc_memory_size says %d "
+                             "are needed" % (size, need))
+        self.memory_size = need
+        self._block = ctypes.create_string_buffer(size)
+        self._check(_lib.polyc_init(self._block, size, ctypes.byref(self._cfg),
+                                    ctypes.byref(self._lim), ctypes.byref(self._ctx)), "init")
 
     def add_scan(self, pose, start_angle_rad, angle_step_rad, min_range_m, max_range_m,
                  ranges_m):
@@ -665,14 +688,7 @@ class Context:
     def polylines(self):
         """The current map, copied out: a list of Polyline."""
         self._enter("polylines")
-        out = []
-        for i in range(_lib.polyc_polyline_count(self._ctx)):
-            pl = _Polyline()
-            self._check(_lib.polyc_get_polyline(self._ctx, i, ctypes.byref(pl)), "get polyline")
-            raw = array("f")
-            raw.frombytes(ctypes.string_at(pl.xy_m, 8 * pl.point_count))
-            out.append(Polyline(Points(array("d", map(_shortest, raw))), bool(pl.closed)))
-        return out
+        return self._copy_polylines()
 
     def grid_image(self):
         """The hit/miss grid (run build_grid first) as the image `polyc grid`
@@ -699,9 +715,7 @@ class Context:
 
     def stats(self):
         self._enter("stats")
-        s = _Stats()
-        self._check(_lib.polyc_get_stats(self._ctx, ctypes.byref(s)), "stats")
-        return {n: getattr(s, n) for n, _ in _Stats._fields_ if n != "reserved"}
+        return self._get_stats()
 
 
 def _scans_and_limits(cfg, scans):
