@@ -15,6 +15,15 @@
     result = polyc.build_map_from_grid(grid.cells, grid.width, grid.height,
                                        grid.resolution, origin=grid.origin)
 
+    online = polyc.OnlineMap(40.0, 361, config={"cell_m": 0.05})  # area side, beams
+    seen = 0
+    for s in scans:                                   # as they arrive
+        scan_id = online.add_scan(*s)                 # Context.add_scan's arguments
+        report = online.update()                      # within the default work budget
+        changes = online.changes_since(seen)          # [(id, 'added', version), ...]
+        seen = report.version
+    online.finish()                                   # converge; online.polylines, .polyline_ids
+
 The shared library is the package's own libpolyc.so (built by `pip install`
 from the repository's C sources, with the polyc tool's log and map readers),
 or the file $POLYC_LIB names; nothing else is searched. At import the ctypes
@@ -22,9 +31,11 @@ structs are checked against polyc_struct_size(): a binding that does not
 match the library raises PolycError instead of corrupting memory.
 
 Memory: each Context owns its block (ctypes.create_string_buffer of
-polyc_memory_size() bytes, or memory_bytes if given); results are copied out.
+polyc_memory_size() bytes, or memory_bytes if given), each OnlineMap its
+block of polyc_online_memory_size() bytes; results are copied out.
 Errors: a failing library call raises PolycError with the status, its
-polyc_status_str() and polyc_last_error(); bad arguments raise TypeError or
+polyc_status_str() and polyc_last_error() (OnlineMap.changes_since's
+POLYC_ERR_RANGE: ResyncError, a PolycError); bad arguments raise TypeError or
 ValueError before the library sees them; an exception raised in a progress
 callback (KeyboardInterrupt too) stops the optimiser and is raised again by
 the call that ran it.
@@ -40,10 +51,12 @@ import threading
 from array import array
 from typing import NamedTuple, Sequence, Tuple
 
-__all__ = ["PolycError", "Scan", "Points", "Polyline", "Result", "Context", "Map", "GridImage",
+__all__ = ["PolycError", "ResyncError", "Scan", "Points", "Polyline", "Result", "Context",
+           "OnlineMap", "OnlineReport", "Change", "Map", "GridImage",
            "build_map", "build_map_from_grid", "grid_image", "read_log", "read_map",
            "default_config",
-           "version", "STATUS", "FLAG_EXACT_POINTS", "FLAG_NO_GRAZING", "FLAG_GRID_TRACE"]
+           "version", "STATUS", "FLAG_EXACT_POINTS", "FLAG_NO_GRAZING", "FLAG_GRID_TRACE",
+           "ONLINE_WORK_DEFAULT", "CHANGE_KINDS"]
 
 # polyc_status, append-only like the C enum
 STATUS = {0: "POLYC_OK", 1: "POLYC_ERR_NULL", 2: "POLYC_ERR_CONFIG", 3: "POLYC_ERR_NOMEM",
@@ -54,6 +67,8 @@ ERR_EXTENT, ERR_LIMIT, ERR_RANGE, ERR_STOPPED, ERR_BUSY = 6, 7, 8, 9, 10
 FLAG_EXACT_POINTS = 0x1
 FLAG_NO_GRAZING = 0x2
 FLAG_GRID_TRACE = 0x4
+ONLINE_WORK_DEFAULT = 4000                 # POLYC_ONLINE_WORK_DEFAULT: work units of one update
+CHANGE_KINDS = {1: "added", 2: "modified", 3: "removed"}   # POLYC_CHANGE_*
 
 _f32, _f64, _u32, _u64 = ctypes.c_float, ctypes.c_double, ctypes.c_uint32, ctypes.c_uint64
 _RANGE = {_u32: (0, 2 ** 32 - 1), _u64: (0, 2 ** 64 - 1)}
@@ -68,6 +83,13 @@ class PolycError(Exception):
         self.name = STATUS.get(status, "status %d" % status)
         text = _lib.polyc_status_str(status).decode() if _lib else self.name
         super().__init__("%s: %s%s (%s)" % (what, text, ": " + detail if detail else "", self.name))
+
+
+class ResyncError(PolycError):
+    """OnlineMap.changes_since(version) for a version older than the
+    removals the library still remembers (POLYC_ERR_RANGE): read the whole
+    map again (polylines, polyline_ids, version) and ask for the changes
+    since that version from then on."""
 
 
 # ---- the public structs of polyc.h, field for field ----
@@ -122,9 +144,27 @@ class _OccupancyGrid(ctypes.Structure):
                 ("cells", ctypes.POINTER(ctypes.c_int8))]
 
 
+class _OnlineLimits(ctypes.Structure):
+    _fields_ = [("area_m", _f64), ("max_grid_cells", _u32), ("max_vertices", _u32),
+                ("max_points", _u32), ("max_scan_beams", _u32), ("keep_scans", _u32),
+                ("keep_beams", _u32), ("reserved", _u32)]
+
+
+class _OnlineReport(ctypes.Structure):
+    _fields_ = [("version", _u64), ("work", _u64), ("scans", _u32), ("pending_scans", _u32),
+                ("backlog_tiles", _u32), ("changed", _u32), ("polylines", _u32),
+                ("vertices", _u32), ("bic", _f64)]
+
+
+class _Change(ctypes.Structure):
+    _fields_ = [("id", _u32), ("kind", _u32), ("version", _u64)]
+
+
 _STRUCTS = {"polyc_config": _Config, "polyc_limits": _Limits, "polyc_scan": _Scan,
             "polyc_box": _Box, "polyc_polyline": _Polyline, "polyc_stats": _Stats,
             "polyc_iteration": _Iteration, "polyc_occupancy_grid": _OccupancyGrid}
+_ONLINE_STRUCTS = {"polyc_online_limits": _OnlineLimits, "polyc_online_report": _OnlineReport,
+                   "polyc_change": _Change}
 _PROGRESS = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.POINTER(_Iteration))
 
 
@@ -184,6 +224,19 @@ def _load():
         "polyc_score": (st, [ctx, P(_f64), P(_f64)]),
         "polyc_last_error": (ctypes.c_char_p, [ctx]),
     }
+    # online mapping (polyc.h, "Online mapping")
+    online = {
+        "polyc_online_limits_for_area": (st, [P(_Config), _f64, _u32, P(_OnlineLimits)]),
+        "polyc_online_memory_size": (sz, [P(_Config), P(_OnlineLimits)]),
+        "polyc_online_init": (st, [ctypes.c_void_p, sz, P(_Config), P(_OnlineLimits), P(ctx)]),
+        "polyc_online_add_scan": (st, [ctx, P(_Scan), ctypes.c_int, P(_u32)]),
+        "polyc_online_update": (st, [ctx, _u64, P(_OnlineReport)]),
+        "polyc_online_finish": (st, [ctx, _PROGRESS, ctypes.c_void_p, P(_OnlineReport)]),
+        "polyc_online_correct": (st, [ctx, _u32, _f64, _f64, _f64]),
+        "polyc_online_changes": (st, [ctx, _u64, P(_Change), _u32, P(_u32)]),
+        "polyc_polyline_id": (st, [ctx, _u32, P(_u32)]),
+        "polyc_online_version": (_u64, [ctx]),
+    }
     # the polyc tool's readers (bindings/python/polyc_io.c): in the package's
     # library, not in a plain libpolyc.so named by POLYC_LIB
     io = {
@@ -202,6 +255,12 @@ def _load():
     for name, (res, args) in signatures.items():
         fn = getattr(lib, name)
         fn.restype, fn.argtypes = res, args
+    # a library built before the online API lands has none of it (OnlineMap
+    # then raises OSError)
+    lib.has_online = hasattr(lib, "polyc_online_init")
+    for name, (res, args) in online.items() if lib.has_online else ():
+        fn = getattr(lib, name)
+        fn.restype, fn.argtypes = res, args
     lib.has_io = hasattr(lib, "polyc_io_version")
     for name, (res, args) in io.items() if lib.has_io else ():
         fn = getattr(lib, name)
@@ -211,7 +270,8 @@ def _load():
 
 _lib = None                                # PolycError works before the load
 _lib = _load()
-for _name, _cls in _STRUCTS.items():
+for _name, _cls in list(_STRUCTS.items()) + list(_ONLINE_STRUCTS.items() if _lib.has_online
+                                                   else ()):
     _size = _lib.polyc_struct_size(_name.encode())
     if _size != ctypes.sizeof(_cls):
         raise PolycError(ERR_CONFIG, "loading " + _library_path(),
@@ -367,6 +427,27 @@ class Polyline(NamedTuple):
 class Result(NamedTuple):
     polylines: list                        # of Polyline
     stats: dict                            # the fields of polyc_stats
+
+
+class OnlineReport(NamedTuple):
+    """What OnlineMap.update or finish did and where the map stands
+    (polyc_online_report)."""
+    version: int                           # the map's version after the call (0: no update yet)
+    work: int                              # work units the call spent
+    scans: int                             # scans added so far
+    pending_scans: int                     # scans added since the last update
+    backlog_tiles: int                     # changed regions (tiles) not yet re-optimised
+    changed: int                           # polylines the call added, modified or removed
+    polylines: int
+    vertices: int
+    bic: float                             # BIC of the map against the data so far
+
+
+class Change(NamedTuple):
+    """One entry of OnlineMap.changes_since: a polyline's latest change."""
+    id: int                                # the polyline's id (OnlineMap.polyline_ids)
+    kind: str                              # 'added', 'modified' or 'removed'
+    version: int                           # the version that made the change
 
 
 class Map(NamedTuple):
@@ -714,6 +795,157 @@ class Context(_Block):
             _lib.polyc_io_grid_image_free(img)
 
     def stats(self):
+        self._enter("stats")
+        return self._get_stats()
+
+
+class OnlineMap(_Block):
+    """A map kept up to date as scans arrive (polyc.h, "Online mapping"), in
+    a block this object owns (ctypes buffer of polyc_online_memory_size()).
+
+    area_m: side of the square the map may span, centred on the first
+    scan's pose; max_scan_beams: beams in one scan; config: a dict of
+    polyc_config fields (cell_m, alpha, seed, ...); keep_scans, keep_beams:
+    how many scans (and their beams in all) add_scan(..., keep=True) may
+    keep for correct(). The other limits (max_grid_cells, max_vertices,
+    max_points) come from polyc_online_limits_for_area; keywords override
+    them. Its methods may not be called from inside finish's progress
+    callback (PolycError POLYC_ERR_BUSY)."""
+
+    def __init__(self, area_m, max_scan_beams, config=None, keep_scans=0, keep_beams=0,
+                 **limits):
+        if not _lib.has_online:
+            raise OSError("OnlineMap needs a libpolyc with the online API; %s has none"
+                          % _library_path())
+        self._ctx = ctypes.c_void_p()
+        self._cfg = _config(dict(config or {}))
+        area_m = _real_field("area_m", area_m)
+        max_scan_beams = _int_field("max_scan_beams", max_scan_beams, _u32)
+        lim = _OnlineLimits()
+        status = _lib.polyc_online_limits_for_area(ctypes.byref(self._cfg), area_m,
+                                                   max_scan_beams, ctypes.byref(lim))
+        if status != OK:
+            raise PolycError(status, "online limits for area",
+                             "area_m %r, max_scan_beams %d" % (area_m, max_scan_beams))
+        _set_fields(lim, dict(limits, keep_scans=keep_scans, keep_beams=keep_beams),
+                    "polyc_online_limits")
+        self._lim = lim
+        need = _lib.polyc_online_memory_size(ctypes.byref(self._cfg), ctypes.byref(lim))
+        if need == 0:
+            raise PolycError(ERR_CONFIG, "online memory size", "the limits are invalid or too "
+                             "large for size_t: %s" % self.limits)
+        self.memory_size = need
+        self._block = ctypes.create_string_buffer(need)
+        self._check(_lib.polyc_online_init(self._block, need, ctypes.byref(self._cfg),
+                                           ctypes.byref(lim), ctypes.byref(self._ctx)),
+                    "online init")
+
+    @property
+    def limits(self):
+        """The polyc_online_limits the block was sized for, as a dict."""
+        return {n: getattr(self._lim, n) for n, _ in _OnlineLimits._fields_ if n != "reserved"}
+
+    def add_scan(self, pose, start_angle_rad, angle_step_rad, min_range_m, max_range_m,
+                 ranges_m, keep=False):
+        """Adds one scan (the arguments of Context.add_scan, see Scan; a Scan
+        s goes in as add_scan(*s)); keep=True keeps it for correct().
+        Returns its scan id (0 for the first). The map changes at the next
+        update."""
+        self._enter("add scan")
+        s, _buf = _scan((pose, start_angle_rad, angle_step_rad, min_range_m, max_range_m,
+                         ranges_m))
+        scan_id = _u32()
+        self._check(_lib.polyc_online_add_scan(self._ctx, ctypes.byref(s), 1 if keep else 0,
+                                               ctypes.byref(scan_id)), "add scan")
+        return scan_id.value
+
+    @staticmethod
+    def _report(r):
+        return OnlineReport(*(getattr(r, n) for n in OnlineReport._fields))
+
+    def update(self, work=ONLINE_WORK_DEFAULT):
+        """Re-optimises what the scans since the last update changed, within
+        about `work` units (0 is PolycError POLYC_ERR_CONFIG); the rest stays
+        in the backlog. Before any scan: PolycError POLYC_ERR_STATE. Returns
+        an OnlineReport."""
+        self._enter("update")
+        work = _int_field("work", work, _u64)
+        r = _OnlineReport()
+        self._check(_lib.polyc_online_update(self._ctx, work, ctypes.byref(r)), "update")
+        return self._report(r)
+
+    def finish(self, progress=None):
+        """Converges the map as a batch build would (the backlog, then the
+        full search); scans may be added after it. progress as for
+        Context.build: returning True stops (PolycError POLYC_ERR_STOPPED,
+        the best map so far kept), an exception it raises (KeyboardInterrupt
+        too) stops and is raised here. Returns an OnlineReport."""
+        r = _OnlineReport()
+        self._run(lambda ctx, cb, user: _lib.polyc_online_finish(ctx, cb, user,
+                                                                  ctypes.byref(r)),
+                  progress, "finish")
+        return self._report(r)
+
+    def correct(self, scan_id, pose):
+        """Gives kept scan scan_id the pose (x_m, y_m, theta_rad), after a
+        loop closure; the next updates re-optimise what changed. A scan not
+        kept (or unknown): PolycError POLYC_ERR_RANGE."""
+        self._enter("correct")
+        scan_id = _int_field("scan_id", scan_id, _u32)
+        x, y, theta = (_real_field("pose", v) for v in pose)
+        self._check(_lib.polyc_online_correct(self._ctx, scan_id, x, y, theta), "correct")
+
+    def changes_since(self, version):
+        """The polylines added, modified or removed by the versions after
+        `version`, one Change (id, kind, version) per polyline, its latest,
+        ids ascending. ResyncError (a PolycError, POLYC_ERR_RANGE) when
+        removals that old are forgotten: read the whole map again."""
+        self._enter("changes since")
+        since = _int_field("version", version, _u64)
+        count = _u32()
+        cap, out = 0, None
+        while True:
+            status = _lib.polyc_online_changes(self._ctx, since, out, cap, ctypes.byref(count))
+            if status == ERR_RANGE:
+                raise ResyncError(status, "changes since %d" % since,
+                                  _lib.polyc_last_error(self._ctx).decode())
+            self._check(status, "changes since %d" % since)
+            if count.value <= cap:
+                break
+            cap = count.value
+            out = (_Change * cap)()
+        return [Change(c.id, CHANGE_KINDS.get(c.kind, "kind %d" % c.kind), c.version)
+                for c in (out[:count.value] if count.value else ())]
+
+    @property
+    def version(self):
+        """The map's version: 0 before the first update, one more for every
+        update or finish that changed the map."""
+        self._enter("version")
+        return _lib.polyc_online_version(self._ctx)
+
+    @property
+    def polylines(self):
+        """The map as the last update or finish left it, copied out: a list
+        of Polyline, as in a batch Result."""
+        self._enter("polylines")
+        return self._copy_polylines()
+
+    @property
+    def polyline_ids(self):
+        """The ids of the polylines, in the order of polylines: an id stays
+        the same while its polyline lives; ids start at 1, never reused."""
+        self._enter("polyline ids")
+        ids = []
+        one = _u32()
+        for i in range(_lib.polyc_polyline_count(self._ctx)):
+            self._check(_lib.polyc_polyline_id(self._ctx, i, ctypes.byref(one)), "polyline id")
+            ids.append(one.value)
+        return ids
+
+    @property
+    def stats(self):
+        """The fields of polyc_stats for the current map (a dict)."""
         self._enter("stats")
         return self._get_stats()
 
