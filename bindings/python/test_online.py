@@ -18,6 +18,7 @@ import math
 import os
 import random
 import re
+import signal
 import struct
 import unittest
 from array import array
@@ -143,8 +144,7 @@ class Online(unittest.TestCase):
             sizes.append(r.polylines)
         self.assertEqual(versions, sorted(versions))         # never goes back
         self.assertGreater(versions[-1], versions[0])        # and grows
-        self.assertGreater(versions[0], 0)                   # the first scan made a map
-        self.assertGreater(sizes[-1], 0)
+        self.assertGreater(min(sizes[4:]), 0)                # a map after a few scans
         ids = m.polyline_ids
         self.assertEqual(len(ids), len(m.polylines))
         self.assertEqual(len(set(ids)), len(ids))
@@ -307,6 +307,13 @@ class Online(unittest.TestCase):
         with self.assertRaises(Mine):
             m.finish(progress=bad)
         self.assertEqual(len(calls), 1)
+
+        def ctrl_c(it):
+            signal.raise_signal(signal.SIGINT)
+
+        with self.assertRaises(KeyboardInterrupt):            # Ctrl-C as for the batch build
+            m.finish(progress=ctrl_c)
+        self.assertIs(signal.getsignal(signal.SIGINT), signal.default_int_handler)
         seen = {}
 
         def reenter(it):
