@@ -28,7 +28,9 @@
 void polyc__online_stage_limits(const polyc_online_limits *ol, polyc_limits *lim)
 {
     memset(lim, 0, sizeof *lim);
-    lim->max_scans = 1 + ol->keep_scans;
+    /* the current scan's slot and the kept ones' (at least two: the stages
+     * size for scans, not for a single scan's chains) */
+    lim->max_scans = 2 + ol->keep_scans;
     /* the stages size their bucket and point arrays from max_beams: here
      * the data cells stand for the beams of a batch context */
     uint64_t beams = (uint64_t)ol->max_scan_beams + ol->keep_beams + ol->max_points;
@@ -268,12 +270,18 @@ static int sum_endpoints(polyc_ctx *ctx, const polyc__scan *s, float sign)
         if (*slot == 0) {
             if (sign < 0.0f)
                 continue;
-            if (on->sums_n >= on->lim.max_points) {
+            uint32_t e;
+            if (on->sums_free) {
+                e = on->sums_free - 1;
+                on->sums_free = on->sums[e].n;
+            } else if (on->sums_n < on->lim.max_points) {
+                e = on->sums_n++;
+            } else {
                 ok = 0;
                 continue;
             }
-            memset(&on->sums[on->sums_n], 0, sizeof on->sums[0]);
-            *slot = ++on->sums_n;
+            memset(&on->sums[e], 0, sizeof on->sums[0]);
+            *slot = e + 1;
         }
         polyc__cell_sums *c = &on->sums[*slot - 1];
         float ox = (b.ex - fx - 0.5f) * g->cell_m, oy = (b.ey - fy - 0.5f) * g->cell_m;
@@ -285,6 +293,11 @@ static int sum_endpoints(polyc_ctx *ctx, const polyc__scan *s, float sign)
         c->vx += sign * (b.sx - b.ex) * g->cell_m;
         c->vy += sign * (b.sy - b.ey) * g->cell_m;
         c->n = sign > 0.0f ? c->n + 1 : (c->n > 0 ? c->n - 1 : 0);
+        if (c->n == 0) { /* its last endpoint went (a correction): the entry is free */
+            c->n = on->sums_free;
+            on->sums_free = *slot;
+            *slot = 0;
+        }
     }
     return ok;
 }
@@ -334,8 +347,10 @@ static polyc_status accumulate(polyc_ctx *ctx, const polyc__scan *s, uint32_t nu
     polyc__prior_learn_scan(ctx, &on->prior, s, number, on->learn_cache, on->lim.max_scan_beams, &on->acc);
     int64_t d = tile_of(g, (int32_t)floorf((float)((double)s->x_m - (g->origin_x_m - ctx->frame_x)) * g->inv_cell),
                         (int32_t)floorf((float)((double)s->y_m - (g->origin_y_m - ctx->frame_y)) * g->inv_cell));
-    if (d >= 0)
+    if (d >= 0 && !((on->pose_bits[d >> 5] >> (d & 31)) & 1u)) {
         on->pose_bits[d >> 5] |= 1u << (d & 31);
+        on->spacing_stale = 1;
+    }
     if (s->count > 1 && (on->min_step_rad == 0.0f || fabsf(s->step_rad) < on->min_step_rad))
         on->min_step_rad = fabsf(s->step_rad);
     on->last_x = s->x_m;

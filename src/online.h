@@ -30,9 +30,11 @@ typedef struct polyc__online {
     uint32_t *slot;
     polyc__cell_sums *sums;
     uint32_t sums_n;
+    uint32_t sums_free;            /* 1 + a free entry (a list through their n), 0: none */
     uint32_t *pose_bits;           /* bit per directory entry: a pose lay in the tile */
     float min_step_rad;            /* smallest |angle step| seen */
     float *spacing_dist;           /* the spacing table (spacing.c), per directory entry */
+    int spacing_stale;             /* a pose fell in a new tile since it was made */
 
     /* the backlog: per directory entry 0, or 1 + the scan count when the
      * tile changed first since it was last re-optimised; and their list */
