@@ -20,6 +20,12 @@
 /* A tile waiting in the backlog gains this on the nearer ones per scan
  * added since it changed: nearest first, but none waits for ever. */
 #define AGE_M_PER_SCAN 0.25f
+/* An update starts a round when the backlog holds this many tiles, or a
+ * tile in it has waited this many scans: a round's fixed costs (the passes
+ * over the map's ends, the region's books) and the climbs of the vertices
+ * near the robot are then paid once for several scans, not for each. */
+#define ROUND_TILES 4u
+#define ROUND_WAIT_SCANS 8u
 /* The tile taken in a round is marked so in dirty_since until it is done. */
 #define TAKEN UINT32_MAX
 
@@ -191,7 +197,10 @@ polyc_status polyc__online_round(polyc_ctx *ctx, uint64_t work, int all, uint64_
     }
     stamp_region(ctx, taken, since);
     o->region_since = since;
+    uint8_t add = o->pol.add_vertices;
+    o->pol.add_vertices = 0;
     polyc__operators(o, since, since);
+    o->pol.add_vertices = add;
     o->region_since = 0;
     POLYC__CHECKS_ITERATION(o);
     for (uint32_t i = 0; i < taken; i++)
@@ -246,7 +255,10 @@ polyc_status polyc_online_update(polyc_ctx *ctx, uint64_t work, polyc_online_rep
     polyc__online *on = ctx->online;
     uint64_t spent = 0;
     uint32_t changed = 0;
-    if (on->dirty_n > 0) {
+    uint32_t oldest = on->scans + 1;
+    for (uint32_t i = 0; i < on->dirty_n; i++)
+        oldest = on->dirty_since[on->dirty[i]] < oldest ? on->dirty_since[on->dirty[i]] : oldest;
+    if (on->dirty_n >= ROUND_TILES || (on->dirty_n > 0 && on->scans + 1 - oldest >= ROUND_WAIT_SCANS)) {
         st = polyc__online_round(ctx, work, 0, &spent);
         polyc_status pst = polyc__online_publish(ctx, &changed);
         if (st == POLYC_OK)
