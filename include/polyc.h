@@ -207,7 +207,8 @@ POLYC_API uint32_t polyc_version(void);
 POLYC_API const char *polyc_status_str(polyc_status status);
 /* sizeof of the public struct named by `name` ("polyc_config", "polyc_limits",
  * "polyc_scan", "polyc_box", "polyc_polyline", "polyc_stats",
- * "polyc_iteration", "polyc_occupancy_grid"), 0 if unknown: lets bindings
+ * "polyc_iteration", "polyc_occupancy_grid", "polyc_online_limits",
+ * "polyc_online_report", "polyc_change"), 0 if unknown: lets bindings
  * detect ABI drift. */
 POLYC_API size_t polyc_struct_size(const char *name);
 

@@ -89,9 +89,12 @@ int polyc__accuracy_scratch(polyc__acc_learn *L, polyc__arena *a, const polyc_li
     return L->samples && L->cells;
 }
 
-/* Online, the samples are paired as they come: each cell keeps its last
- * PAIR_TRIES samples (a ring), a new one is compared with them and takes
- * the oldest's place; the cell's sums stay. */
+/* Online, the samples are paired as they come: each cell keeps PAIR_TRIES
+ * of its samples, a uniform choice among all it has seen (a reservoir: the
+ * n-th takes a place with chance PAIR_TRIES / n), and a new sample is
+ * compared with them, so that, as in the batch's pairing, the scans
+ * compared are spread over the whole run and not only the last few (whose
+ * poses share their error). The cell's sums stay. */
 int polyc__accuracy_online(polyc__acc_learn *L, polyc__arena *a)
 {
     if (!L->p)
@@ -154,7 +157,16 @@ void polyc__accuracy_sample(polyc__acc_learn *L, float x, float y, float nx, flo
         uint32_t n = L->ring_n[cell];
         for (uint32_t k = 0; k < n && k < PAIR_TRIES; k++)
             pair(c, s, &ring[k]);
-        ring[n % PAIR_TRIES] = *s;
+        uint32_t at = n;
+        if (n >= PAIR_TRIES) { /* a hash of (cell, n): the same choices on every run */
+            uint32_t h = (cell * 2654435761u) ^ (n * 2246822519u);
+            h ^= h >> 15;
+            h *= 2654435761u;
+            h ^= h >> 13;
+            at = h % (n + 1);
+        }
+        if (at < PAIR_TRIES)
+            ring[at] = *s;
         L->ring_n[cell] = n + 1;
     }
 }

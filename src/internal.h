@@ -260,6 +260,8 @@ float polyc__spacing_at(const polyc__spacing *sp, float x, float y);
  * (the pose and every reflected endpoint, frame shifted by ox, oy) grows
  * box[4] = min x, min y, max x, max y (have: it holds something) */
 int polyc__pose_ok(double x, double y, double th);
+/* api.c: what is wrong with a scan's geometry (a static message), or NULL */
+const char *polyc__scan_problem(const polyc_scan *s);
 void polyc__extent_add(const polyc_scan *s, double ox, double oy, double *box, int *have);
 
 /* grid.c */
@@ -271,7 +273,7 @@ void polyc__grid_reserve(polyc__arena *a, const polyc_limits *lim);
 polyc_status polyc__grid_build(polyc_ctx *ctx);
 /* online: a grid over a square of side_m centred on the frame origin, with
  * no tile yet; one scan counted into it, or taken back (a pose correction) */
-polyc_status polyc__grid_online_init(polyc_ctx *ctx, double side_m);
+polyc_status polyc__grid_online_init(polyc_ctx *ctx, double side_m, uint32_t max_cells);
 polyc_status polyc__grid_add_scan(polyc_ctx *ctx, const polyc__scan *s, int take_back);
 polyc__tile *polyc__grid_tile(const polyc__grid *g, int32_t ix, int32_t iy);
 /* NULL for cells outside the grid or in tiles not stored (no beam ends in a

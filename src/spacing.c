@@ -52,15 +52,19 @@ static void chamfer(polyc__spacing *sp)
         }
 }
 
-/* Online, from the tiles where some pose was (the poses are not kept). */
+/* Online, from the tiles where some pose was (the poses are not kept);
+ * made again only when a pose fell in a new tile. */
 static polyc_status online_table(polyc_ctx *ctx, polyc__spacing *sp, size_t n)
 {
-    const polyc__online *on = ctx->online;
+    polyc__online *on = ctx->online;
     sp->min_step_rad = on->min_step_rad;
     sp->dist = on->spacing_dist;
+    if (!on->spacing_stale)
+        return POLYC_OK;
     for (size_t i = 0; i < n; i++)
         sp->dist[i] = (on->pose_bits[i >> 5] >> (i & 31)) & 1u ? 0.0f : 1e30f;
     chamfer(sp);
+    on->spacing_stale = 0;
     return POLYC_OK;
 }
 
