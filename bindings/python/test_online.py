@@ -104,12 +104,11 @@ def segments(polylines):
         yield from pairs
 
 
-def new_map(**kw):
+def new_map(area_m=16.0, **kw):
     kw.setdefault("config", {"cell_m": CELL_M})
-    return polyc.OnlineMap(16.0, BEAMS, **kw)
+    return polyc.OnlineMap(area_m, BEAMS, **kw)
 
 
-@unittest.skipUnless(polyc._lib.has_online, "the library has no online API yet")
 class Online(unittest.TestCase):
     def assert_on_walls(self, polylines, tol_m=0.05):
         """Every segment within tol_m of a wall (ends and eight points between),
@@ -272,7 +271,7 @@ class Online(unittest.TestCase):
         scans = room_scans(12)
         true_pose = scans[5].pose
         wrong = (true_pose[0] + 0.4, true_pose[1] - 0.3, true_pose[2] + 0.2)
-        m = new_map(keep_scans=1, keep_beams=BEAMS)
+        m = new_map(20.0, keep_scans=1, keep_beams=BEAMS)   # room for the wrong pose's walls
         for i, s in enumerate(scans):
             if i == 5:
                 kept = m.add_scan(*s._replace(pose=wrong), keep=True)
@@ -283,6 +282,9 @@ class Online(unittest.TestCase):
             m.add_scan(*scans[0], keep=True)
         self.assertEqual(e.exception.status, polyc.ERR_LIMIT)
         self.assertEqual(m.stats["scans"], len(scans))       # that scan was not added
+        # the wrong pose put a wall far from the room's
+        self.assertGreater(max(wall_dist(x, y) for line in m.polylines for x, y in line.points),
+                           0.2)
         before = m.version
         m.correct(kept, true_pose)
         r = m.update()

@@ -237,6 +237,7 @@ def _load():
         "polyc_polyline_id": (st, [ctx, _u32, P(_u32)]),
         "polyc_online_version": (_u64, [ctx]),
     }
+    signatures.update(online)
     # the polyc tool's readers (bindings/python/polyc_io.c): in the package's
     # library, not in a plain libpolyc.so named by POLYC_LIB
     io = {
@@ -255,12 +256,6 @@ def _load():
     for name, (res, args) in signatures.items():
         fn = getattr(lib, name)
         fn.restype, fn.argtypes = res, args
-    # a library built before the online API lands has none of it (OnlineMap
-    # then raises OSError)
-    lib.has_online = hasattr(lib, "polyc_online_init")
-    for name, (res, args) in online.items() if lib.has_online else ():
-        fn = getattr(lib, name)
-        fn.restype, fn.argtypes = res, args
     lib.has_io = hasattr(lib, "polyc_io_version")
     for name, (res, args) in io.items() if lib.has_io else ():
         fn = getattr(lib, name)
@@ -270,8 +265,7 @@ def _load():
 
 _lib = None                                # PolycError works before the load
 _lib = _load()
-for _name, _cls in list(_STRUCTS.items()) + list(_ONLINE_STRUCTS.items() if _lib.has_online
-                                                   else ()):
+for _name, _cls in list(_STRUCTS.items()) + list(_ONLINE_STRUCTS.items()):
     _size = _lib.polyc_struct_size(_name.encode())
     if _size != ctypes.sizeof(_cls):
         raise PolycError(ERR_CONFIG, "loading " + _library_path(),
@@ -814,9 +808,6 @@ class OnlineMap(_Block):
 
     def __init__(self, area_m, max_scan_beams, config=None, keep_scans=0, keep_beams=0,
                  **limits):
-        if not _lib.has_online:
-            raise OSError("OnlineMap needs a libpolyc with the online API; %s has none"
-                          % _library_path())
         self._ctx = ctypes.c_void_p()
         self._cfg = _config(dict(config or {}))
         area_m = _real_field("area_m", area_m)
