@@ -132,6 +132,7 @@ class Online(unittest.TestCase):
         self.assertEqual(m.polylines, [])
         self.assertEqual(m.changes_since(0), [])
         versions, sizes = [], []
+        client, seen = {}, 0                # a copy of the map kept by the changes alone
         for i, s in enumerate(room_scans()):
             self.assertEqual(m.add_scan(*s), i)
             r = m.update()
@@ -141,6 +142,19 @@ class Online(unittest.TestCase):
             self.assertEqual(r.polylines, len(m.polylines))
             versions.append(r.version)
             sizes.append(r.polylines)
+            now = dict(zip(m.polyline_ids, m.polylines))
+            changes = m.changes_since(seen)
+            self.assertEqual(len(changes) > 0, r.version > seen)
+            self.assertTrue(all(seen < c.version <= r.version for c in changes))
+            for c in changes:
+                if c.kind == "removed":
+                    self.assertNotIn(c.id, now)
+                    client.pop(c.id, None)
+                else:
+                    self.assertEqual(c.kind == "added", c.id not in client)
+                    client[c.id] = now[c.id]
+            self.assertEqual(client, now)
+            seen = r.version
         self.assertEqual(versions, sorted(versions))         # never goes back
         self.assertGreater(versions[-1], versions[0])        # and grows
         self.assertGreater(min(sizes[4:]), 0)                # a map after a few scans
@@ -367,10 +381,16 @@ class Online(unittest.TestCase):
         self.assertIn("added", printed.getvalue())
 
     def test_struct_sizes(self):
-        for name, cls in polyc._ONLINE_STRUCTS.items():
+        # in the import's check (test_polyc tests every struct of _STRUCTS)
+        for name in ("polyc_online_limits", "polyc_online_report", "polyc_change"):
+            cls = polyc._STRUCTS[name]
             self.assertEqual(polyc._lib.polyc_struct_size(name.encode()), ctypes.sizeof(cls),
                              name)
-        self.assertEqual(polyc.ONLINE_WORK_DEFAULT, 4000)
+        with open(os.path.join(REPO, "include", "polyc.h")) as f:
+            header = f.read()
+        self.assertIn("#define POLYC_ONLINE_WORK_DEFAULT %du" % polyc.ONLINE_WORK_DEFAULT, header)
+        for value, kind in polyc.CHANGE_KINDS.items():
+            self.assertIn("#define POLYC_CHANGE_%s %du" % (kind.upper(), value), header)
 
 
 def point_seg_dist(x, y, a, b):

@@ -162,9 +162,9 @@ class _Change(ctypes.Structure):
 
 _STRUCTS = {"polyc_config": _Config, "polyc_limits": _Limits, "polyc_scan": _Scan,
             "polyc_box": _Box, "polyc_polyline": _Polyline, "polyc_stats": _Stats,
-            "polyc_iteration": _Iteration, "polyc_occupancy_grid": _OccupancyGrid}
-_ONLINE_STRUCTS = {"polyc_online_limits": _OnlineLimits, "polyc_online_report": _OnlineReport,
-                   "polyc_change": _Change}
+            "polyc_iteration": _Iteration, "polyc_occupancy_grid": _OccupancyGrid,
+            "polyc_online_limits": _OnlineLimits, "polyc_online_report": _OnlineReport,
+            "polyc_change": _Change}
 _PROGRESS = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.POINTER(_Iteration))
 
 
@@ -223,9 +223,7 @@ def _load():
         "polyc_get_stats": (st, [ctx, P(_Stats)]),
         "polyc_score": (st, [ctx, P(_f64), P(_f64)]),
         "polyc_last_error": (ctypes.c_char_p, [ctx]),
-    }
-    # online mapping (polyc.h, "Online mapping")
-    online = {
+        # online mapping (polyc.h, "Online mapping")
         "polyc_online_limits_for_area": (st, [P(_Config), _f64, _u32, P(_OnlineLimits)]),
         "polyc_online_memory_size": (sz, [P(_Config), P(_OnlineLimits)]),
         "polyc_online_init": (st, [ctypes.c_void_p, sz, P(_Config), P(_OnlineLimits), P(ctx)]),
@@ -237,7 +235,6 @@ def _load():
         "polyc_polyline_id": (st, [ctx, _u32, P(_u32)]),
         "polyc_online_version": (_u64, [ctx]),
     }
-    signatures.update(online)
     # the polyc tool's readers (bindings/python/polyc_io.c): in the package's
     # library, not in a plain libpolyc.so named by POLYC_LIB
     io = {
@@ -265,7 +262,7 @@ def _load():
 
 _lib = None                                # PolycError works before the load
 _lib = _load()
-for _name, _cls in list(_STRUCTS.items()) + list(_ONLINE_STRUCTS.items()):
+for _name, _cls in _STRUCTS.items():
     _size = _lib.polyc_struct_size(_name.encode())
     if _size != ctypes.sizeof(_cls):
         raise PolycError(ERR_CONFIG, "loading " + _library_path(),
