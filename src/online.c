@@ -40,7 +40,7 @@ void polyc__online_stage_limits(const polyc_online_limits *ol, polyc_limits *lim
     /* a weighted point gathers the data cells of a 2 x 2 block: half of
      * them is room for blocks of under two cells on average (intel's hold
      * 2.5, freiburg-079's 7) */
-    lim->max_points = ol->max_points / 2 > 4096 ? ol->max_points / 2 : 4096;
+    lim->max_points = ol->max_points / 2 > 16 ? ol->max_points / 2 : 16;
 }
 
 static int limits_ok(const polyc_online_limits *ol)
