@@ -37,7 +37,10 @@ void polyc__online_stage_limits(const polyc_online_limits *ol, polyc_limits *lim
     lim->max_beams = beams > 0x7fffffffu ? 0x7fffffffu : (uint32_t)beams;
     lim->max_grid_cells = ol->max_grid_cells;
     lim->max_vertices = ol->max_vertices;
-    lim->max_points = ol->max_points;
+    /* a weighted point gathers the data cells of a 2 x 2 block: half of
+     * them is room for blocks of under two cells on average (intel's hold
+     * 2.5, freiburg-079's 7) */
+    lim->max_points = ol->max_points / 2 > 16 ? ol->max_points / 2 : 16;
 }
 
 static int limits_ok(const polyc_online_limits *ol)
@@ -66,9 +69,11 @@ polyc_status polyc_online_limits_for_area(const polyc_config *config, double are
      * square is taken whole */
     double stored = tiles <= 256.0 ? tiles : fmax(256.0, ceil(tiles / 4.0));
     double cells = fmin(stored * POLYC__TILE_CELLS, 0x40000000);
-    /* endpoints fall in one cell in 12 of a stored tile (intel: 70,000
-     * cells with hits in 817 tiles), vertices one per 64 such cells */
-    double points = fmin(fmax(cells / 12.0, 4096.0), 0x10000000);
+    /* endpoints fall in one cell in 15 of a stored tile on intel (57,712
+     * cells in 851 tiles), one in 5 on freiburg-079 (143,127 in 720, long
+     * range in a small building): room for one in 4; vertices one per 64
+     * such cells */
+    double points = fmin(fmax(cells / 4.0, 4096.0), 0x10000000);
     out->area_m = area_m;
     out->max_grid_cells = (uint32_t)cells;
     out->max_points = (uint32_t)points;

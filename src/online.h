@@ -35,6 +35,8 @@ typedef struct polyc__online {
     float min_step_rad;            /* smallest |angle step| seen */
     float *spacing_dist;           /* the spacing table (spacing.c), per directory entry */
     int spacing_stale;             /* a pose fell in a new tile since it was made */
+    uint32_t spacing_scans;        /* the scan count when it was made */
+    int spacing_now;               /* make it again now if stale (the finishing call) */
 
     /* the backlog: per directory entry 0, or 1 + the scan count when the
      * tile changed first since it was last re-optimised; and their list */

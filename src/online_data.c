@@ -45,9 +45,7 @@ polyc_status polyc__online_refresh_tiles(polyc_ctx *ctx, uint32_t n_taken)
     polyc__online *on = ctx->online;
     polyc__opt *o = &on->opt;
     polyc__hash *h = &o->h;
-    polyc__prior_online_sums(&on->prior);
-    polyc__accuracy_weigh(&on->acc, ctx->cfg.alpha);
-    o->prior = on->prior;
+    o->prior = on->prior; /* its totals and weights are kept as scans come */
     polyc_status st = polyc__spacing_build(ctx, &o->spacing);
     if (st != POLYC_OK)
         return st;

@@ -282,8 +282,10 @@ polyc_status polyc_online_finish(polyc_ctx *ctx, polyc_progress_fn progress, voi
     st = polyc__online_round(ctx, UINT64_MAX, 1, &spent);
     /* the data exact for the search: every point weighed as the accuracy
      * stands now, the books from scratch */
+    on->spacing_now = 1;
     if (st == POLYC_OK)
         st = polyc__opt_refresh(&on->opt);
+    on->spacing_now = 0;
     if (st == POLYC_OK && ctx->cfg.max_iterations > 0) {
         polyc__guarded g = {ctx, progress, user};
         st = polyc__search(&on->opt, progress ? polyc__guarded_progress : NULL, &g);
