@@ -220,10 +220,11 @@ class Online(unittest.TestCase):
 
     def test_errors(self):
         m = new_map()
-        with self.assertRaises(polyc.PolycError) as e:       # before any scan
-            m.update()
-        self.assertEqual(e.exception.status, polyc.ERR_STATE)
-        self.assertTrue(e.exception.detail)                  # the library's message
+        for call in (m.update, m.finish):                    # before any scan
+            with self.assertRaises(polyc.PolycError) as e:
+                call()
+            self.assertEqual(e.exception.status, polyc.ERR_STATE)
+            self.assertTrue(e.exception.detail)              # the library's message
         s = room_scans(2)
         first = m.add_scan(*s[0])
         with self.assertRaises(polyc.PolycError) as e:       # no work allowed
@@ -306,6 +307,25 @@ class Online(unittest.TestCase):
         m.finish()
         self.assert_on_walls(m.polylines)
         m.correct(kept, true_pose)                           # again, the same pose: fine
+        with self.assertRaises(polyc.PolycError) as e:       # a pose outside the area
+            m.correct(kept, (true_pose[0] + 9.0, true_pose[1], true_pose[2]))
+        self.assertEqual(e.exception.status, polyc.ERR_EXTENT)
+        with self.assertRaises(polyc.PolycError) as e:
+            m.correct(kept, (math.inf, 0.0, 0.0))
+        self.assertEqual(e.exception.status, polyc.ERR_SCAN)
+
+    def test_scans_after_finish(self):
+        scans = room_scans(12)
+        m = new_map()
+        for s in scans[:6]:
+            m.add_scan(*s)
+            m.update()
+        m.finish()
+        for s in scans[6:]:
+            m.add_scan(*s)
+            m.update()
+        self.assertEqual(m.finish().scans, len(scans))
+        self.assert_on_walls(m.polylines)
 
     def test_finish_progress(self):
         class Mine(Exception):
