@@ -916,7 +916,7 @@ static double core_rms(const polyc_ctx *ctx, const scene *s)
  *   office     4.88 mm, 0.9961, 63 v  235.65 / 55.88 mm, 0.7876 / 0.8076 15.35 mm, 0.9888, 55 v
  * (RMS, completeness, vertices); the backlog drained in 2 and 6 updates.
  * The office's corrected RMS is all one stray polyline: see
- * FIXME(finish-keeps-dataless-polyline) below; its core RMS (samples within
+ * FIXME(finish-keeps-walker-polyline) below; its core RMS (samples within
  * 0.5 m of a wall) is that of the batch map. */
 #define CORRECT_DRAIN_UPDATES 20   /* updates the backlog drains in after corrections */
 /* core RMS at most the batch's + this (measured: office +0.77 mm; square
@@ -987,11 +987,15 @@ static void check_correction(const char *name)
     assert_true(fabs((double)after.vertices - (double)batch.vertices) <=
                 FINISH_VERTICES * (double)batch.vertices);
     assert_true(after_core <= batch_core + CORRECT_RMS_M);
-    /* FIXME(finish-keeps-dataless-polyline): on the office a 2-point,
-     * 2 cm polyline born before the corrections (id 94, at (4.498, 8.536)),
-     * 0.83 m from any wall on a walker's trail, whose cells are free
-     * (0-13 hits against 46-233 misses), survives the drained updates and
-     * polyc_online_finish: RMS 15.35 mm against the batch's 4.88 mm.
+    /* FIXME(finish-keeps-walker-polyline): on the office a 2-point, 2 cm
+     * polyline traced before the corrections (id 94, (4.498, 8.536) to
+     * (4.478, 8.536)), 0.83 m from any wall on a walker's trail, survives
+     * the drained updates and polyc_online_finish. Its cell has 13 hits
+     * against 50 misses (m 0.21: data under data_min_m 0.2, far under the
+     * contour threshold 0.5, so the batch never traces it; its neighbours
+     * 0-7 hits against 46-233 misses). RMS 15.35 mm against the batch's
+     * 4.88 mm; the same scans online without the drift and corrections
+     * lose it at finish (5.28 mm).
      * assert_true(after.precision_rms_m <= batch.precision_rms_m + FINISH_RMS_M); */
     /* and clearly better than the drifted map, updated or finished */
     assert_true(after.precision_rms_m < 0.5 * before.precision_rms_m);
