@@ -635,6 +635,66 @@ static void test_changes_since_version(void **state)
     scene_free(&s);
 }
 
+/* With few vertices (160: a ring of 96 removals) the office's removals
+ * outrun the ring: a copy too old gets POLYC_ERR_RANGE (and reads the map
+ * again), a recent one still rebuilds exactly. */
+static void test_changes_forgotten(void **state)
+{
+    (void)state;
+    scene s;
+    scene_make(&s, "office", SCENE_SEED);
+    online o;
+    memset(&o, 0, sizeof o);
+    config_of(&o.config);
+    check_status(polyc_online_limits_for_area(&o.config, s.area_m, s.beams, &o.limits), NULL,
+                 "limits");
+    o.limits.max_vertices = 160;
+    o.size = polyc_online_memory_size(&o.config, &o.limits);
+    assert_true(o.size > 0);
+    o.block = malloc(o.size);
+    assert_non_null(o.block);
+    check_status(polyc_online_init(o.block, o.size, &o.config, &o.limits, &o.ctx), NULL, "init");
+    map_copy client, prev;
+    map_take(&client, o.ctx);
+    map_take(&prev, o.ctx);
+    uint64_t client_at = 0, prev_at = 0;
+    uint32_t refused = 0, applied = 0, a = 0, m = 0, rm = 0, unseen = 0;
+    polyc_online_report r;
+    for (uint32_t i = 0; i < s.sim.scan_count; i++) {
+        add(&o, &s.sim.scans[i], 0);
+        update(&o, POLYC_ONLINE_WORK_DEFAULT, &r);
+        /* the copy of the update before: never forgotten here */
+        check_changes_apply(o.ctx, &prev, prev_at, &a, &m, &rm, &unseen);
+        map_free(&prev);
+        map_take(&prev, o.ctx);
+        prev_at = r.version;
+        /* the copy of version 0, or the last re-read */
+        uint32_t n;
+        polyc_status st = polyc_online_changes(o.ctx, client_at, NULL, 0, &n);
+        if (st == POLYC_ERR_RANGE) {
+            refused++;
+            map_free(&client);
+            map_take(&client, o.ctx); /* the caller reads the whole map */
+            client_at = r.version;
+            continue;
+        }
+        check_status(st, o.ctx, "polyc_online_changes");
+        if (i % 8 == 7) {
+            check_changes_apply(o.ctx, &client, client_at, &a, &m, &rm, &unseen);
+            applied++;
+        }
+    }
+    print_message("office, 160 vertices: %u refusals (POLYC_ERR_RANGE) of an old copy, %u "
+                  "applied; %u added, %u modified, %u removed\n",
+                  refused, applied, a, m, rm);
+    assert_true(refused > 0);
+    assert_int_equal(polyc_online_changes(o.ctx, 0, NULL, 0, &a), POLYC_ERR_RANGE);
+    map_free(&client);
+    map_free(&prev);
+    online_close(&o);
+    scene_free(&s);
+}
+
 /* ---- 3. a valid map between updates -------------------------------------- */
 
 /* The scene scan by scan, an update after each (of `work`, or with work 0
@@ -1480,6 +1540,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_update_within_budget),
         cmocka_unit_test(test_changes_since_version),
+        cmocka_unit_test(test_changes_forgotten),
         cmocka_unit_test(test_valid_between_updates),
         cmocka_unit_test(test_walker_trail),
         cmocka_unit_test(test_finish_against_batch),
