@@ -887,6 +887,54 @@ static void test_finish_against_batch(void **state)
     compare_finish("angled");
 }
 
+/* Scans may be added after finish: the office's first half, finish, the
+ * second half with updates, finish again. The map stays valid throughout,
+ * the changes since the first finish rebuild its copy, and the end scores
+ * like the batch map (measured: 56 vertices, RMS 5.41 mm, completeness
+ * 0.9941 against the batch's 63, 4.88 mm, 0.9961). */
+static void test_finish_then_more(void **state)
+{
+    (void)state;
+    scene s;
+    scene_make(&s, "office", SCENE_SEED);
+    gtscore_map_score b, f;
+    batch_score(&s, s.sim.scans, &b);
+    online o;
+    polyc_online_report r;
+    online_open(&o, &s, 0);
+    uint32_t half = s.sim.scan_count / 2, crossings, junctions;
+    double cover;
+    for (uint32_t i = 0; i < half; i++) {
+        add(&o, &s.sim.scans[i], 0);
+        update(&o, POLYC_ONLINE_WORK_DEFAULT, &r);
+    }
+    finish(&o, &r);
+    assert_int_equal(r.backlog_tiles, 0);
+    assert_int_equal(r.pending_scans, 0);
+    map_copy mid;
+    map_take(&mid, o.ctx);
+    uint64_t mid_at = r.version;
+    for (uint32_t i = half; i < s.sim.scan_count; i++) {
+        add(&o, &s.sim.scans[i], 0);
+        update(&o, POLYC_ONLINE_WORK_DEFAULT, &r);
+        map_validity(o.ctx, &crossings, &junctions, &cover);
+        assert_int_equal(crossings, 0);
+        assert_true(cover == 0.0);
+    }
+    finish(&o, &r);
+    uint32_t a = 0, m = 0, rm = 0, unseen = 0;
+    check_changes_apply(o.ctx, &mid, mid_at, &a, &m, &rm, &unseen);
+    score_ctx(o.ctx, &s, &f);
+    print_message("office, finished half-way and at the end:\n");
+    print_score("  batch", &b);
+    print_score("  online", &f);
+    assert_scores_like("finished twice", &f, &b, FINISH_RMS_M, FINISH_COMPLETENESS,
+                       FINISH_VERTICES);
+    map_free(&mid);
+    online_close(&o);
+    scene_free(&s);
+}
+
 /* ---- 5. ten passes in the block for one ---------------------------------- */
 
 /* Measured (office, seed 7): one pass 54 vertices, RMS 5.28 mm,
@@ -1544,6 +1592,7 @@ int main(void)
         cmocka_unit_test(test_valid_between_updates),
         cmocka_unit_test(test_walker_trail),
         cmocka_unit_test(test_finish_against_batch),
+        cmocka_unit_test(test_finish_then_more),
         cmocka_unit_test(test_ten_passes),
         cmocka_unit_test(test_pose_correction),
         cmocka_unit_test(test_bad_use),
