@@ -935,6 +935,55 @@ static void test_finish_then_more(void **state)
     scene_free(&s);
 }
 
+/* finish's progress callback: called back with the context busy, and
+ * asking to stop keeps a valid map (POLYC_ERR_STOPPED); updates go on. */
+typedef struct stopper {
+    polyc_ctx *ctx;
+    uint32_t calls, stop_at;
+    polyc_status busy;
+} stopper;
+
+static int stop_early(void *user, const polyc_iteration *it)
+{
+    stopper *st = user;
+    (void)it;
+    st->calls++;
+    st->busy = polyc_online_update(st->ctx, POLYC_ONLINE_WORK_DEFAULT, NULL);
+    return st->calls >= st->stop_at;
+}
+
+static void test_finish_stopped(void **state)
+{
+    (void)state;
+    scene s;
+    scene_make(&s, "office", SCENE_SEED);
+    online o;
+    polyc_online_report r;
+    online_open(&o, &s, 0);
+    for (uint32_t i = 0; i < s.sim.scan_count / 2; i++) {
+        add(&o, &s.sim.scans[i], 0);
+        update(&o, POLYC_ONLINE_WORK_DEFAULT, &r);
+    }
+    stopper st = {o.ctx, 0, 2, POLYC_OK};
+    assert_int_equal(polyc_online_finish(o.ctx, stop_early, &st, &r), POLYC_ERR_STOPPED);
+    assert_int_equal(st.calls, 2);
+    assert_int_equal(st.busy, POLYC_ERR_BUSY);
+    assert_true(polyc_polyline_count(o.ctx) > 0);
+    assert_int_equal(r.polylines, polyc_polyline_count(o.ctx));
+    uint32_t crossings, junctions;
+    double cover;
+    map_validity(o.ctx, &crossings, &junctions, &cover);
+    assert_int_equal(crossings, 0);
+    for (uint32_t i = s.sim.scan_count / 2; i < s.sim.scan_count; i++) {
+        add(&o, &s.sim.scans[i], 0);
+        update(&o, POLYC_ONLINE_WORK_DEFAULT, &r);
+    }
+    finish(&o, &r);
+    assert_true(polyc_polyline_count(o.ctx) > 0);
+    online_close(&o);
+    scene_free(&s);
+}
+
 /* ---- 5. ten passes in the block for one ---------------------------------- */
 
 /* Measured (office, seed 7): one pass 54 vertices, RMS 5.28 mm,
@@ -1593,6 +1642,7 @@ int main(void)
         cmocka_unit_test(test_walker_trail),
         cmocka_unit_test(test_finish_against_batch),
         cmocka_unit_test(test_finish_then_more),
+        cmocka_unit_test(test_finish_stopped),
         cmocka_unit_test(test_ten_passes),
         cmocka_unit_test(test_pose_correction),
         cmocka_unit_test(test_bad_use),
