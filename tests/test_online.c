@@ -7,7 +7,12 @@
  * sized for one; corrected poses give the map of the true poses; misuse
  * gives clear statuses; and too small a block fails cleanly. Scenes come
  * from the simulator (tools/eval/scansim), deterministic by seed; scores
- * from tools/eval/gtscore and gttopo. Needs nothing outside the repository. */
+ * from tools/eval/gtscore and gttopo. Needs nothing outside the repository.
+ * What the tests found is marked FIXME(name) where an assertion waits for
+ * the library: changes-since-0-lists-unseen-removals,
+ * online-keeps-transient-polylines, finish-keeps-walker-polyline,
+ * online-stats-memory-used, stage-calls-hide-online-map,
+ * nan-points-after-sums-run-out. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
