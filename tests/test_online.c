@@ -733,9 +733,10 @@ static void check_valid_replay(const char *name, uint64_t work, uint32_t every)
     uint32_t crossings, junctions;
     double cover;
     map_validity(o.ctx, &crossings, &junctions, &cover);
-    print_message("%s (work %llu, 0: 500 and the default in turn): %u maps checked, %u junction touches (within %.0f mm of an end); "
+    print_message("%s (work %llu%s): %u maps checked, %u junction touches (within %.0f mm of an end); "
                   "finished: %u crossings, %.3f m doubly covered\n",
-                  name, (unsigned long long)work, checks, junctions_seen, 1e3 * JUNCTION_M, crossings, cover);
+                  name, (unsigned long long)work, work ? "" : ": 500 and the default in turn",
+                  checks, junctions_seen, 1e3 * JUNCTION_M, crossings, cover);
     assert_int_equal(crossings, 0);
     assert_true(cover == 0.0);
     assert_int_equal(bad, 0);
