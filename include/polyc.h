@@ -331,7 +331,8 @@ typedef struct polyc_online_limits {
                                   some beam ended in a hit) */
     uint32_t max_vertices;     /* polyline vertices of the map */
     uint32_t max_points;       /* grid cells holding endpoints (each keeps their
-                                  sums); also bounds the weighted data points */
+                                  sums); the weighted data points (a 2 x 2 block
+                                  of cells each) are bounded by half of it */
     uint32_t max_scan_beams;   /* beams in one scan */
     uint32_t keep_scans;       /* scans kept for pose corrections (0: none) */
     uint32_t keep_beams;       /* beams of the kept scans, in all */

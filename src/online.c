@@ -28,14 +28,19 @@
 void polyc__online_stage_limits(const polyc_online_limits *ol, polyc_limits *lim)
 {
     memset(lim, 0, sizeof *lim);
-    lim->max_scans = 1 + ol->keep_scans;
+    /* the current scan's slot and the kept ones' (at least two: the stages
+     * size for scans, not for a single scan's chains) */
+    lim->max_scans = 2 + ol->keep_scans;
     /* the stages size their bucket and point arrays from max_beams: here
      * the data cells stand for the beams of a batch context */
     uint64_t beams = (uint64_t)ol->max_scan_beams + ol->keep_beams + ol->max_points;
     lim->max_beams = beams > 0x7fffffffu ? 0x7fffffffu : (uint32_t)beams;
     lim->max_grid_cells = ol->max_grid_cells;
     lim->max_vertices = ol->max_vertices;
-    lim->max_points = ol->max_points;
+    /* a weighted point gathers the data cells of a 2 x 2 block: half of
+     * them is room for blocks of under two cells on average (intel's hold
+     * 2.5, freiburg-079's 7) */
+    lim->max_points = ol->max_points / 2 > 16 ? ol->max_points / 2 : 16;
 }
 
 static int limits_ok(const polyc_online_limits *ol)
@@ -64,9 +69,11 @@ polyc_status polyc_online_limits_for_area(const polyc_config *config, double are
      * square is taken whole */
     double stored = tiles <= 256.0 ? tiles : fmax(256.0, ceil(tiles / 4.0));
     double cells = fmin(stored * POLYC__TILE_CELLS, 0x40000000);
-    /* endpoints fall in one cell in 12 of a stored tile (intel: 70,000
-     * cells with hits in 817 tiles), vertices one per 64 such cells */
-    double points = fmin(fmax(cells / 12.0, 4096.0), 0x10000000);
+    /* endpoints fall in one cell in 15 of a stored tile on intel (57,712
+     * cells in 851 tiles), one in 5 on freiburg-079 (143,127 in 720, long
+     * range in a small building): room for one in 4; vertices one per 64
+     * such cells */
+    double points = fmin(fmax(cells / 4.0, 4096.0), 0x10000000);
     out->area_m = area_m;
     out->max_grid_cells = (uint32_t)cells;
     out->max_points = (uint32_t)points;
@@ -133,6 +140,7 @@ static int lay_out(polyc_ctx *ctx, polyc__online *on, polyc__arena *a)
     POLYC__CARVE(ok, a, on->bucket_fill, nb);
     POLYC__CARVE_ZERO(ok, a, on->tile_raw, tile_cap);
     POLYC__CARVE_ZERO(ok, a, on->tile_new, tile_cap);
+    POLYC__CARVE_ZERO(ok, a, on->tile_miss, tile_cap);
     if (!ok)
         return 0;
     saved = ctx->arena;
@@ -228,6 +236,28 @@ static void mark_dirty(polyc__online *on, size_t d)
     }
 }
 
+/* A tile also joins the backlog when beams have passed through its cells
+ * with hits as often as it held endpoints at its last update: then the
+ * data rule may drop them (a person who walked by); looked at every
+ * MISS_CHECK_SCANS scans (a pass over the directory). */
+#define MISS_CHECK_SCANS 8u
+
+void polyc__online_backlog_misses(polyc_ctx *ctx)
+{
+    polyc__online *on = ctx->online;
+    if (on->scans % MISS_CHECK_SCANS != 0)
+        return;
+    const polyc__grid *g = &ctx->grid;
+    size_t dir_n = (size_t)g->tiles_x * (size_t)g->tiles_y;
+    for (size_t d = 0; d < dir_n; d++) {
+        if (!g->dir[d])
+            continue;
+        uint32_t k = g->dir[d] - 1;
+        if (on->tile_miss[k] >= CHANGE_MIN && (double)on->tile_miss[k] >= on->tile_raw[k])
+            mark_dirty(on, d);
+    }
+}
+
 void polyc__online_backlog_all(polyc_ctx *ctx)
 {
     const polyc__grid *g = &ctx->grid;
@@ -268,12 +298,18 @@ static int sum_endpoints(polyc_ctx *ctx, const polyc__scan *s, float sign)
         if (*slot == 0) {
             if (sign < 0.0f)
                 continue;
-            if (on->sums_n >= on->lim.max_points) {
+            uint32_t e;
+            if (on->sums_free) {
+                e = on->sums_free - 1;
+                on->sums_free = on->sums[e].n;
+            } else if (on->sums_n < on->lim.max_points) {
+                e = on->sums_n++;
+            } else {
                 ok = 0;
                 continue;
             }
-            memset(&on->sums[on->sums_n], 0, sizeof on->sums[0]);
-            *slot = ++on->sums_n;
+            memset(&on->sums[e], 0, sizeof on->sums[0]);
+            *slot = e + 1;
         }
         polyc__cell_sums *c = &on->sums[*slot - 1];
         float ox = (b.ex - fx - 0.5f) * g->cell_m, oy = (b.ey - fy - 0.5f) * g->cell_m;
@@ -285,6 +321,11 @@ static int sum_endpoints(polyc_ctx *ctx, const polyc__scan *s, float sign)
         c->vx += sign * (b.sx - b.ex) * g->cell_m;
         c->vy += sign * (b.sy - b.ey) * g->cell_m;
         c->n = sign > 0.0f ? c->n + 1 : (c->n > 0 ? c->n - 1 : 0);
+        if (c->n == 0) { /* its last endpoint went (a correction): the entry is free */
+            c->n = on->sums_free;
+            on->sums_free = *slot;
+            *slot = 0;
+        }
     }
     return ok;
 }
@@ -326,7 +367,7 @@ static polyc_status accumulate(polyc_ctx *ctx, const polyc__scan *s, uint32_t nu
 {
     polyc__online *on = ctx->online;
     const polyc__grid *g = &ctx->grid;
-    polyc_status st = polyc__grid_add_scan(ctx, s, take_back);
+    polyc_status st = polyc__grid_add_scan(ctx, s, take_back, on->tile_miss);
     int sums_ok = sum_endpoints(ctx, s, take_back ? -1.0f : 1.0f);
     if (take_back)
         return st;
@@ -334,8 +375,10 @@ static polyc_status accumulate(polyc_ctx *ctx, const polyc__scan *s, uint32_t nu
     polyc__prior_learn_scan(ctx, &on->prior, s, number, on->learn_cache, on->lim.max_scan_beams, &on->acc);
     int64_t d = tile_of(g, (int32_t)floorf((float)((double)s->x_m - (g->origin_x_m - ctx->frame_x)) * g->inv_cell),
                         (int32_t)floorf((float)((double)s->y_m - (g->origin_y_m - ctx->frame_y)) * g->inv_cell));
-    if (d >= 0)
+    if (d >= 0 && !((on->pose_bits[d >> 5] >> (d & 31)) & 1u)) {
         on->pose_bits[d >> 5] |= 1u << (d & 31);
+        on->spacing_stale = 1;
+    }
     if (s->count > 1 && (on->min_step_rad == 0.0f || fabsf(s->step_rad) < on->min_step_rad))
         on->min_step_rad = fabsf(s->step_rad);
     on->last_x = s->x_m;

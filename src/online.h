@@ -30,9 +30,13 @@ typedef struct polyc__online {
     uint32_t *slot;
     polyc__cell_sums *sums;
     uint32_t sums_n;
+    uint32_t sums_free;            /* 1 + a free entry (a list through their n), 0: none */
     uint32_t *pose_bits;           /* bit per directory entry: a pose lay in the tile */
     float min_step_rad;            /* smallest |angle step| seen */
     float *spacing_dist;           /* the spacing table (spacing.c), per directory entry */
+    int spacing_stale;             /* a pose fell in a new tile since it was made */
+    uint32_t spacing_scans;        /* the scan count when it was made */
+    int spacing_now;               /* make it again now if stale (the finishing call) */
 
     /* the backlog: per directory entry 0, or 1 + the scan count when the
      * tile changed first since it was last re-optimised; and their list */
@@ -69,6 +73,7 @@ typedef struct polyc__online {
     uint32_t *alt_tile, *pt_tile, *alt_start, *bucket_fill;
     double *tile_raw;
     uint32_t *tile_new;            /* per stored tile: endpoints in or out since its refresh */
+    uint32_t *tile_miss;           /* and misses counted in its cells with hits */
 
     polyc__opt opt;                /* the optimiser (its arrays in the block) */
     int opt_ready;                 /* it holds the map (0 before the first update) */
@@ -77,14 +82,17 @@ typedef struct polyc__online {
     uint64_t version;
     polyc__pub *pub, *pub_next;    /* sorted by id */
     uint32_t pub_n;
-    polyc_change *gone;            /* removals, oldest first (a ring of gone_cap) */
+    polyc__pub *gone;              /* removals (version: the removal's), oldest
+                                    * first, a ring of gone_cap */
     uint32_t gone_first, gone_n, gone_cap;
     uint64_t forgot_through;       /* removals of versions up to this are forgotten */
 } polyc__online;
 
 /* online.c: the context's limits for the stages, from the online limits */
 void polyc__online_stage_limits(const polyc_online_limits *ol, polyc_limits *lim);
-/* online.c: every stored tile into the backlog (the finishing call) */
+/* online.c: the tiles whose cells with hits beams have crossed often into
+ * the backlog (every few scans); every stored tile (the finishing call) */
+void polyc__online_backlog_misses(polyc_ctx *ctx);
 void polyc__online_backlog_all(polyc_ctx *ctx);
 /* online_data.c: the points of the n taken tiles (the first n of the
  * backlog, marked) made again from the sums */

@@ -45,9 +45,7 @@ polyc_status polyc__online_refresh_tiles(polyc_ctx *ctx, uint32_t n_taken)
     polyc__online *on = ctx->online;
     polyc__opt *o = &on->opt;
     polyc__hash *h = &o->h;
-    polyc__prior_online_sums(&on->prior);
-    polyc__accuracy_weigh(&on->acc, ctx->cfg.alpha);
-    o->prior = on->prior;
+    o->prior = on->prior; /* its totals and weights are kept as scans come */
     polyc_status st = polyc__spacing_build(ctx, &o->spacing);
     if (st != POLYC_OK)
         return st;
@@ -59,6 +57,7 @@ polyc_status polyc__online_refresh_tiles(polyc_ctx *ctx, uint32_t n_taken)
         if (g->dir[on->dirty[j]]) {
             o->d.n -= on->tile_raw[g->dir[on->dirty[j]] - 1];
             on->tile_new[g->dir[on->dirty[j]] - 1] = 0;
+            on->tile_miss[g->dir[on->dirty[j]] - 1] = 0;
         }
     int32_t nf = polyc__points_of_tiles(o, on->dirty, n_taken, on->pts_tmp, on->view_tmp,
                                         on->fresh_tile, cap, on->tile_raw);

@@ -151,9 +151,7 @@ polyc_status polyc__opt_refresh(polyc__opt *o)
 {
     polyc_ctx *ctx = o->ctx;
     polyc__online *on = ctx->online;
-    polyc__prior_online_sums(&on->prior);
-    polyc__accuracy_weigh(&on->acc, ctx->cfg.alpha);
-    o->prior = on->prior;
+    o->prior = on->prior; /* its totals and weights are kept as scans come */
     polyc_status st = polyc__spacing_build(ctx, &o->spacing);
     if (st != POLYC_OK)
         return st;
