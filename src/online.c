@@ -127,6 +127,10 @@ static int lay_out(polyc_ctx *ctx, polyc__online *on, polyc__arena *a)
     ok = ok && polyc__opt_carve_online(ctx, a, &on->opt);
     if (!ok)
         return 0;
+    if (a->base)
+        ok &= polyc__flat_init(a, &on->first, (uint32_t)lines, (uint32_t)V);
+    else
+        polyc__flat_reserve(a, V);
     size_t P = (size_t)polyc__points_bound(&ctx->cfg, &ctx->lim), nb = (size_t)on->opt.h.bx * (size_t)on->opt.h.by;
     POLYC__CARVE(ok, a, on->alt_pts, P);
     POLYC__CARVE(ok, a, on->alt_view, 2 * P);
