@@ -379,9 +379,16 @@ polyc_status polyc_online_finish(polyc_ctx *ctx, polyc_progress_fn progress, voi
         st = polyc__search(o, fn, &g);
         double first = polyc__bic(o);
         polyc__flat_from_store(&on->first, o->s);
-        if (st == POLYC_OK && trace_afresh(ctx, &st) && st == POLYC_OK) {
-            st = polyc__search(o, fn, &g);
-            if (polyc__bic(o) > first && (st == POLYC_OK || st == POLYC_ERR_STOPPED)) {
+        polyc_status fresh = POLYC_OK;
+        if (st == POLYC_OK && trace_afresh(ctx, &fresh)) {
+            if (fresh == POLYC_OK)
+                fresh = polyc__search(o, fn, &g);
+            /* the first map stays when it is better, or when the second
+             * search could not run (a trace larger than the vertex limit:
+             * the message stays, the status is the first search's) */
+            if (fresh == POLYC_ERR_STOPPED)
+                st = fresh;
+            if ((fresh != POLYC_OK && fresh != POLYC_ERR_STOPPED) || polyc__bic(o) > first) {
                 if (polyc__store_from_flat(o->s, &on->first) != POLYC_OK)
                     st = polyc__fail(ctx, POLYC_ERR_NOMEM, "no room to restore the first map");
                 else if (polyc__rebuild(o) != POLYC_OK)
