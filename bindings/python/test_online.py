@@ -2,13 +2,16 @@
 
 A robot drives through a rectangular room (scans generated here, ray cast
 against the walls with seeded noise); each scan is added and followed by an
-update: the map fills up, its version grows, changes_since(0) lists every
-current polyline as added and changes_since(version) nothing, and finish()
-gives segments within a few cm of the walls. The errors (work 0, an update
-before any scan, correcting a scan not kept, a scan outside the area, an old
-version: ResyncError) raise PolycError with the library's status and
-message; a kept scan given a wrong pose and corrected gives the walls back;
-ranges in lists, array('f') and numpy arrays give the same map.
+update: the map fills up, its version grows, a copy of the map kept from
+changes_since alone equals the map after every update, changes_since(0)
+lists every current polyline as added and changes_since(version) nothing,
+and finish() gives segments within a few cm of the walls. The errors (work
+0, an update or finish before any scan, correcting a scan not kept, a scan
+outside the area) raise PolycError with the library's status and message;
+POLYC_ERR_RANGE from polyc_online_changes is a ResyncError (a substitute
+function returns it: these scenes never outrun the library's memory of
+removals). A kept scan given a wrong pose and corrected gives the walls
+back; ranges in lists, array('f') and numpy arrays give the same map.
 Environment as for test_polyc.py (POLYC_LIB).
 """
 import contextlib
