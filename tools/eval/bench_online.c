@@ -414,8 +414,23 @@ static double median(double *v, uint32_t n)
     return n % 2u ? v[n / 2u] : 0.5 * (v[n / 2u - 1u] + v[n / 2u]);
 }
 
+/* The 1-minute load average (Linux, /proc/loadavg), < 0 if unknown: the
+ * times are wall-clock, and other jobs on the machine lengthen them. */
+static double load_average(void)
+{
+    FILE *f = fopen("/proc/loadavg", "r");
+    double load = -1.0;
+    if (f) {
+        if (fscanf(f, "%lf", &load) != 1)
+            load = -1.0;
+        fclose(f);
+    }
+    return load;
+}
+
 static void print_replay_header(const options *o, int batch_from_table)
 {
+    double load = load_average();
     printf("\nonline (polyc_online_*): each log replayed scan by scan, polyc_online_add_scan "
            "then\npolyc_online_update(POLYC_ONLINE_WORK_DEFAULT = %u) after each; area = "
            "the square (centred on\nthe first pose) holding every pose and endpoint with "
@@ -429,6 +444,8 @@ static void print_replay_header(const options *o, int batch_from_table)
            (unsigned)POLYC_ONLINE_WORK_DEFAULT, AREA_MARGIN_M,
            batch_from_table ? "the main table's median" : "one run", CHECK_EVERY, CHECK_MAX,
            CHECK_EVERY);
+    if (load >= 0.0)
+        printf("(wall-clock times; the machine's load average at the start: %.2f)\n", load);
     (void)o;
     printf("%-24s %6s %6s %8s | %6s %6s %6s %7s | %8s %6s %7s %7s | %5s %7s %6s %6s %6s\n",
            "scene", "scans", "area", "blockMiB", "add", "a+u", "a+u", "a+u", "total", "xbatch",
@@ -564,7 +581,7 @@ static int memory_row(const options *o, const scene *s, const scene_result *one)
     polyc_config config;
     polyc_stats stats;
     bench_figures f;
-    char status[64], batch_mib[16] = "-";
+    char status[64], batch_mib[16] = "-", used_mib[16] = "-";
     int rc;
 
     memset(&on, 0, sizeof on);
@@ -608,9 +625,11 @@ static int memory_row(const options *o, const scene *s, const scene_result *one)
         polyc_get_stats(on.ctx, &stats);
     if (one->batch.ok)
         snprintf(batch_mib, sizeof batch_mib, "%.2f", bench_mib(one->batch.block_bytes));
-    printf("%-24s %6.0f %9.2f %9s | %6u %6u %-14s %8.2f %8.1f %9.1f\n", one->label,
+    if (stats.memory_used_bytes > 0u) /* (0: the context does not say) */
+        snprintf(used_mib, sizeof used_mib, "%.2f", bench_mib(stats.memory_used_bytes));
+    printf("%-24s %6.0f %9.2f %9s | %6u %6u %-14s %8s %8.1f %9.1f\n", one->label,
            on.limits.area_m, bench_mib(on.block_size), batch_mib, PASSES, r.scans, status,
-           bench_mib(stats.memory_used_bytes), r.total_ms, r.finish_ms);
+           used_mib, r.total_ms, r.finish_ms);
     if (on.failed_at)
         print_failure(one->label, &on);
     print_figures_header();
