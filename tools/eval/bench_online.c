@@ -693,7 +693,8 @@ static int correction_row(const options *o, const scene *s, const scene_result *
            "(%.2f, %.2f) m\nat the last), all kept (keep_scans = all), an update after each "
            "add; then\npolyc_online_correct for every scan with its true pose (correct: all "
            "of them), updates\nuntil the backlog is 0 (at most %u), polyc_online_finish; "
-           "drifted = the map before\nthe corrections (scored against the true endpoints)\n",
+           "drifted = the map before\nthe corrections as the updates left it, corrected = "
+           "after them and the finish (both\nscored against the true poses' endpoints)\n",
            s->name, DRIFT_RAD, DRIFT_X_M, DRIFT_Y_M, SETTLE_MAX);
     printf("%-24s %6s %9s | %8s | %9s %6s | %7s %8s | %8s %-10s\n", "scene", "kept", "blockMiB",
            "replay", "correct", "scans", "updates", "updates", "finish", "status");
@@ -764,6 +765,7 @@ int bench_online_section(const options *o, const scene *list, size_t count,
                          const bench_figures *batch)
 {
     scene_result *res = calloc(count ? count : 1u, sizeof *res);
+    double t0 = pipeline_now_ms();
     int failed = 0, from_table = batch && count && batch[0].ok;
     size_t i, intel = count;
     if (!res) {
@@ -797,6 +799,8 @@ int bench_online_section(const options *o, const scene *list, size_t count,
         if (correction_row(o, &list[intel], &res[intel]) != 0)
             failed = 1;
     }
+    printf("\nonline section: %.0f s in all (replays, checkpoints, batch builds and scores)\n",
+           (pipeline_now_ms() - t0) / 1e3);
     fflush(stdout);
     free(res);
     return failed ? -1 : 0;
