@@ -15,10 +15,11 @@
 
 #define CHECK_EVERY 100u  /* a checkpoint every 100 scans... */
 #define CHECK_MAX 10u     /* ...at most 10 a log, evenly spread over those */
-#define AREA_MARGIN_M 2.0 /* the area's half-side: the farthest pose or endpoint
-                             from the first pose, plus this */
-#define LIMIT_TRIES 3u    /* out of vertices or points: again with twice the
-                             limits, up to this many times in all */
+#define AREA_MARGIN_M PIPELINE_ONLINE_MARGIN_M /* the area's half-side: the
+                             farthest pose or endpoint from the first pose,
+                             plus this */
+#define LIMIT_TRIES 3u    /* out of grid cells, vertices or data cells: again
+                             with twice the limits, up to this many times in all */
 #define PASSES 10u        /* the memory row: intel this many times over */
 #define SETTLE_MAX 200u   /* the correction row: updates to re-converge, at most */
 /* The correction row's drift: 0 at the first scan, growing linearly to a
@@ -82,26 +83,17 @@ static int scene_data_load(const scene *s, scene_data *d, const char *label)
 }
 
 /* Side of the square centred on the first pose that holds every pose and
- * every reflected endpoint of scans, with AREA_MARGIN_M to spare. */
-static double area_for(const polyc_scan *scans, uint32_t n, double x0, double y0)
+ * endpoint of scans by the library's extent rule (polyc_scan_extent), with
+ * AREA_MARGIN_M to spare: pipeline_run_online's area (the sweep's). */
+static double area_for(const polyc_config *config, const polyc_scan *scans, uint32_t n,
+                       double x0, double y0)
 {
-    double far = 0.0;
-    uint32_t i, b;
-    for (i = 0; i < n; i++) {
-        const polyc_scan *sc = &scans[i];
-        far = fmax(far, fmax(fabs(sc->pose_x_m - x0), fabs(sc->pose_y_m - y0)));
-        for (b = 0; b < sc->beam_count; b++) {
-            double a, r;
-            if (!gtscore_beam_reflected(sc, b))
-                continue;
-            a = sc->pose_theta_rad + (double)sc->start_angle_rad +
-                (double)b * (double)sc->angle_step_rad;
-            r = (double)sc->range_m[b];
-            far = fmax(far, fmax(fabs(sc->pose_x_m + r * cos(a) - x0),
-                                 fabs(sc->pose_y_m + r * sin(a) - y0)));
-        }
-    }
-    return 2.0 * (far + AREA_MARGIN_M);
+    polyc_box box = {HUGE_VAL, HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+    uint32_t i;
+    for (i = 0; i < n; i++)
+        polyc_scan_extent(config, &scans[i], &box);
+    return 2.0 * (fmax(fmax(x0 - box.min_x_m, box.max_x_m - x0),
+                       fmax(y0 - box.min_y_m, box.max_y_m - y0)) + AREA_MARGIN_M);
 }
 
 /* ---- a map's figures ----------------------------------------------------- */
@@ -239,10 +231,10 @@ static polyc_status limits_for(const polyc_config *config, const scene_data *d,
 {
     const polyc_scan *scans = d->log.scans;
     uint32_t n = d->log.count;
-    double area = area_for(scans, n, scans[0].pose_x_m, scans[0].pose_y_m);
+    double area = area_for(config, scans, n, scans[0].pose_x_m, scans[0].pose_y_m);
     polyc_status st;
     if (other)
-        area = fmax(area, area_for(other, n, scans[0].pose_x_m, scans[0].pose_y_m));
+        area = fmax(area, area_for(config, other, n, scans[0].pose_x_m, scans[0].pose_y_m));
     st = polyc_online_limits_for_area(config, area, d->max_beams, out);
     if (st == POLYC_OK && keep) {
         out->keep_scans = n;
@@ -364,13 +356,22 @@ static int replay_run(const options *o, online *on, const polyc_scan *scans, uin
     return 0;
 }
 
-/* replay_run, again with twice the vertices and points while it runs out
- * of them (POLYC_ERR_NOMEM), LIMIT_TRIES times in all; r->tries says how
+/* 2 x, at most cap */
+static uint32_t twice(uint32_t a, double cap)
+{
+    return (uint32_t)fmin(2.0 * (double)a, cap);
+}
+
+/* replay_run, again with twice the grid cells (at most the square's),
+ * vertices and data cells while it runs out of them (POLYC_ERR_NOMEM), as
+ * pipeline_run_online does, LIMIT_TRIES times in all; r->tries says how
  * many runs it took. */
 static int replay_grow(const options *o, online *on, const polyc_scan *scans, uint32_t n,
                        int checks, const bench_figures *full, replay *r, const char *label)
 {
     double *add_ms = r->add_ms, *step_ms = r->step_ms;
+    polyc_config config;
+    double tiles;
     unsigned tries = 0;
     int rc;
     for (;;) {
@@ -379,12 +380,15 @@ static int replay_grow(const options *o, online *on, const polyc_scan *scans, ui
         r->step_ms = step_ms;
         r->tries = ++tries;
         rc = replay_run(o, on, scans, n, 1, 0, NULL, checks, full, 1, r, label);
-        if (rc == 0 || on->status != POLYC_ERR_NOMEM || tries >= LIMIT_TRIES ||
-            on->limits.max_vertices > UINT32_MAX / 2u || on->limits.max_points > UINT32_MAX / 2u)
+        if (rc == 0 || on->status != POLYC_ERR_NOMEM || tries >= LIMIT_TRIES)
             return rc;
         online_close(on);
-        on->limits.max_vertices *= 2u;
-        on->limits.max_points *= 2u;
+        bench_config(o, &config);
+        tiles = ceil(on->limits.area_m / (double)config.cell_m / 32.0);
+        on->limits.max_grid_cells =
+            twice(on->limits.max_grid_cells, fmin(tiles * tiles * 1024.0, 0x40000000));
+        on->limits.max_vertices = twice(on->limits.max_vertices, 0x10000000);
+        on->limits.max_points = twice(on->limits.max_points, 0x10000000);
     }
 }
 
@@ -435,7 +439,7 @@ static void print_replay_header(const options *o, int batch_from_table)
            "then\npolyc_online_update(POLYC_ONLINE_WORK_DEFAULT = %u) after each; area = "
            "the square (centred on\nthe first pose) holding every pose and endpoint with "
            "%.0f m to spare, limits from\npolyc_online_limits_for_area (x2, x4: doubled "
-           "vertices and points after running out).\nadd = one add, a+u = one add and its "
+           "cells, vertices and points after running out).\nadd = one add, a+u = one add and its "
            "update; total = all adds, updates and polyc_online_finish;\nxbatch = total / "
            "the batch build's library time (add to optimise, %s);\ncheckpoints every %u "
            "scans, at most %u a log (evenly spread over the multiples of %u):\nthe online "
