@@ -355,18 +355,37 @@ static void label_contour(polyc_ctx *ctx, const polyc__scan *s)
         polyc__walk w;
         polyc__walk_start(&w, &b);
         int32_t cx = w.ex, cy = w.ey;
-        while (w.n > 0) {
-            polyc__tile *t = polyc__grid_tile(g, w.ix, w.iy);
-            if (t && polyc__cell_occupied(t, polyc__cell_index(w.ix, w.iy), thr)) {
+        /* tile by tile: over tiles no beam wanted (no hit, so no occupied
+         * cell) in one move, as the grid's count does */
+        const polyc__tile *t = NULL;
+        int in = w.n > 0 && polyc__walk_enter(&w, g->width, g->height);
+        while (in && w.n > 0) {
+            if (!(t = polyc__grid_tile(g, w.ix, w.iy))) {
+                int to = polyc__walk_skip_tiles(&w, g->width, g->height, g->tiles_x, g->wanted);
+                if (to <= 0)
+                    break; /* the end cell next, or out of the grid */
+                in = polyc__walk_enter(&w, g->width, g->height);
+                continue;
+            }
+            int left = 0, found = 0;
+            do {
+                if (polyc__cell_occupied(t, w.idx, thr)) {
+                    found = 1;
+                    break;
+                }
+                left = polyc__walk_step(&w);
+            } while (!left && w.n > 0);
+            if (found) {
                 cx = w.ix;
                 cy = w.iy;
                 break;
             }
-            polyc__walk_step(&w);
+            if (left && w.n > 0)
+                in = polyc__walk_enter(&w, g->width, g->height);
         }
-        polyc__tile *t = polyc__grid_tile(g, cx, cy);
-        if (t && polyc__cell_occupied(t, polyc__cell_index(cx, cy), thr))
-            t->contour[cy & (POLYC__TILE_SIDE - 1)] |= 1u << (cx & (POLYC__TILE_SIDE - 1));
+        polyc__tile *e = polyc__grid_tile(g, cx, cy);
+        if (e && polyc__cell_occupied(e, polyc__cell_index(cx, cy), thr))
+            e->contour[cy & (POLYC__TILE_SIDE - 1)] |= 1u << (cx & (POLYC__TILE_SIDE - 1));
     }
 }
 
