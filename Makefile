@@ -13,12 +13,12 @@ LDLIBS  = -lm
 LIB_SRC  = $(wildcard src/*.c)
 LIB_OBJ  = $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
 # tools/: the shipped tool (POLYC_SRC: main, command line, input, run,
-# messages) and its modules (log reader, map files, SVG/JSON/TXT output,
+# the online replay, messages) and its modules (log reader, map files, SVG/JSON/TXT output,
 # the library's block), which the tests, the bench and the binding use too.
 # tools/eval/: the evaluation harness (bench, sweep, simulator, ground-truth
 # and topology scores), which the tests and the benchmark use and the tool
 # does not.
-POLYC_SRC = tools/polyc.c tools/cli.c tools/options.c tools/load.c tools/run.c
+POLYC_SRC = tools/polyc.c tools/cli.c tools/options.c tools/load.c tools/run.c tools/online.c
 POLYC_OBJ = $(POLYC_SRC:tools/%.c=$(BUILD)/tobj/%.o)
 TOOL_MOD = $(filter-out $(POLYC_SRC),$(wildcard tools/*.c))
 TOOL_OBJ = $(TOOL_MOD:tools/%.c=$(BUILD)/tobj/%.o)
@@ -189,9 +189,10 @@ $(BUILD)/footprint8: examples/footprint.c $(EMB_OBJ)
 	$(CC) $(WARN) $(OPT) $(CFLAGS) -Iinclude $^ -o $@ $(LDLIBS)
 
 # Robustness (docs/security.md). test-cli: every bad input of the tool
-# (tests/cli_bad_input.sh) and where it writes (tests/cli_output.sh: as root,
-# also as an ordinary user). test-fuzz-replay: the committed fuzz corpus through
-# the fuzz targets, built with $(CC). test-asan: unit tests, corpus replay and
+# (tests/cli_bad_input.sh), where it writes (tests/cli_output.sh: as root,
+# also as an ordinary user) and --online (tests/cli_online.sh).
+# test-fuzz-replay: the committed fuzz corpus through the fuzz targets, built
+# with $(CC). test-asan: unit tests, corpus replay and
 # the quick bad-input tests again in build-asan/ under ASan and UBSan.
 # test-valgrind: the tool over a sample log, its grid as a ROS map and a bad
 # log, no error or leak.
@@ -206,6 +207,7 @@ CLI_TEST_ARGS ?=
 test-cli: $(BUILD)/polyc
 	tests/cli_bad_input.sh $(CLI_TEST_ARGS) $(BUILD)/polyc
 	tests/cli_output.sh $(BUILD)/polyc
+	tests/cli_online.sh $(BUILD)/polyc
 SAN_LIST  = address,undefined,float-cast-overflow
 SAN_FLAGS = -fsanitize=$(SAN_LIST) -fno-sanitize-recover=all
 test-asan:

@@ -9,7 +9,8 @@
  * Formats and rules: docs/formats.md.
  *
  * This file: main. The rest of the tool: options.c (the command line),
- * load.c (the input), run.c (the library's run and the outputs), cli.c
+ * load.c (the input), run.c (the library's run and the outputs), online.c
+ * (--online: the log replayed as a stream), cli.c
  * (messages, the progress line, writing the outputs); cli.h joins them. */
 #include <stdlib.h>
 #include <string.h>
@@ -77,6 +78,7 @@ int main(int argc, char **argv)
         if (!rc)
             rc = o.command == CMD_CONVERT ? convert(&o, &r)
                  : o.command == CMD_GRID  ? grid_files(&o, &r, t_start)
+                 : o.online               ? online_map(&o, &r, t_start, &t)
                                           : make_map(&o, &r, t_start, &t);
     }
     progress_clear();
