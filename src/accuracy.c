@@ -89,6 +89,20 @@ int polyc__accuracy_scratch(polyc__acc_learn *L, polyc__arena *a, const polyc_li
     return L->samples && L->cells;
 }
 
+/* Online, the samples are paired as they come: each cell keeps its last
+ * PAIR_TRIES samples (a ring), a new one is compared with them and takes
+ * the oldest's place; the cell's sums stay. */
+int polyc__accuracy_online(polyc__acc_learn *L, polyc__arena *a)
+{
+    if (!L->p)
+        return 1;
+    size_t cells = (size_t)L->p->w * (size_t)L->p->h;
+    L->cells = polyc__alloc_zero(a, cells, sizeof(acc_cell));
+    L->samples = polyc__alloc(a, cells * PAIR_TRIES, sizeof(acc_sample));
+    L->ring_n = polyc__alloc_zero(a, cells, sizeof(uint32_t));
+    return L->cells && L->samples && L->ring_n;
+}
+
 /* The prior cell holding (x, y) (frame metres); 0 outside the prior. */
 static int cell_at(const polyc__prior *p, float x, float y, uint32_t *cell)
 {
@@ -99,16 +113,32 @@ static int cell_at(const polyc__prior *p, float x, float y, uint32_t *cell)
     return 1;
 }
 
+/* Adds the offset across the wall between a and b to the cell's pairs
+ * when they describe the same stretch of wall from different scans. */
+static void pair(acc_cell *c, const acc_sample *a, const acc_sample *b)
+{
+    if (b->scan == a->scan || a->nx * b->nx + a->ny * b->ny < PAIR_COS)
+        return;
+    float dx = b->x - a->x, dy = b->y - a->y;
+    float along = dx * a->ny - dy * a->nx, across = dx * a->nx + dy * a->ny;
+    if (fabsf(along) > PAIR_ALONG_M || fabsf(across) > PAIR_ACROSS_M)
+        return;
+    c->delta2 += across * across;
+    c->pairs++;
+}
+
 void polyc__accuracy_sample(polyc__acc_learn *L, float x, float y, float nx, float ny,
                             uint32_t scan, float res2, float density)
 {
     const polyc__prior *p = L->p;
-    if (!p || !L->samples || L->n >= L->cap)
+    if (!p || !L->samples || (!L->ring_n && L->n >= L->cap))
         return;
     uint32_t cell;
     if (!cell_at(p, x, y, &cell))
         return;
-    acc_sample *s = &((acc_sample *)L->samples)[L->n++];
+    acc_sample tmp, *s = &tmp;
+    if (!L->ring_n)
+        s = &((acc_sample *)L->samples)[L->n++];
     s->x = x;
     s->y = y;
     s->nx = nx;
@@ -119,6 +149,14 @@ void polyc__accuracy_sample(polyc__acc_learn *L, float x, float y, float nx, flo
     c->res2 += res2;
     c->density += density;
     c->samples++;
+    if (L->ring_n) {
+        acc_sample *ring = (acc_sample *)L->samples + (size_t)cell * PAIR_TRIES;
+        uint32_t n = L->ring_n[cell];
+        for (uint32_t k = 0; k < n && k < PAIR_TRIES; k++)
+            pair(c, s, &ring[k]);
+        ring[n % PAIR_TRIES] = *s;
+        L->ring_n[cell] = n + 1;
+    }
 }
 
 /* Offsets across the wall between samples of one cell, each sample against
@@ -134,15 +172,7 @@ static void pair_up(acc_cell *cells, const acc_sample *smp, const uint32_t *orde
         for (uint32_t i = 0; i < n; i++) {
             const acc_sample *a = &smp[order[lo + i]];
             for (uint32_t k = 1; k <= PAIR_TRIES && k * step < n; k++) {
-                const acc_sample *b = &smp[order[lo + (i + k * step) % n]];
-                if (b->scan == a->scan || a->nx * b->nx + a->ny * b->ny < PAIR_COS)
-                    continue;
-                float dx = b->x - a->x, dy = b->y - a->y;
-                float along = dx * a->ny - dy * a->nx, across = dx * a->nx + dy * a->ny;
-                if (fabsf(along) > PAIR_ALONG_M || fabsf(across) > PAIR_ACROSS_M)
-                    continue;
-                cells[c].delta2 += across * across;
-                cells[c].pairs++;
+                pair(&cells[c], a, &smp[order[lo + (i + k * step) % n]]);
             }
         }
     }
@@ -184,16 +214,28 @@ void polyc__accuracy_finish(polyc__acc_learn *L, polyc__arena *a, float alpha)
         start[c] = start[c - 1];
     start[0] = 0;
     pair_up(cell, smp, order, start, cells);
+    polyc__accuracy_weigh(L, alpha);
+}
+
+void polyc__accuracy_weigh(polyc__acc_learn *L, float alpha)
+{
+    polyc__prior *p = L->p;
+    if (!p || !L->cells)
+        return;
+    size_t cells = (size_t)p->w * (size_t)p->h;
+    const acc_cell *cell = L->cells;
     float s0_2 = alpha > 0.0f ? 0.5f / alpha : 0.0f;
     for (size_t c = 0; c < cells; c++) {
-        if (cell[c].pairs < MIN_PAIRS || cell[c].samples == 0)
-            continue;
-        float b2 = 0.5f * cell[c].delta2 / (float)cell[c].pairs;
-        float r2 = cell[c].res2 / (float)cell[c].samples;
-        float m = CORRELATION_M * cell[c].density / (float)cell[c].samples;
-        float excess = b2 - s0_2;
-        if (excess > 0.0f && m > 1.0f)
-            p->weight[c] = (r2 + s0_2) / (r2 + s0_2 + m * excess);
+        float w = 1.0f;
+        if (cell[c].pairs >= MIN_PAIRS && cell[c].samples > 0) {
+            float b2 = 0.5f * cell[c].delta2 / (float)cell[c].pairs;
+            float r2 = cell[c].res2 / (float)cell[c].samples;
+            float m = CORRELATION_M * cell[c].density / (float)cell[c].samples;
+            float excess = b2 - s0_2;
+            if (excess > 0.0f && m > 1.0f)
+                w = (r2 + s0_2) / (r2 + s0_2 + m * excess);
+        }
+        p->weight[c] = w;
     }
 }
 

@@ -197,15 +197,11 @@ static void smooth_table(polyc__prior *p, polyc__arena *a, size_t room)
     p->smooth = t;
 }
 
-polyc_status polyc__prior_build(polyc_ctx *ctx, polyc__prior *p, size_t spare)
+/* The prior's cells on the grid: K x K tiles, K = 1 unless the tile grid
+ * has more than `cap` tiles. */
+static void lay_out(const polyc_ctx *ctx, polyc__prior *p, uint64_t cap)
 {
     const polyc__grid *g = &ctx->grid;
-    memset(p, 0, sizeof *p);
-    if (g->width <= 0 || g->height <= 0 || g->tiles_x <= 0 || g->tiles_y <= 0)
-        return POLYC_OK; /* no data: an empty prior, uniform everywhere */
-
-    /* prior cells of K x K tiles, K = 1 unless the tile grid is too large */
-    uint64_t cap = (uint64_t)cell_cap(&ctx->lim);
     uint64_t tx = (uint64_t)g->tiles_x, ty = (uint64_t)g->tiles_y, k = 1;
     while (((tx + k - 1) / k) * ((ty + k - 1) / k) > cap)
         k++;
@@ -215,6 +211,26 @@ polyc_status polyc__prior_build(polyc_ctx *ctx, polyc__prior *p, size_t spare)
     p->inv_cell = 1.0f / p->cell_m;
     p->origin_x = g->origin_x_m - ctx->frame_x;
     p->origin_y = g->origin_y_m - ctx->frame_y;
+}
+
+/* per row, the sum of its counts */
+static void sum_rows(polyc__prior *p)
+{
+    for (uint32_t r = 0; r < p->rows; r++) {
+        uint32_t n = 0;
+        for (int b = 0; b < BINS; b++)
+            n += p->hist[(size_t)r * BINS + (size_t)b];
+        p->total[r] = n;
+    }
+}
+
+polyc_status polyc__prior_build(polyc_ctx *ctx, polyc__prior *p, size_t spare)
+{
+    const polyc__grid *g = &ctx->grid;
+    memset(p, 0, sizeof *p);
+    if (g->width <= 0 || g->height <= 0 || g->tiles_x <= 0 || g->tiles_y <= 0)
+        return POLYC_OK; /* no data: an empty prior, uniform everywhere */
+    lay_out(ctx, p, (uint64_t)cell_cap(&ctx->lim));
     size_t cells = (size_t)p->w * (size_t)p->h;
     p->row_of = row_index(&ctx->arena, cells);
     polyc__acc_learn acc;
@@ -243,18 +259,35 @@ polyc_status polyc__prior_build(polyc_ctx *ctx, polyc__prior *p, size_t spare)
         memset(p, 0, sizeof *p);
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the angle prior");
     }
-    for (uint32_t r = 0; r < p->rows; r++) {
-        uint32_t n = 0;
-        for (int b = 0; b < BINS; b++)
-            n += p->hist[(size_t)r * BINS + (size_t)b];
-        p->total[r] = n;
-    }
+    sum_rows(p);
     /* the table only where the block has room beyond the budget: the
      * library's footprint stays what polyc_memory_size says */
     size_t free_bytes = ctx->arena.size - ctx->arena.used;
     if (free_bytes > spare)
         smooth_table(p, &ctx->arena, free_bytes - spare);
     return POLYC_OK;
+}
+
+/* Online, the prior is laid out once over the grid (the area) with a row
+ * for every cell, learned scan by scan (polyc__prior_learn_scan), its rows
+ * summed before each search (polyc__prior_online_sums) and queried without
+ * the smoothed table. */
+int polyc__prior_online(const polyc_ctx *ctx, polyc__prior *p, polyc__acc_learn *acc,
+                        polyc__arena *a)
+{
+    memset(p, 0, sizeof *p);
+    lay_out(ctx, p, (uint64_t)cell_cap(&ctx->lim));
+    size_t cells = (size_t)p->w * (size_t)p->h;
+    p->row_of = row_index(a, cells);
+    p->hist = row_counts(a, cells);
+    p->total = row_totals(a, cells);
+    return p->row_of && p->hist && p->total && polyc__accuracy_begin(acc, p, a, &ctx->lim) &&
+           polyc__accuracy_online(acc, a);
+}
+
+void polyc__prior_online_sums(polyc__prior *p)
+{
+    sum_rows(p);
 }
 
 /* ---- query (the optimiser's hot loop: no trigonometry, 9 cells x 3 bins) ---- */

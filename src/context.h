@@ -72,6 +72,7 @@ struct polyc_ctx {
 
 
     polyc_stats stats;
+    struct polyc__online *online;  /* online.h; NULL for a batch context */
 };
 
 #define POLYC__MAGIC 0x706f6c79u   /* "poly" */
@@ -95,6 +96,8 @@ static inline polyc__input polyc__input_kind(const polyc_ctx *ctx)
 {
     if (ctx->from_grid)
         return POLYC__INPUT_GRID;
+    if (ctx->online)
+        return POLYC__INPUT_SCANS;
     return ctx->scan_count == 1 && !(ctx->cfg.flags & POLYC_FLAG_GRID_TRACE) ? POLYC__INPUT_ONE_SCAN
                                                                               : POLYC__INPUT_SCANS;
 }

@@ -17,6 +17,15 @@ static void count_inc(polyc__count *a, polyc__count *b)
     (*a)++;
 }
 
+/* A scan taken back (an online pose correction): exact unless the cell
+ * saturated since, then never below 0. */
+static void count_dec(polyc__count *a, polyc__count *b)
+{
+    (void)b;
+    if (*a > 0)
+        (*a)--;
+}
+
 /* bytes of the bit per directory entry that says a tile is wanted */
 static size_t wanted_bytes(size_t dir_n)
 {
@@ -207,6 +216,7 @@ typedef struct count_pass {
     polyc__arena *a;
     const uint32_t *wanted;
     polyc__tile *spill;
+    void (*count)(polyc__count *a, polyc__count *b); /* count_inc, or count_dec */
 } count_pass;
 
 /* The tile of cell (ix, iy) inside the grid: stored (allocated on first use
@@ -264,7 +274,7 @@ static void count_beam(const count_pass *p, const polyc__beam *b)
         int left;
         do {
             if (polyc__walk_t(&w) < miss_end)
-                count_inc(&t->misses[w.idx], &t->hits[w.idx]);
+                p->count(&t->misses[w.idx], &t->hits[w.idx]);
             left = polyc__walk_step(&w);
         } while (!left && w.n > 0);
         if (left && w.n > 0 &&
@@ -277,29 +287,23 @@ static void count_beam(const count_pass *p, const polyc__beam *b)
         return;
     int idx = polyc__cell_index(w.ex, w.ey);
     if (b->hit)
-        count_inc(&t->hits[idx], &t->misses[idx]);
+        p->count(&t->hits[idx], &t->misses[idx]);
     else if (polyc__walk_t(&w) < miss_end)
-        count_inc(&t->misses[idx], &t->hits[idx]);
+        p->count(&t->misses[idx], &t->hits[idx]);
 }
 
-polyc_status polyc__grid_build(polyc_ctx *ctx)
+/* The grid's cells over w_m x h_m metres from the frame-relative corner
+ * (x0, y0), its directory, wanted bits and spill tile; the tiles follow in
+ * the block as beams reach them. */
+static polyc_status grid_lay_out(polyc_ctx *ctx, double x0, double y0, double w_m, double h_m)
 {
     polyc__grid *g = &ctx->grid;
-    memset(g, 0, sizeof *g);
-    if (!ctx->ext.have)
-        return POLYC_OK; /* no data: an empty grid */
     float cell = ctx->cfg.cell_m;
-    double cell_d = (double)cell, ext = (double)ctx->cfg.max_extent_m;
-    double pad = 2.0 * cell_d;
-    double w_m = ctx->ext.max_x - ctx->ext.min_x + 2.0 * pad;
-    double h_m = ctx->ext.max_y - ctx->ext.min_y + 2.0 * pad;
-    if (w_m > ext || h_m > ext)
-        return polyc__fail(ctx, POLYC_ERR_EXTENT,
-                           "the data span more than config.max_extent_m (a far-away scan?)");
+    double cell_d = (double)cell;
     g->cell_m = cell;
     g->inv_cell = 1.0f / cell;
-    g->origin_x_m = ctx->frame_x + ctx->ext.min_x - pad;
-    g->origin_y_m = ctx->frame_y + ctx->ext.min_y - pad;
+    g->origin_x_m = ctx->frame_x + x0;
+    g->origin_y_m = ctx->frame_y + y0;
     double wc = ceil(w_m / cell_d), hc = ceil(h_m / cell_d);
     if (wc > 2147483000.0 || hc > 2147483000.0)
         return polyc__fail(ctx, POLYC_ERR_EXTENT, "grid too large for 32-bit cell indices");
@@ -315,45 +319,99 @@ polyc_status polyc__grid_build(polyc_ctx *ctx)
                               polyc__bytes(1, sizeof(polyc__tile))); /* + the spill tile */
     if (dir_bytes == 0 || fixed >= budget)
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "grid extent too large for limits.max_grid_cells");
+    g->dir = polyc__alloc_zero(&ctx->arena, dir_n, sizeof(uint32_t));
+    g->wanted = polyc__alloc_zero(&ctx->arena, dir_n / 32 + 1, sizeof(uint32_t));
+    g->spill = polyc__alloc_zero(&ctx->arena, 1, sizeof(polyc__tile));
+    if (!g->dir || !g->wanted || !g->spill)
+        return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the grid directory");
+    g->tile_cap = (uint32_t)((budget - fixed) / sizeof(polyc__tile));
+    g->tiles = (polyc__tile *)(ctx->arena.base + ctx->arena.used);
+    g->fixed_bytes = fixed;
+    return POLYC_OK;
+}
+
+/* Sets the wanted bit of the tiles where the scan's beams end in a hit. */
+static void want_hits(polyc_ctx *ctx, const polyc__scan *s)
+{
+    polyc__grid *g = &ctx->grid;
+    for (uint32_t i = 0; i < s->count; i++) {
+        polyc__beam b;
+        if (!polyc__beam_path(ctx, s, i, &b) || !b.hit)
+            continue;
+        int32_t ix = (int32_t)floorf(b.ex), iy = (int32_t)floorf(b.ey);
+        if (ix >= 0 && iy >= 0 && ix < g->width && iy < g->height) {
+            size_t d = dir_index(g, ix, iy);
+            g->wanted[d >> 5] |= 1u << (d & 31);
+        }
+    }
+}
+
+/* Counts (or takes back) every beam of the scan. */
+static polyc_status count_scan(polyc_ctx *ctx, const polyc__scan *s, int take_back)
+{
+    polyc__grid *g = &ctx->grid;
     count_pass p;
     p.g = g;
     p.a = &ctx->arena;
-    g->dir = polyc__alloc_zero(&ctx->arena, dir_n, sizeof(uint32_t));
-    uint32_t *wanted = polyc__alloc_zero(&ctx->arena, dir_n / 32 + 1, sizeof(uint32_t));
-    p.spill = polyc__alloc_zero(&ctx->arena, 1, sizeof(polyc__tile));
-    if (!g->dir || !wanted || !p.spill)
-        return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the grid directory");
-    p.wanted = wanted;
-    g->tile_cap = (uint32_t)((budget - fixed) / sizeof(polyc__tile));
-    g->tiles = (polyc__tile *)(ctx->arena.base + ctx->arena.used);
-
-    for (uint32_t si = 0; si < ctx->scan_count; si++)
-        for (uint32_t i = 0; i < ctx->scans[si].count; i++) {
-            polyc__beam b;
-            if (!polyc__beam_path(ctx, &ctx->scans[si], i, &b) || !b.hit)
-                continue;
-            int32_t ix = (int32_t)floorf(b.ex), iy = (int32_t)floorf(b.ey);
-            if (ix >= 0 && iy >= 0 && ix < g->width && iy < g->height) {
-                size_t d = dir_index(g, ix, iy);
-                wanted[d >> 5] |= 1u << (d & 31);
-            }
-        }
-    for (uint32_t si = 0; si < ctx->scan_count; si++) {
-        const polyc__scan *s = &ctx->scans[si];
-        step_rot rot = {cosf(s->step_rad), sinf(s->step_rad)};
-        for (uint32_t i = 0; i < s->count; i++) {
-            polyc__beam b;
-            if (!beam_fill(ctx, s, i, &b, 1, &rot))
-                continue;
-            count_beam(&p, &b);
-            if (g->out_of_tiles)
-                return polyc__fail(ctx, POLYC_ERR_NOMEM,
-                                   "grid needs more cells than limits.max_grid_cells");
-        }
+    p.wanted = g->wanted;
+    p.spill = g->spill;
+    p.count = take_back ? count_dec : count_inc;
+    step_rot rot = {cosf(s->step_rad), sinf(s->step_rad)};
+    for (uint32_t i = 0; i < s->count; i++) {
+        polyc__beam b;
+        if (!beam_fill(ctx, s, i, &b, 1, &rot))
+            continue;
+        count_beam(&p, &b);
+        if (g->out_of_tiles)
+            return polyc__fail(ctx, POLYC_ERR_NOMEM, "grid needs more cells than limits.max_grid_cells");
     }
+    return POLYC_OK;
+}
+
+static void grid_stats(polyc_ctx *ctx)
+{
+    const polyc__grid *g = &ctx->grid;
     ctx->stats.grid_width = (uint32_t)g->width;
     ctx->stats.grid_height = (uint32_t)g->height;
     ctx->stats.grid_tiles = g->tile_count;
-    ctx->stats.grid_bytes = (uint64_t)fixed + (uint64_t)g->tile_count * sizeof(polyc__tile);
+    ctx->stats.grid_bytes = (uint64_t)g->fixed_bytes + (uint64_t)g->tile_count * sizeof(polyc__tile);
+}
+
+polyc_status polyc__grid_build(polyc_ctx *ctx)
+{
+    polyc__grid *g = &ctx->grid;
+    memset(g, 0, sizeof *g);
+    if (!ctx->ext.have)
+        return POLYC_OK; /* no data: an empty grid */
+    double ext = (double)ctx->cfg.max_extent_m, pad = 2.0 * (double)ctx->cfg.cell_m;
+    double w_m = ctx->ext.max_x - ctx->ext.min_x + 2.0 * pad;
+    double h_m = ctx->ext.max_y - ctx->ext.min_y + 2.0 * pad;
+    if (w_m > ext || h_m > ext)
+        return polyc__fail(ctx, POLYC_ERR_EXTENT,
+                           "the data span more than config.max_extent_m (a far-away scan?)");
+    polyc_status st = grid_lay_out(ctx, ctx->ext.min_x - pad, ctx->ext.min_y - pad, w_m, h_m);
+    if (st != POLYC_OK)
+        return st;
+    for (uint32_t si = 0; si < ctx->scan_count; si++)
+        want_hits(ctx, &ctx->scans[si]);
+    for (uint32_t si = 0; si < ctx->scan_count; si++)
+        if ((st = count_scan(ctx, &ctx->scans[si], 0)) != POLYC_OK)
+            return st;
+    grid_stats(ctx);
     return POLYC_OK;
+}
+
+polyc_status polyc__grid_online_init(polyc_ctx *ctx, double side_m)
+{
+    memset(&ctx->grid, 0, sizeof ctx->grid);
+    return grid_lay_out(ctx, -0.5 * side_m, -0.5 * side_m, side_m, side_m);
+}
+
+polyc_status polyc__grid_add_scan(polyc_ctx *ctx, const polyc__scan *s, int take_back)
+{
+    if (!take_back)
+        want_hits(ctx, s);
+    polyc_status st = count_scan(ctx, s, take_back);
+    grid_stats(ctx);
+    return st;
 }

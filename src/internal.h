@@ -74,6 +74,9 @@ typedef struct polyc__grid {
     polyc__tile *tiles;            /* contiguous, tile_count used of tile_cap */
     uint32_t tile_count, tile_cap;
     int out_of_tiles;              /* set when a beam needed a tile past tile_cap */
+    uint32_t *wanted;              /* bit per directory entry: a tile to store */
+    polyc__tile *spill;            /* where misses in tiles not stored go */
+    size_t fixed_bytes;            /* directory, bits and spill tile */
 } polyc__grid;
 
 /* ---- scans as stored ---- */
@@ -97,6 +100,7 @@ typedef struct polyc__line {
     int32_t tail;                  /* last vertex (head->prev when closed) */
     int32_t count;
     int32_t closed;                /* POLYC__NONE when the slot is free */
+    uint32_t id;                   /* stable while the polyline lives (polyc_polyline_id) */
 } polyc__line;
 
 typedef struct polyc__store {
@@ -106,6 +110,7 @@ typedef struct polyc__store {
     int32_t v_free, l_free;        /* free lists (through .next / .head) */
     int32_t v_live, l_live;
     int32_t v_high, l_high;        /* slots in use are among [0, high) */
+    uint32_t last_id;              /* the id the newest polyline got (never reused) */
 } polyc__store;
 
 /* ---- flattened map, the form results are read in ---- */
@@ -113,6 +118,7 @@ typedef struct polyc__flat {
     float *xy;                     /* 2 floats per point */
     uint32_t *start;               /* point offset of each polyline, count + 1 entries */
     uint8_t *closed;
+    uint32_t *id;                  /* per polyline: its store id */
     uint32_t count, points;
     uint32_t cap_lines, cap_points;
 } polyc__flat;
@@ -172,8 +178,9 @@ typedef struct polyc__prior {
 /* ---- the data's accuracy (accuracy.c), learned in the prior's pass ---- */
 typedef struct polyc__acc_learn {
     polyc__prior *p;               /* NULL: nothing to learn (one scan) */
-    void *samples, *cells;         /* scratch */
+    void *samples, *cells;         /* scratch (online: kept) */
     uint32_t n, cap;
+    uint32_t *ring_n;              /* online: per cell, the samples it has seen */
 } polyc__acc_learn;
 /* the weights (all 1), after the prior's cells are laid out; 0: no room */
 int polyc__accuracy_begin(polyc__acc_learn *L, polyc__prior *p, polyc__arena *a,
@@ -187,6 +194,11 @@ void polyc__accuracy_sample(polyc__acc_learn *L, float x, float y, float nx, flo
                             uint32_t scan, float res2, float density);
 /* pairs the samples up and sets the weights (alpha: the error term's) */
 void polyc__accuracy_finish(polyc__acc_learn *L, polyc__arena *a, float alpha);
+/* online: the per-cell sums and rings, kept (after polyc__accuracy_begin);
+ * samples are then paired as they come; 0: no room */
+int polyc__accuracy_online(polyc__acc_learn *L, polyc__arena *a);
+/* the weights from the pairs so far */
+void polyc__accuracy_weigh(polyc__acc_learn *L, float alpha);
 /* what polyc__accuracy_finish allocates at most (L->cap samples), on a
  * counting arena */
 void polyc__accuracy_reserve_finish(polyc__acc_learn *L, polyc__arena *a);
@@ -200,11 +212,19 @@ size_t polyc__prior_bytes(const polyc_limits *lim);
  * with `spare` bytes or more of the block free beyond what the later stages
  * are budgeted, also the table of smoothed counts (p->smooth). */
 polyc_status polyc__prior_build(polyc_ctx *ctx, polyc__prior *p, size_t spare);
+/* online: the prior and the accuracy over the whole grid, carved from a;
+ * 0: no room. Its rows' totals before a search: polyc__prior_online_sums. */
+int polyc__prior_online(const polyc_ctx *ctx, polyc__prior *p, polyc__acc_learn *acc,
+                        polyc__arena *a);
+void polyc__prior_online_sums(polyc__prior *p);
 /* prior_learn.c: the counts from every scan, into p (laid out, rows handed
  * out as cells get evidence); cache: cache_cap beams' endpoints (NULL: none);
  * acc: the accuracy's samples (NULL: none) */
 void polyc__prior_learn(const polyc_ctx *ctx, polyc__prior *p, float *cache, uint32_t cache_cap,
                         polyc__acc_learn *acc);
+/* the same for one scan (its number `scan`: lines of one scan are not paired) */
+void polyc__prior_learn_scan(const polyc_ctx *ctx, polyc__prior *p, const polyc__scan *s,
+                             uint32_t scan, float *cache, uint32_t cache_cap, polyc__acc_learn *acc);
 /* p(turn | x, y) in [0, 1]; x, y frame-relative metres; turn in [0, pi]. */
 float polyc__prior_p(const polyc__prior *p, float x, float y, float turn_rad);
 /* The same for many turns at one place: its cell's smoothed counts. */
@@ -249,6 +269,10 @@ size_t polyc__grid_budget_bytes(const polyc_limits *lim);
 /* the budget, on a counting arena */
 void polyc__grid_reserve(polyc__arena *a, const polyc_limits *lim);
 polyc_status polyc__grid_build(polyc_ctx *ctx);
+/* online: a grid over a square of side_m centred on the frame origin, with
+ * no tile yet; one scan counted into it, or taken back (a pose correction) */
+polyc_status polyc__grid_online_init(polyc_ctx *ctx, double side_m);
+polyc_status polyc__grid_add_scan(polyc_ctx *ctx, const polyc__scan *s, int take_back);
 polyc__tile *polyc__grid_tile(const polyc__grid *g, int32_t ix, int32_t iy);
 /* NULL for cells outside the grid or in tiles not stored (no beam ends in a
  * hit there: free space or never reached) */
@@ -353,6 +377,9 @@ polyc_status polyc__store_from_flat(polyc__store *s, const polyc__flat *f);
 
 /* trace.c */
 polyc_status polyc__trace_build(polyc_ctx *ctx);
+/* the walks alone: the cells of ctx->contour_xy that are marked in their
+ * tiles (t->mark) traced into polylines added to the store (online) */
+polyc_status polyc__trace_more(polyc_ctx *ctx);
 void polyc__trace_reserve(polyc__arena *a, const polyc_limits *lim);
 /* scan_chains.c: a single scan's initial polylines from its beam order */
 void polyc__chains_reserve(polyc__arena *a, const polyc_limits *lim);

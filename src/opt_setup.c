@@ -4,7 +4,7 @@
  * prior, the spacing, the spatial hash, the points and the model's terms.
  * Takes: the context after the trace. Gives: a polyc__opt ready to search
  * (optimize.c) or to score. */
-#include "optimize.h"
+#include "online.h"
 
 #include <math.h>
 #include <string.h>
@@ -97,9 +97,8 @@ static const polyc_config *grid_config(polyc_ctx *ctx)
     return c;
 }
 
-/* Everything the optimiser needs, carved from the arena after the trace
- * (also the entry point of the optimiser's unit tests). */
-polyc_status polyc__opt_setup(polyc_ctx *ctx, polyc__opt *o)
+/* The fields set before anything is carved or computed. */
+static void opt_begin(polyc_ctx *ctx, polyc__opt *o)
 {
     memset(o, 0, sizeof *o);
     o->ctx = ctx;
@@ -110,6 +109,58 @@ polyc_status polyc__opt_setup(polyc_ctx *ctx, polyc__opt *o)
     o->R = o->cfg->search_radius_m;
     o->R2 = o->R * o->R;
     o->rng.state = ctx->cfg.seed;
+}
+
+/* Online: the optimiser lives across updates, its arrays carved once for
+ * the limits (on the block, or on the size query's counting arena): the
+ * spatial hash over the whole grid, the points, its own arrays, the best
+ * map. The prior and the spacing are the context's (online.h). */
+int polyc__opt_carve_online(polyc_ctx *ctx, polyc__arena *a, polyc__opt *o)
+{
+    polyc__online *on = ctx->online;
+    opt_begin(ctx, o);
+    int32_t V = polyc__max_vertices(&ctx->lim), P = polyc__points_bound(o->cfg, &ctx->lim);
+    polyc__rays_init(&o->rays, ctx);
+    int ok = polyc__hash_lay_out(o, a) && polyc__points_carve_online(a, o, &on->pts_tmp, &on->view_tmp) &&
+             opt_carve(a, o, P > 0 ? P : 1, V, 1, loc_soa_cap(&ctx->lim));
+    if (!a->base) { /* a counting arena: nothing is written */
+        polyc__flat_reserve(a, V);
+        return ok;
+    }
+    if (!ok || !polyc__flat_init(a, &o->best, (uint32_t)polyc__line_cap(V), (uint32_t)V))
+        return 0;
+    polyc__hash_clear(o);
+    memset(o->v_work, 0, (size_t)V * sizeof(uint32_t));
+    memset(o->v_touch, 0, (size_t)V * sizeof(uint32_t));
+    memset(o->seg_in, 0, (size_t)V);
+    memset(o->split_due, 0, (size_t)V);
+    return 1;
+}
+
+/* Before an update's search: the prior's totals and weights, the spacing,
+ * the points from the cells' sums, the hash and every point's segment. */
+polyc_status polyc__opt_refresh(polyc__opt *o)
+{
+    polyc_ctx *ctx = o->ctx;
+    polyc__online *on = ctx->online;
+    polyc__prior_online_sums(&on->prior);
+    polyc__accuracy_weigh(&on->acc, ctx->cfg.alpha);
+    o->prior = on->prior;
+    polyc_status st = polyc__spacing_build(ctx, &o->spacing);
+    if (st != POLYC_OK)
+        return st;
+    polyc__hash_clear(o);
+    if ((st = polyc__points_collect(o)) != POLYC_OK)
+        return st;
+    o->d.log_n = log(o->d.n > 1.0 ? o->d.n : 1.0);
+    return polyc__rebuild(o);
+}
+
+/* Everything the optimiser needs, carved from the arena after the trace
+ * (also the entry point of the optimiser's unit tests). */
+polyc_status polyc__opt_setup(polyc_ctx *ctx, polyc__opt *o)
+{
+    opt_begin(ctx, o);
     int32_t V = o->s->v_cap;
     polyc__rays_init(&o->rays, ctx);
     /* what the optimiser will still take from the block after the prior */

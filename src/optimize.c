@@ -4,6 +4,7 @@
  * zigzags, noise, vertex count) until `patience` iterations bring no better
  * BIC, or the iteration cap or the caller's progress callback stops it. */
 #include "cost.h"
+#include "online.h"
 
 #include <math.h>
 #include <string.h>
@@ -122,36 +123,45 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
     polyc_status st = polyc__opt_setup(ctx, &o);
     if (st != POLYC_OK)
         return st;
-    const polyc_config *cfg = o.cfg;
-    polyc__flat_from_store(&o.best, o.s);
-    double best = polyc__bic(&o);
+    return polyc__search(&o, progress, user);
+}
+
+/* The search from the map in the store (the batch's trace, or an online
+ * context's map), on an optimiser set up and scored. */
+polyc_status polyc__search(polyc__opt *o, polyc_progress_fn progress, void *user)
+{
+    polyc_ctx *ctx = o->ctx;
+    polyc_status st;
+    const polyc_config *cfg = o->cfg;
+    polyc__flat_from_store(&o->best, o->s);
+    double best = polyc__bic(o);
     double sigma = (double)cfg->noise_m;
     uint32_t quiet = 0, it;
     polyc_status result = POLYC_OK;
     uint32_t prev_start = 0, prev_mark = 0;
     double prev_bic = best;
     for (it = 0; it < cfg->max_iterations; it++) {
-        uint32_t start = ++o.touch_stamp;
+        uint32_t start = ++o->touch_stamp;
         /* F: noise to leave local minima, shrinking every iteration. Below
          * half a hill-climbing step it is not applied any more: the steps
          * could not correct it. Without noise, only what changed since the
          * previous iteration is adjusted and offered for removal again. */
         double noise = it > 0 && sigma >= 0.5 * (double)cfg->step_m ? sigma : 0.0;
-        if (!o.pol.noise)
+        if (!o->pol.noise)
             noise = 0.0;
         if (noise > 0.0) {
-            polyc__op_noise(&o, noise);
-            o.untangle_mark = o.zip_mark = 0; /* every segment moved */
-            if ((st = polyc__rebuild(&o)) != POLYC_OK)
-                return restore_best(&o, st);
+            polyc__op_noise(o, noise);
+            o->untangle_mark = o->zip_mark = 0; /* every segment moved */
+            if ((st = polyc__rebuild(o)) != POLYC_OK)
+                return restore_best(o, st);
         }
         uint32_t since = it == 0 || noise > 0.0 ? 0 : prev_start;
         prev_start = start;
-        prev_mark = operators(&o, since, o.pol.climb_since_prev && it > 0 ? prev_mark : since);
-        if (o.h.out_of_entries)
-            return restore_best(&o, polyc__fail(ctx, POLYC_ERR_NOMEM, "spatial hash full"));
-        POLYC__CHECKS_ITERATION(&o);
-        double bic = polyc__bic(&o);
+        prev_mark = operators(o, since, o->pol.climb_since_prev && it > 0 ? prev_mark : since);
+        if (o->h.out_of_entries)
+            return restore_best(o, polyc__fail(ctx, POLYC_ERR_NOMEM, "spatial hash full"));
+        POLYC__CHECKS_ITERATION(o);
+        double bic = polyc__bic(o);
         /* any better map is kept; a gain under one BIC unit (no evidence
          * either way) does not restart the patience: late iterations can
          * cycle between maps that differ by a vertex and a fraction of it.
@@ -159,21 +169,21 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
          * on purpose, and a run of them all worse than iteration 0 stopped
          * infinite-corridor at iteration 5 with 5,766 vertices (3,793 when
          * the noise is allowed to decay) */
-        int gained = bic < best - (o.pol.gain_share > 0.0 ? fmax(1.0, o.pol.gain_share * fabs(best)) : 1.0);
+        int gained = bic < best - (o->pol.gain_share > 0.0 ? fmax(1.0, o->pol.gain_share * fabs(best)) : 1.0);
         /* Nor do iterations that are still coming down from the noise by
          * more than POLYC__RECOVER_GAIN of the BIC each (tunables.h) */
-        int recovering = o.pol.recover && it > 0 && bic < prev_bic - POLYC__RECOVER_GAIN * fabs(prev_bic);
+        int recovering = o->pol.recover && it > 0 && bic < prev_bic - POLYC__RECOVER_GAIN * fabs(prev_bic);
         prev_bic = bic;
-        quiet = gained ? 0 : ((noise > 0.0 && o.pol.noise_spares_patience) || recovering ? quiet : quiet + 1);
+        quiet = gained ? 0 : ((noise > 0.0 && o->pol.noise_spares_patience) || recovering ? quiet : quiet + 1);
         if (bic < best - 1e-9 * fabs(best)) {
             best = bic;
-            polyc__flat_from_store(&o.best, o.s);
+            polyc__flat_from_store(&o->best, o->s);
         }
         polyc_iteration rep;
         memset(&rep, 0, sizeof rep);
         rep.iteration = it;
-        rep.vertices = (uint32_t)o.s->v_live;
-        rep.polylines = (uint32_t)live_lines(o.s);
+        rep.vertices = (uint32_t)o->s->v_live;
+        rep.polylines = (uint32_t)live_lines(o->s);
         rep.bic = bic;
         rep.best_bic = best;
         rep.noise_m = noise;
@@ -190,26 +200,26 @@ polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *u
          * and of what the previous one edited: one that edited nothing is
          * followed by copies of itself, so the patience would run out on
          * the same best map. */
-        int noisy_later = o.pol.noise && sigma >= 0.5 * (double)cfg->step_m;
-        if (!noisy_later && !edited_since(&o, start))
+        int noisy_later = o->pol.noise && sigma >= 0.5 * (double)cfg->step_m;
+        if (!noisy_later && !edited_since(o, start))
             break;
         /* A single scan has no noise either: an iteration that gained less
          * than one BIC unit leaves so little edited that the next ones gain
          * nothing measurable (the 130 bench scans: 4 vertices more in
          * all, the same f and ray RMSE, 4 % fewer instructions) */
-        if (o.pol.stop_without_gain && !gained)
+        if (o->pol.stop_without_gain && !gained)
             break;
     }
     ctx->stats.iterations = it < cfg->max_iterations ? it + (result == POLYC_OK) : it;
     /* the best model found is the result */
-    if (polyc__store_from_flat(o.s, &o.best) != POLYC_OK)
+    if (polyc__store_from_flat(o->s, &o->best) != POLYC_OK)
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room to restore the best map");
     ctx->opt_result_valid = 1;
-    if ((st = polyc__rebuild(&o)) != POLYC_OK)
+    if ((st = polyc__rebuild(o)) != POLYC_OK)
         return st;
-    if (o.pol.restructure && result == POLYC_OK && (st = polish(&o, best)) != POLYC_OK)
+    if (o->pol.restructure && result == POLYC_OK && (st = polish(o, best)) != POLYC_OK)
         return st;
-    fill_stats(&o);
+    fill_stats(o);
     return result;
 }
 

@@ -216,6 +216,8 @@ int32_t polyc__points_bound(const polyc_config *cfg, const polyc_limits *lim);
 /* whether the points carry the direction they were seen from (pt_view) */
 int polyc__points_viewed(const polyc_ctx *ctx);
 polyc_status polyc__points_collect(polyc__opt *o);
+/* online: the points (in o->d) and their unsorted copy, carved once */
+int polyc__points_carve_online(polyc__arena *a, polyc__opt *o, polyc__point **tmp, float **tmp_view);
 /* the points' allocations under the limits, on a counting arena */
 void polyc__points_reserve(polyc__arena *a, const polyc_config *cfg, const polyc_limits *lim);
 
@@ -223,6 +225,8 @@ void polyc__points_reserve(polyc__arena *a, const polyc_config *cfg, const polyc
 int32_t polyc__hash_bucket_cap(const polyc_limits *lim);
 int32_t polyc__hash_entry_cap(const polyc_limits *lim);
 polyc_status polyc__hash_init(polyc__opt *o);
+/* the buckets over the grid, carved from a (no clearing); 0: no room */
+int polyc__hash_lay_out(polyc__opt *o, polyc__arena *a);
 /* the hash's allocations under the limits, on a counting arena */
 void polyc__hash_reserve(polyc__arena *a, polyc__opt *o, const polyc_limits *lim);
 int polyc__hash_insert(polyc__opt *o, int32_t seg);

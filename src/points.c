@@ -4,7 +4,7 @@
  * per block of 2 x 2 grid cells (count, mean, second moments: squared distances to a line
  * stay exact) or, with POLYC_FLAG_EXACT_POINTS, one point per endpoint;
  * sorted by spatial-hash bucket. */
-#include "optimize.h"
+#include "online.h"
 
 #include <math.h>
 #include <string.h>
@@ -69,17 +69,15 @@ static float block_centre(double origin, int32_t i, float cell)
     return (float)(origin + ((double)i + 0.5 * BLOCK_SIDE) * (double)cell);
 }
 
-/* One weighted point per marked cell: mark cells, number them, accumulate. */
-static polyc_status collect_cells(polyc__opt *o, polyc__point *tmp, float *view, int32_t cap,
-                                  int32_t *n_out)
+/* Marks the blocks that hold data, from the counters (the grid counts a
+ * hit only in the end cell of a reflection, the cell endpoint_of finds, so
+ * a cell with hits that passes the data rule holds an endpoint that
+ * endpoint_of accepts, and only such cells do: the same marks as a pass
+ * over the beams, without computing every endpoint once more), and numbers
+ * them in tile order; returns their count. */
+static uint32_t mark_blocks(polyc_ctx *ctx)
 {
-    polyc_ctx *ctx = o->ctx;
     polyc__grid *g = &ctx->grid;
-    /* The blocks that hold data, from the counters: the grid counts a hit
-     * only in the end cell of a reflection, the cell endpoint_of finds, so a
-     * cell with hits that passes the data rule holds an endpoint that
-     * endpoint_of accepts (and only such cells do). Same marks as a pass
-     * over the beams, without computing every endpoint once more. */
     const int32_t side = POLYC__TILE_SIDE, block = ~(int32_t)(BLOCK_SIDE - 1);
     for (uint32_t k = 0; k < g->tile_count; k++) {
         polyc__tile *t = &g->tiles[k];
@@ -96,7 +94,6 @@ static polyc_status collect_cells(polyc__opt *o, polyc__point *tmp, float *view,
                     t->mark[r & block] |= 1u << (c & block);
         }
     }
-    endpoint e;
     uint32_t n = 0;
     for (uint32_t k = 0; k < g->tile_count; k++) {
         polyc__tile *t = &g->tiles[k];
@@ -112,42 +109,27 @@ static polyc_status collect_cells(polyc__opt *o, polyc__point *tmp, float *view,
         }
         n += in_tile;
     }
-    if (n > (uint32_t)cap)
-        return polyc__fail(ctx, POLYC_ERR_NOMEM, "more weighted data points than limits.max_points");
-    memset(tmp, 0, (size_t)n * sizeof *tmp);
-    if (view)
-        memset(view, 0, (size_t)n * 2 * sizeof *view);
-    for (uint32_t si = 0; si < ctx->scan_count; si++)
-        for (uint32_t i = 0; i < ctx->scans[si].count; i++) {
-            if (!endpoint_of(ctx, &ctx->scans[si], i, &e))
-                continue;
-            int32_t bx, by;
-            float fx, fy;
-            to_block(&e, g->cell_m, &bx, &by, &fx, &fy);
-            const polyc__tile *t = polyc__grid_tile(g, e.ix, e.iy); /* the block's tile too */
-            uint32_t row = t->mark[by & 31], col = (uint32_t)(bx & 31);
-            uint32_t below = row & ((1u << col) - 1u);
-            uint32_t c = 0;
-            while (below) {
-                below &= below - 1;
-                c++;
-            }
-            uint32_t at = t->mark_base + t->mark_row[by & 31] + c;
-            polyc__point *p = &tmp[at];
-            if (view) {
-                view[2 * at] += e.vx;
-                view[2 * at + 1] += e.vy;
-            }
-            /* sums of offsets from the block centre: small numbers, float is exact enough */
-            p->w += 1.0f;
-            p->x += fx;
-            p->y += fy;
-            p->cxx += fx * fx;
-            p->cxy += fx * fy;
-            p->cyy += fy * fy;
-        }
-    /* means and central moments; the cell of each point is found again by
-     * walking the directory in the numbering order of the marks */
+    return n;
+}
+
+/* The number of the marked block (bx, by) of tile t. */
+static uint32_t block_number(const polyc__tile *t, int32_t bx, int32_t by)
+{
+    uint32_t row = t->mark[by & 31], col = (uint32_t)(bx & 31);
+    uint32_t below = row & ((1u << col) - 1u);
+    uint32_t c = 0;
+    while (below) {
+        below &= below - 1;
+        c++;
+    }
+    return t->mark_base + t->mark_row[by & 31] + c;
+}
+
+/* Means and central moments from the sums; the cell of each point is found
+ * again by walking the directory in the numbering order of the marks. */
+static void finish_moments(polyc_ctx *ctx, polyc__point *tmp)
+{
+    polyc__grid *g = &ctx->grid;
     double ox = g->origin_x_m - ctx->frame_x, oy = g->origin_y_m - ctx->frame_y;
     int32_t dir_n = g->tiles_x * g->tiles_y;
     for (int32_t d = 0; d < dir_n; d++) {
@@ -171,6 +153,90 @@ static polyc_status collect_cells(polyc__opt *o, polyc__point *tmp, float *view,
                 p->y = block_centre(oy, ty + r, g->cell_m) + my;
             }
     }
+}
+
+/* One weighted point per marked block, from the endpoints. */
+static polyc_status collect_cells(polyc__opt *o, polyc__point *tmp, float *view, int32_t cap,
+                                  int32_t *n_out)
+{
+    polyc_ctx *ctx = o->ctx;
+    polyc__grid *g = &ctx->grid;
+    uint32_t n = mark_blocks(ctx);
+    if (n > (uint32_t)cap)
+        return polyc__fail(ctx, POLYC_ERR_NOMEM, "more weighted data points than limits.max_points");
+    memset(tmp, 0, (size_t)n * sizeof *tmp);
+    if (view)
+        memset(view, 0, (size_t)n * 2 * sizeof *view);
+    endpoint e;
+    for (uint32_t si = 0; si < ctx->scan_count; si++)
+        for (uint32_t i = 0; i < ctx->scans[si].count; i++) {
+            if (!endpoint_of(ctx, &ctx->scans[si], i, &e))
+                continue;
+            int32_t bx, by;
+            float fx, fy;
+            to_block(&e, g->cell_m, &bx, &by, &fx, &fy);
+            uint32_t at = block_number(polyc__grid_tile(g, e.ix, e.iy), bx, by); /* the block's tile too */
+            polyc__point *p = &tmp[at];
+            if (view) {
+                view[2 * at] += e.vx;
+                view[2 * at + 1] += e.vy;
+            }
+            /* sums of offsets from the block centre: small numbers, float is exact enough */
+            p->w += 1.0f;
+            p->x += fx;
+            p->y += fy;
+            p->cxx += fx * fx;
+            p->cxy += fx * fy;
+            p->cyy += fy * fy;
+        }
+    finish_moments(ctx, tmp);
+    *n_out = (int32_t)n;
+    return POLYC_OK;
+}
+
+/* The same from the cells' sums (online: the scans are not kept). A
+ * cell's offsets move to its block's centre by (dx, dy): the sums of
+ * products gain the cross terms. */
+static polyc_status collect_sums(polyc__opt *o, polyc__point *tmp, float *view, int32_t cap,
+                                 int32_t *n_out)
+{
+    polyc_ctx *ctx = o->ctx;
+    const polyc__online *on = ctx->online;
+    polyc__grid *g = &ctx->grid;
+    uint32_t n = mark_blocks(ctx);
+    if (n > (uint32_t)cap)
+        return polyc__fail(ctx, POLYC_ERR_NOMEM, "more weighted data points than limits.max_points");
+    memset(tmp, 0, (size_t)n * sizeof *tmp);
+    memset(view, 0, (size_t)n * 2 * sizeof *view);
+    const float half = 0.5f * (float)(BLOCK_SIDE - 1);
+    int32_t dir_n = g->tiles_x * g->tiles_y;
+    for (int32_t d = 0; d < dir_n; d++) {
+        if (!g->dir[d])
+            continue;
+        uint32_t k = g->dir[d] - 1;
+        const polyc__tile *t = &g->tiles[k];
+        const uint32_t *slot = on->slot + (size_t)k * POLYC__TILE_CELLS;
+        for (int idx = 0; idx < POLYC__TILE_CELLS; idx++) {
+            if (!slot[idx] || !t->hits[idx] || !cell_holds_data(ctx, t, idx))
+                continue;
+            const polyc__cell_sums *c = &on->sums[slot[idx] - 1];
+            int32_t ix = idx & (POLYC__TILE_SIDE - 1), iy = idx >> POLYC__TILE_SHIFT;
+            int32_t bx = ix & ~(int32_t)(BLOCK_SIDE - 1), by = iy & ~(int32_t)(BLOCK_SIDE - 1);
+            float dx = ((float)(ix - bx) - half) * g->cell_m, dy = ((float)(iy - by) - half) * g->cell_m;
+            float w = (float)c->n;
+            uint32_t at = block_number(t, bx, by);
+            polyc__point *p = &tmp[at];
+            view[2 * at] += c->vx;
+            view[2 * at + 1] += c->vy;
+            p->w += w;
+            p->x += c->fx + w * dx;
+            p->y += c->fy + w * dy;
+            p->cxx += c->fxx + 2.0f * dx * c->fx + w * dx * dx;
+            p->cxy += c->fxy + dx * c->fy + dy * c->fx + w * dx * dy;
+            p->cyy += c->fyy + 2.0f * dy * c->fy + w * dy * dy;
+        }
+    }
+    finish_moments(ctx, tmp);
     *n_out = (int32_t)n;
     return POLYC_OK;
 }
@@ -283,6 +349,13 @@ static int points_carve(polyc__arena *a, int32_t cap, int viewed, polyc__point *
     return *pts && (!viewed || *view);
 }
 
+/* online: the points and their unsorted copy, carved once */
+int polyc__points_carve_online(polyc__arena *a, polyc__opt *o, polyc__point **tmp, float **tmp_view)
+{
+    int32_t cap = polyc__points_bound(o->cfg, &o->ctx->lim);
+    return points_carve(a, cap, 1, &o->d.pts, &o->d.pt_view) && points_carve(a, cap, 1, tmp, tmp_view);
+}
+
 void polyc__points_reserve(polyc__arena *a, const polyc_config *cfg, const polyc_limits *lim)
 {
     polyc__point *pts;
@@ -301,17 +374,24 @@ polyc_status polyc__points_collect(polyc__opt *o)
     /* final array first, the unsorted one after it (released at the end);
      * where the endpoints were seen from: scans (more than one) only */
     int viewed = polyc__points_viewed(ctx);
-    int ok = points_carve(&ctx->arena, cap, viewed, &o->d.pts, &o->d.pt_view);
     size_t mark = ctx->arena.used;
     polyc__point *tmp;
     float *tmp_view;
-    if (!ok || !points_carve(&ctx->arena, cap, viewed, &tmp, &tmp_view))
-        return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the data points");
+    if (ctx->online) { /* carved once, with the optimiser (polyc__opt_carve_online) */
+        tmp = ctx->online->pts_tmp;
+        tmp_view = ctx->online->view_tmp;
+    } else {
+        int ok = points_carve(&ctx->arena, cap, viewed, &o->d.pts, &o->d.pt_view);
+        mark = ctx->arena.used;
+        if (!ok || !points_carve(&ctx->arena, cap, viewed, &tmp, &tmp_view))
+            return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the data points");
+    }
     int32_t n = 0;
     /* one scan: a point per return, whose beam the ends are set by (a
      * weighted point of several near returns would set them by their mean) */
-    int exact = (o->cfg->flags & POLYC_FLAG_EXACT_POINTS) || o->rays.on;
+    int exact = !ctx->online && ((o->cfg->flags & POLYC_FLAG_EXACT_POINTS) || o->rays.on);
     polyc_status st = ctx->from_grid ? collect_occupied(o, tmp, cap, &n)
+                      : ctx->online  ? collect_sums(o, tmp, tmp_view, cap, &n)
                       : exact        ? collect_raw(o, tmp, tmp_view, cap, &n)
                                      : collect_cells(o, tmp, tmp_view, cap, &n);
     if (st != POLYC_OK)

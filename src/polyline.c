@@ -94,6 +94,7 @@ int32_t polyc__line_new(polyc__store *s)
     s->l[l].head = s->l[l].tail = POLYC__NONE;
     s->l[l].count = 0;
     s->l[l].closed = 0;
+    s->l[l].id = ++s->last_id;
     s->l_live++;
     return l;
 }
@@ -212,7 +213,8 @@ static int flat_carve(polyc__arena *a, polyc__flat *f, uint32_t cap_lines, uint3
     f->xy = polyc__alloc(a, (size_t)cap_points * 2, sizeof(float));
     f->start = polyc__alloc(a, (size_t)cap_lines + 1, sizeof(uint32_t));
     f->closed = polyc__alloc(a, cap_lines, 1);
-    return f->xy && f->start && f->closed;
+    f->id = polyc__alloc(a, cap_lines, sizeof(uint32_t));
+    return f->xy && f->start && f->closed && f->id;
 }
 
 void polyc__flat_reserve(polyc__arena *a, int32_t v_cap)
@@ -247,18 +249,23 @@ void polyc__flat_from_store(polyc__flat *f, const polyc__store *s)
             v = s->v[v].next;
         }
         f->closed[f->count] = (uint8_t)(ln->closed == 1);
+        f->id[f->count] = ln->id;
         f->count++;
         f->start[f->count] = f->points;
     }
 }
 
+/* The polylines keep their ids; the next new one gets an id none had. */
 polyc_status polyc__store_from_flat(polyc__store *s, const polyc__flat *f)
 {
+    uint32_t last = s->last_id;
     polyc__store_clear(s);
     for (uint32_t i = 0; i < f->count; i++) {
         int32_t l = polyc__line_new(s);
         if (l == POLYC__NONE)
             return POLYC_ERR_NOMEM;
+        s->l[l].id = f->id[i];
+        s->last_id = last;
         for (uint32_t k = f->start[i]; k < f->start[i + 1]; k++)
             if (polyc__vertex_append(s, l, f->xy[2 * k], f->xy[2 * k + 1]) == POLYC__NONE)
                 return POLYC_ERR_NOMEM;

@@ -337,6 +337,13 @@ static void learn_scan(prior_pass *q)
 void polyc__prior_learn(const polyc_ctx *ctx, polyc__prior *p, float *cache, uint32_t cache_cap,
                         polyc__acc_learn *acc)
 {
+    for (uint32_t si = 0; si < ctx->scan_count; si++)
+        polyc__prior_learn_scan(ctx, p, &ctx->scans[si], si, cache, cache_cap, acc);
+}
+
+void polyc__prior_learn_scan(const polyc_ctx *ctx, polyc__prior *p, const polyc__scan *s,
+                             uint32_t scan, float *cache, uint32_t cache_cap, polyc__acc_learn *acc)
+{
     prior_pass q;
     memset(&q, 0, sizeof q);
     q.p = p;
@@ -346,9 +353,7 @@ void polyc__prior_learn(const polyc_ctx *ctx, polyc__prior *p, float *cache, uin
     q.cache_cap = cache_cap;
     q.cache = cache;
     q.acc = acc;
-    for (uint32_t si = 0; si < ctx->scan_count; si++) {
-        q.s = &ctx->scans[si];
-        q.scan = si;
-        learn_scan(&q);
-    }
+    q.s = s;
+    q.scan = scan;
+    learn_scan(&q);
 }

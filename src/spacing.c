@@ -7,7 +7,7 @@
  * distance is measured to each pose when asked. The table's two passes
  * over every tile of the extent would take 5-6 % of a freiburg-campus
  * scan's time (13,000 tiles for its 80 m returns), for a handful of queries. */
-#include "context.h"
+#include "online.h"
 
 #include <math.h>
 
@@ -24,44 +24,9 @@ void polyc__spacing_reserve(polyc__arena *a, const polyc_limits *lim)
     dist_table(a, polyc__grid_dir_cap(lim));
 }
 
-polyc_status polyc__spacing_build(polyc_ctx *ctx, polyc__spacing *sp)
+/* two chamfer passes, weights 1 and sqrt 2 tiles, from the tiles at 0 */
+static void chamfer(polyc__spacing *sp)
 {
-    const polyc__grid *g = &ctx->grid;
-    sp->w = g->tiles_x;
-    sp->h = g->tiles_y;
-    sp->tile_m = g->cell_m * (float)POLYC__TILE_SIDE;
-    sp->origin_x = (float)(g->origin_x_m - ctx->frame_x);
-    sp->origin_y = (float)(g->origin_y_m - ctx->frame_y);
-    sp->min_step_rad = 0.0f;
-    sp->dist = NULL;
-    sp->poses = NULL;
-    sp->pose_count = 0;
-    size_t n = (size_t)sp->w * (size_t)sp->h;
-    if (n == 0)
-        return POLYC_OK;
-    float step = 1e30f;
-    for (uint32_t k = 0; k < ctx->scan_count; k++)
-        if (ctx->scans[k].count > 1 && fabsf(ctx->scans[k].step_rad) < step)
-            step = fabsf(ctx->scans[k].step_rad);
-    sp->min_step_rad = step < 1e29f ? step : 0.0f;
-    if (ctx->scan_count <= DIRECT_POSES) {
-        sp->poses = ctx->scans;
-        sp->pose_count = ctx->scan_count;
-        return POLYC_OK;
-    }
-    sp->dist = dist_table(&ctx->arena, n);
-    if (!sp->dist)
-        return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the spacing field");
-    for (size_t i = 0; i < n; i++)
-        sp->dist[i] = 1e30f;
-    for (uint32_t k = 0; k < ctx->scan_count; k++) {
-        const polyc__scan *s = &ctx->scans[k];
-        int32_t tx = (int32_t)floorf((s->x_m - sp->origin_x) / sp->tile_m);
-        int32_t ty = (int32_t)floorf((s->y_m - sp->origin_y) / sp->tile_m);
-        if (tx >= 0 && ty >= 0 && tx < sp->w && ty < sp->h)
-            sp->dist[(size_t)ty * (size_t)sp->w + (size_t)tx] = 0.0f;
-    }
-    /* two chamfer passes, weights 1 and sqrt 2 tiles */
     const float a = sp->tile_m, b = sp->tile_m * 1.41421356f;
     for (int32_t y = 0; y < sp->h; y++)
         for (int32_t x = 0; x < sp->w; x++) {
@@ -85,6 +50,60 @@ polyc_status polyc__spacing_build(polyc_ctx *ctx, polyc__spacing *sp)
                 if (x > 0) *d = polyc__minf(*d, dn[-1] + b);
             }
         }
+}
+
+/* Online, from the tiles where some pose was (the poses are not kept). */
+static polyc_status online_table(polyc_ctx *ctx, polyc__spacing *sp, size_t n)
+{
+    const polyc__online *on = ctx->online;
+    sp->min_step_rad = on->min_step_rad;
+    sp->dist = on->spacing_dist;
+    for (size_t i = 0; i < n; i++)
+        sp->dist[i] = (on->pose_bits[i >> 5] >> (i & 31)) & 1u ? 0.0f : 1e30f;
+    chamfer(sp);
+    return POLYC_OK;
+}
+
+polyc_status polyc__spacing_build(polyc_ctx *ctx, polyc__spacing *sp)
+{
+    const polyc__grid *g = &ctx->grid;
+    sp->w = g->tiles_x;
+    sp->h = g->tiles_y;
+    sp->tile_m = g->cell_m * (float)POLYC__TILE_SIDE;
+    sp->origin_x = (float)(g->origin_x_m - ctx->frame_x);
+    sp->origin_y = (float)(g->origin_y_m - ctx->frame_y);
+    sp->min_step_rad = 0.0f;
+    sp->dist = NULL;
+    sp->poses = NULL;
+    sp->pose_count = 0;
+    size_t n = (size_t)sp->w * (size_t)sp->h;
+    if (n == 0)
+        return POLYC_OK;
+    if (ctx->online)
+        return online_table(ctx, sp, n);
+    float step = 1e30f;
+    for (uint32_t k = 0; k < ctx->scan_count; k++)
+        if (ctx->scans[k].count > 1 && fabsf(ctx->scans[k].step_rad) < step)
+            step = fabsf(ctx->scans[k].step_rad);
+    sp->min_step_rad = step < 1e29f ? step : 0.0f;
+    if (ctx->scan_count <= DIRECT_POSES) {
+        sp->poses = ctx->scans;
+        sp->pose_count = ctx->scan_count;
+        return POLYC_OK;
+    }
+    sp->dist = dist_table(&ctx->arena, n);
+    if (!sp->dist)
+        return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the spacing field");
+    for (size_t i = 0; i < n; i++)
+        sp->dist[i] = 1e30f;
+    for (uint32_t k = 0; k < ctx->scan_count; k++) {
+        const polyc__scan *s = &ctx->scans[k];
+        int32_t tx = (int32_t)floorf((s->x_m - sp->origin_x) / sp->tile_m);
+        int32_t ty = (int32_t)floorf((s->y_m - sp->origin_y) / sp->tile_m);
+        if (tx >= 0 && ty >= 0 && tx < sp->w && ty < sp->h)
+            sp->dist[(size_t)ty * (size_t)sp->w + (size_t)tx] = 0.0f;
+    }
+    chamfer(sp);
     return POLYC_OK;
 }
 

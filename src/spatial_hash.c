@@ -60,6 +60,14 @@ void polyc__hash_reserve(polyc__arena *a, polyc__opt *o, const polyc_limits *lim
 
 polyc_status polyc__hash_init(polyc__opt *o)
 {
+    if (!polyc__hash_lay_out(o, &o->ctx->arena))
+        return polyc__fail(o->ctx, POLYC_ERR_NOMEM, "no room for the spatial hash");
+    polyc__hash_clear(o);
+    return POLYC_OK;
+}
+
+int polyc__hash_lay_out(polyc__opt *o, polyc__arena *a)
+{
     polyc_ctx *ctx = o->ctx;
     polyc__hash *h = &o->h;
     const polyc__grid *g = &ctx->grid;
@@ -78,10 +86,7 @@ polyc_status polyc__hash_init(polyc__opt *o)
     h->origin_x = (float)(g->origin_x_m - ctx->frame_x) - HASH_MARGIN_M;
     h->origin_y = (float)(g->origin_y_m - ctx->frame_y) - HASH_MARGIN_M;
     size_t nb = (size_t)h->bx * (size_t)h->by;
-    if (!hash_carve(&ctx->arena, o, nb, polyc__hash_entry_cap(&ctx->lim)))
-        return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the spatial hash");
-    polyc__hash_clear(o);
-    return POLYC_OK;
+    return hash_carve(a, o, nb, polyc__hash_entry_cap(&ctx->lim));
 }
 
 void polyc__hash_clear(polyc__opt *o)

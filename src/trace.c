@@ -314,6 +314,14 @@ polyc_status polyc__trace_build(polyc_ctx *ctx)
     const polyc__grid *g = &ctx->grid;
     if (!polyc__store_init(&ctx->arena, &ctx->store, polyc__max_vertices(&ctx->lim)))
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the polylines");
+    for (uint32_t k = 0; k < g->tile_count; k++)
+        memcpy(g->tiles[k].mark, g->tiles[k].contour, sizeof g->tiles[k].mark);
+    return polyc__trace_more(ctx);
+}
+
+polyc_status polyc__trace_more(polyc_ctx *ctx)
+{
+    const polyc__grid *g = &ctx->grid;
     polyc_status st;
     size_t after_store = ctx->arena.used; /* the walk scratch is released at the end */
     walk w;
@@ -322,8 +330,6 @@ polyc_status polyc__trace_build(polyc_ctx *ctx)
     w.xy = walk_cells(&ctx->arena, w.cap);
     if (!w.xy)
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for tracing");
-    for (uint32_t k = 0; k < g->tile_count; k++)
-        memcpy(g->tiles[k].mark, g->tiles[k].contour, sizeof g->tiles[k].mark);
     thin(ctx, w.xy, w.cap); /* the walk buffer is free until the walks start */
 
     tracer tr;
