@@ -320,7 +320,9 @@ $(BUILD)/sweep: tools/eval/sweep.c $(EVAL_OBJ) $(TOOL_OBJ) $(BUILD)/libpolyc.a
 
 # The README's pictures (docs/img/*.png but corridor.png, which is `make
 # sweep`'s): the tool's SVGs, from the bench build, rendered 700 px wide by
-# rsvg-convert (librsvg2-bin). intel.log is read from DATA.
+# rsvg-convert (librsvg2-bin). intel.log is read from DATA. online-strip.png:
+# intel replayed with --online, its frames after 200, 400, 600 and 910 scans
+# side by side (tools/eval/svgstrip.sh: one SVG of the four, rendered once).
 # `make images DATA=../shared/data`
 IMG_DIR = build-bench/img
 .PHONY: images
@@ -336,6 +338,11 @@ images:
 	    rsvg-convert -w 700 -o docs/img/$$f.png $(IMG_DIR)/$$f.svg || exit 1; done
 	build-bench/polyc --points -o $(IMG_DIR)/fhw.svg $(DATA)/carmen/fhw.log
 	sh tools/eval/svgcrop.sh $(IMG_DIR)/fhw.svg docs/img/fhw-band.png 6 9 12 15 450
+	rm -rf $(IMG_DIR)/online
+	build-bench/polyc --online --frames $(IMG_DIR)/online --every 10 \
+	    -o $(IMG_DIR)/intel-online.svg $(DATA)/carmen/intel.log
+	sh tools/eval/svgstrip.sh docs/img/online-strip.png 1400 \
+	    $(foreach n,00200 00400 00600 00910,$(IMG_DIR)/online/frame-$(n).svg)
 
 # Regenerate the bundled example (examples/office.*) with the simulator
 .PHONY: examples
