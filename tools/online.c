@@ -22,6 +22,7 @@ typedef struct replay {
     double area_m, finish_ms, frames_ms;
     polyc_box box;                 /* every scan's endpoints and pose: the frames' view */
     uint32_t max_backlog, frames, attempts;
+    char stage[48];                /* the progress line's */
 } replay;
 
 /* The side of the square round the first pose that holds every scan's
@@ -108,11 +109,15 @@ static int add_and_update(const options *o, run *r, const polyc_config *cfg, pol
                           size_t size, int retry, replay *rp)
 {
     polyc_online_report rep;
-    progress_stage("online: adding scans, updating");
     rp->max_backlog = 0;
     rp->frames = 0;
     rp->frames_ms = 0;
     for (uint32_t i = 0; i < r->log.count; i++) {
+        if (i % 64 == 0 && progress_on()) {
+            snprintf(rp->stage, sizeof rp->stage, "online: scan %u of %u", (unsigned)i + 1,
+                     (unsigned)r->log.count);
+            progress_stage(rp->stage);
+        }
         double t0 = now_ms();
         polyc_status st = polyc_online_add_scan(ctx, &r->log.scans[i], 0, NULL);
         double t1 = now_ms();
