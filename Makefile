@@ -326,7 +326,7 @@ $(BUILD)/sweep: tools/eval/sweep.c $(EVAL_OBJ) $(TOOL_OBJ) $(BUILD)/libpolyc.a
 # `make images DATA=../shared/data`
 IMG_DIR = build-bench/img
 .PHONY: images
-images:
+images: images-online
 	$(MAKE) BUILD=build-bench OPT='-O3 -march=native -DNDEBUG' build-bench/polyc
 	@mkdir -p $(IMG_DIR)
 	build-bench/polyc -o $(IMG_DIR)/office.svg examples/office.log
@@ -338,6 +338,12 @@ images:
 	    rsvg-convert -w 700 -o docs/img/$$f.png $(IMG_DIR)/$$f.svg || exit 1; done
 	build-bench/polyc --points -o $(IMG_DIR)/fhw.svg $(DATA)/carmen/fhw.log
 	sh tools/eval/svgcrop.sh $(IMG_DIR)/fhw.svg docs/img/fhw-band.png 6 9 12 15 450
+
+# `make images-online DATA=../shared/data`: the strip alone
+.PHONY: images-online
+images-online:
+	$(MAKE) BUILD=build-bench OPT='-O3 -march=native -DNDEBUG' build-bench/polyc
+	@mkdir -p $(IMG_DIR)
 	rm -rf $(IMG_DIR)/online
 	build-bench/polyc --online --frames $(IMG_DIR)/online --every 10 \
 	    -o $(IMG_DIR)/intel-online.svg $(DATA)/carmen/intel.log
