@@ -207,7 +207,8 @@ POLYC_API uint32_t polyc_version(void);
 POLYC_API const char *polyc_status_str(polyc_status status);
 /* sizeof of the public struct named by `name` ("polyc_config", "polyc_limits",
  * "polyc_scan", "polyc_box", "polyc_polyline", "polyc_stats",
- * "polyc_iteration", "polyc_occupancy_grid"), 0 if unknown: lets bindings
+ * "polyc_iteration", "polyc_occupancy_grid", "polyc_online_limits",
+ * "polyc_online_report", "polyc_change"), 0 if unknown: lets bindings
  * detect ABI drift. */
 POLYC_API size_t polyc_struct_size(const char *name);
 
@@ -330,7 +331,8 @@ typedef struct polyc_online_limits {
                                   some beam ended in a hit) */
     uint32_t max_vertices;     /* polyline vertices of the map */
     uint32_t max_points;       /* grid cells holding endpoints (each keeps their
-                                  sums); also bounds the weighted data points */
+                                  sums); the weighted data points (a 2 x 2 block
+                                  of cells each) are bounded by half of it */
     uint32_t max_scan_beams;   /* beams in one scan */
     uint32_t keep_scans;       /* scans kept for pose corrections (0: none) */
     uint32_t keep_beams;       /* beams of the kept scans, in all */

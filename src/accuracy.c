@@ -89,11 +89,15 @@ int polyc__accuracy_scratch(polyc__acc_learn *L, polyc__arena *a, const polyc_li
     return L->samples && L->cells;
 }
 
-/* Online, the samples are paired as they come: each cell keeps its last
- * PAIR_TRIES samples (a ring), a new one is compared with them and takes
- * the oldest's place; the cell's sums stay. */
-int polyc__accuracy_online(polyc__acc_learn *L, polyc__arena *a)
+/* Online, the samples are paired as they come: each cell keeps PAIR_TRIES
+ * of its samples, a uniform choice among all it has seen (a reservoir: the
+ * n-th takes a place with chance PAIR_TRIES / n), and a new sample is
+ * compared with them, so that, as in the batch's pairing, the scans
+ * compared are spread over the whole run and not only the last few (whose
+ * poses share their error). The cell's sums stay. */
+int polyc__accuracy_online(polyc__acc_learn *L, polyc__arena *a, float alpha)
 {
+    L->alpha = alpha;
     if (!L->p)
         return 1;
     size_t cells = (size_t)L->p->w * (size_t)L->p->h;
@@ -111,6 +115,19 @@ static int cell_at(const polyc__prior *p, float x, float y, uint32_t *cell)
         return 0;
     *cell = (uint32_t)((int32_t)fy * p->w + (int32_t)fx);
     return 1;
+}
+
+/* The weight of a cell's points from its sums (s0_2: the variance alpha
+ * assumes). */
+static float cell_weight(const acc_cell *c, float s0_2)
+{
+    if (c->pairs < MIN_PAIRS || c->samples == 0)
+        return 1.0f;
+    float b2 = 0.5f * c->delta2 / (float)c->pairs;
+    float r2 = c->res2 / (float)c->samples;
+    float m = CORRELATION_M * c->density / (float)c->samples;
+    float excess = b2 - s0_2;
+    return excess > 0.0f && m > 1.0f ? (r2 + s0_2) / (r2 + s0_2 + m * excess) : 1.0f;
 }
 
 /* Adds the offset across the wall between a and b to the cell's pairs
@@ -154,8 +171,18 @@ void polyc__accuracy_sample(polyc__acc_learn *L, float x, float y, float nx, flo
         uint32_t n = L->ring_n[cell];
         for (uint32_t k = 0; k < n && k < PAIR_TRIES; k++)
             pair(c, s, &ring[k]);
-        ring[n % PAIR_TRIES] = *s;
+        uint32_t at = n;
+        if (n >= PAIR_TRIES) { /* a hash of (cell, n): the same choices on every run */
+            uint32_t h = (cell * 2654435761u) ^ (n * 2246822519u);
+            h ^= h >> 15;
+            h *= 2654435761u;
+            h ^= h >> 13;
+            at = h % (n + 1);
+        }
+        if (at < PAIR_TRIES)
+            ring[at] = *s;
         L->ring_n[cell] = n + 1;
+        p->weight[cell] = cell_weight(c, L->alpha > 0.0f ? 0.5f / L->alpha : 0.0f);
     }
 }
 
@@ -225,18 +252,8 @@ void polyc__accuracy_weigh(polyc__acc_learn *L, float alpha)
     size_t cells = (size_t)p->w * (size_t)p->h;
     const acc_cell *cell = L->cells;
     float s0_2 = alpha > 0.0f ? 0.5f / alpha : 0.0f;
-    for (size_t c = 0; c < cells; c++) {
-        float w = 1.0f;
-        if (cell[c].pairs >= MIN_PAIRS && cell[c].samples > 0) {
-            float b2 = 0.5f * cell[c].delta2 / (float)cell[c].pairs;
-            float r2 = cell[c].res2 / (float)cell[c].samples;
-            float m = CORRELATION_M * cell[c].density / (float)cell[c].samples;
-            float excess = b2 - s0_2;
-            if (excess > 0.0f && m > 1.0f)
-                w = (r2 + s0_2) / (r2 + s0_2 + m * excess);
-        }
-        p->weight[c] = w;
-    }
+    for (size_t c = 0; c < cells; c++)
+        p->weight[c] = cell_weight(&cell[c], s0_2);
 }
 
 float polyc__accuracy_weight(const polyc__prior *p, float x, float y)

@@ -269,9 +269,8 @@ polyc_status polyc__prior_build(polyc_ctx *ctx, polyc__prior *p, size_t spare)
 }
 
 /* Online, the prior is laid out once over the grid (the area) with a row
- * for every cell, learned scan by scan (polyc__prior_learn_scan), its rows
- * summed before each search (polyc__prior_online_sums) and queried without
- * the smoothed table. */
+ * for every cell, learned scan by scan (polyc__prior_learn_scan, which
+ * keeps the rows' totals) and queried without the smoothed table. */
 int polyc__prior_online(const polyc_ctx *ctx, polyc__prior *p, polyc__acc_learn *acc,
                         polyc__arena *a)
 {
@@ -282,12 +281,7 @@ int polyc__prior_online(const polyc_ctx *ctx, polyc__prior *p, polyc__acc_learn 
     p->hist = row_counts(a, cells);
     p->total = row_totals(a, cells);
     return p->row_of && p->hist && p->total && polyc__accuracy_begin(acc, p, a, &ctx->lim) &&
-           polyc__accuracy_online(acc, a);
-}
-
-void polyc__prior_online_sums(polyc__prior *p)
-{
-    sum_rows(p);
+           polyc__accuracy_online(acc, a, ctx->cfg.alpha);
 }
 
 /* ---- query (the optimiser's hot loop: no trigonometry, 9 cells x 3 bins) ---- */

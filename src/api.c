@@ -93,6 +93,8 @@ polyc_status polyc_reset(polyc_ctx *ctx)
     polyc_status cst = polyc__check_ctx(ctx);
     if (cst != POLYC_OK)
         return cst;
+    if (ctx->online)
+        return polyc__fail(ctx, POLYC_ERR_STATE, "an online context: use the polyc_online_* calls");
     ctx->arena.used = ctx->scans_mark = ctx->base_mark;
     ctx->scan_count = ctx->range_count = 0;
     ctx->have_frame = ctx->ext.have = 0;
@@ -112,6 +114,22 @@ polyc_status polyc_reset(polyc_ctx *ctx)
     return POLYC_OK;
 }
 
+const char *polyc__scan_problem(const polyc_scan *s)
+{
+    if (!polyc__pose_ok(s->pose_x_m, s->pose_y_m, s->pose_theta_rad))
+        return "scan pose is not finite or beyond 1e7 m";
+    if (!isfinite(s->start_angle_rad) || !isfinite(s->angle_step_rad) ||
+        fabsf(s->angle_step_rad) > 6.2832f || fabsf(s->start_angle_rad) > 100.0f)
+        return "scan angles are not finite or out of range";
+    if (s->beam_count > 1 && s->angle_step_rad == 0.0f)
+        return "scan angle_step_rad is 0";
+    if (!(s->min_range_m >= 0.0f) || !(s->max_range_m > s->min_range_m))
+        return "scan range interval is empty or negative";
+    if (s->reserved != 0)
+        return "scan.reserved must be 0";
+    return NULL;
+}
+
 polyc_status polyc_add_scan(polyc_ctx *ctx, const polyc_scan *s)
 {
     polyc_status cst = polyc__check_ctx(ctx);
@@ -121,20 +139,11 @@ polyc_status polyc_add_scan(polyc_ctx *ctx, const polyc_scan *s)
     if (ctx->from_grid)
         return polyc__fail(ctx, POLYC_ERR_STATE,
                            "the context holds a grid: scans need a context of their own");
+    if (ctx->online)
+        return polyc__fail(ctx, POLYC_ERR_STATE, "an online context takes scans by polyc_online_add_scan");
     if (s->beam_count && !s->range_m)
         return polyc__fail(ctx, POLYC_ERR_NULL, "scan.range_m is NULL with beams");
-    const char *bad = NULL;
-    if (!polyc__pose_ok(s->pose_x_m, s->pose_y_m, s->pose_theta_rad))
-        bad = "scan pose is not finite or beyond 1e7 m";
-    else if (!isfinite(s->start_angle_rad) || !isfinite(s->angle_step_rad) ||
-             fabsf(s->angle_step_rad) > 6.2832f || fabsf(s->start_angle_rad) > 100.0f)
-        bad = "scan angles are not finite or out of range";
-    else if (s->beam_count > 1 && s->angle_step_rad == 0.0f)
-        bad = "scan angle_step_rad is 0";
-    else if (!(s->min_range_m >= 0.0f) || !(s->max_range_m > s->min_range_m))
-        bad = "scan range interval is empty or negative";
-    else if (s->reserved != 0)
-        bad = "scan.reserved must be 0";
+    const char *bad = polyc__scan_problem(s);
     if (bad) {
         ctx->err.scan = (int32_t)ctx->scan_count;
         return polyc__fail(ctx, POLYC_ERR_SCAN, bad);
@@ -185,6 +194,8 @@ polyc_status polyc_add_grid(polyc_ctx *ctx, const polyc_occupancy_grid *grid)
     if (cst != POLYC_OK || !grid)
         return cst != POLYC_OK ? cst : POLYC_ERR_NULL;
     ctx->err.msg = NULL;
+    if (ctx->online)
+        return polyc__fail(ctx, POLYC_ERR_STATE, "an online context: use the polyc_online_* calls");
     return polyc__occ_add(ctx, grid);
 }
 
@@ -234,7 +245,7 @@ static polyc_status stage_contour(polyc_ctx *ctx)
 
 /* The result form, in the frame of the input poses (an occupancy grid's
  * map frame: its origin pose applied). */
-static void export_result(polyc_ctx *ctx)
+void polyc__export_result(polyc_ctx *ctx)
 {
     polyc__flat_from_store(&ctx->flat, &ctx->store);
     for (uint32_t i = 0; ctx->from_grid && i < ctx->flat.points; i++) {
@@ -258,7 +269,7 @@ static polyc_status stage_trace(polyc_ctx *ctx)
     int32_t vcap = ctx->store.v_cap;
     if (!polyc__flat_init(&ctx->arena, &ctx->flat, (uint32_t)polyc__line_cap(vcap), (uint32_t)vcap))
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the result polylines");
-    export_result(ctx);
+    polyc__export_result(ctx);
     ctx->stats.initial_polylines = ctx->stats.polylines;
     ctx->stats.initial_vertices = ctx->stats.vertices;
     ctx->trace_mark = ctx->arena.used;
@@ -268,6 +279,8 @@ static polyc_status stage_trace(polyc_ctx *ctx)
 static polyc_status need_stage(polyc_ctx *ctx, polyc__stage want)
 {
     polyc_status st = POLYC_OK;
+    if (ctx->online)
+        return polyc__fail(ctx, POLYC_ERR_STATE, "an online context: use the polyc_online_* calls");
     if (ctx->from_grid && ctx->stage < POLYC__STAGE_CONTOUR)
         ctx->stage = POLYC__STAGE_CONTOUR; /* an occupancy grid's are its input */
     if (ctx->stage < POLYC__STAGE_GRID && want >= POLYC__STAGE_GRID)
@@ -331,15 +344,9 @@ polyc_status polyc_trace(polyc_ctx *ctx)
 /* The caller's callback, with the context marked busy while it runs: a
  * call back into the library on it is refused (POLYC_ERR_BUSY) instead of
  * changing the model under the optimiser. */
-typedef struct guarded {
-    polyc_ctx *ctx;
-    polyc_progress_fn progress;
-    void *user;
-} guarded;
-
-static int guarded_progress(void *user, const polyc_iteration *it)
+int polyc__guarded_progress(void *user, const polyc_iteration *it)
 {
-    guarded *g = (guarded *)user;
+    polyc__guarded *g = (polyc__guarded *)user;
     g->ctx->magic = POLYC__MAGIC_BUSY;
     int stop = g->progress(g->user, it);
     g->ctx->magic = POLYC__MAGIC;
@@ -356,14 +363,14 @@ polyc_status polyc_optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *us
     if (st != POLYC_OK)
         return st;
     ctx->arena.used = ctx->trace_mark;
-    guarded g = {ctx, progress, user};
-    st = polyc__optimize(ctx, progress ? guarded_progress : NULL, &g);
+    polyc__guarded g = {ctx, progress, user};
+    st = polyc__optimize(ctx, progress ? polyc__guarded_progress : NULL, &g);
     note_memory(ctx);
     ctx->arena.used = ctx->trace_mark;
     if (ctx->opt_result_valid) {
         /* the best map found (after a failure mid-search too: the store
          * and the published result never disagree) */
-        export_result(ctx);
+        polyc__export_result(ctx);
         ctx->stage = POLYC__STAGE_OPTIMIZED;
     }
     return st;
@@ -387,6 +394,8 @@ polyc_status polyc_score(polyc_ctx *ctx, double *bic, double *err)
     if (cst != POLYC_OK)
         return cst;
     ctx->err.msg = NULL;
+    if (ctx->online)
+        return polyc__fail(ctx, POLYC_ERR_STATE, "an online context: use the polyc_online_* calls");
     if (ctx->stage < POLYC__STAGE_TRACE)
         return polyc__fail(ctx, POLYC_ERR_STATE, "no polylines yet: run polyc_trace first");
     ctx->arena.used = ctx->trace_mark;

@@ -70,6 +70,26 @@ void polyc__chg_dirty(polyc__opt *o, int32_t v)
     o->chg.dirty_list[o->chg.dirty_n++] = v;
 }
 
+int32_t polyc__region_points(polyc__opt *o, polyc__seg_pred want)
+{
+    if (o->region_since == 0)
+        return -1;
+    const polyc__store *s = o->s;
+    polyc__chg_begin(o); /* a new epoch for the bucket marks; no change is open */
+    for (int32_t v = 0; v < s->v_high; v++)
+        if (s->v[v].line != POLYC__NONE && s->v[v].next != POLYC__NONE && want(o, v))
+            polyc__chg_mark_region(o, v);
+    const polyc__hash *h = &o->h;
+    int32_t n = 0;
+    for (int32_t k = 0; k < o->chg.bucket_n; k++) {
+        int32_t b = o->chg.bucket_list[k];
+        for (uint32_t i = h->pt_start[b]; i < h->pt_start[b + 1]; i++)
+            o->region_pt[n++] = (int32_t)i;
+    }
+    o->chg.bucket_n = 0;
+    return n;
+}
+
 void polyc__chg_commit(polyc__opt *o)
 {
     const polyc__hash *h = &o->h;

@@ -38,6 +38,9 @@ size_t polyc_struct_size(const char *name)
         {"polyc_polyline", sizeof(polyc_polyline)}, {"polyc_stats", sizeof(polyc_stats)},
         {"polyc_iteration", sizeof(polyc_iteration)},
         {"polyc_occupancy_grid", sizeof(polyc_occupancy_grid)},
+        {"polyc_online_limits", sizeof(polyc_online_limits)},
+        {"polyc_online_report", sizeof(polyc_online_report)},
+        {"polyc_change", sizeof(polyc_change)},
     };
     if (!name)
         return 0;

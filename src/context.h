@@ -80,6 +80,15 @@ struct polyc_ctx {
  * its magic reads POLYC__MAGIC_BUSY and every entry point refuses it with
  * POLYC_ERR_BUSY (api.c, guarded_progress). */
 #define POLYC__MAGIC_BUSY 0x62757379u /* "busy" */
+/* the caller's progress callback, called with the context lent (api.c) */
+typedef struct polyc__guarded {
+    polyc_ctx *ctx;
+    polyc_progress_fn progress;
+    void *user;
+} polyc__guarded;
+int polyc__guarded_progress(void *user, const polyc_iteration *it);
+/* the store as the published result, in the input's frame (api.c) */
+void polyc__export_result(polyc_ctx *ctx);
 /* POLYC_OK for a context an entry point may use (api.c) */
 polyc_status polyc__check_ctx(const polyc_ctx *ctx);
 

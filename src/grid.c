@@ -295,7 +295,8 @@ static void count_beam(const count_pass *p, const polyc__beam *b)
 /* The grid's cells over w_m x h_m metres from the frame-relative corner
  * (x0, y0), its directory, wanted bits and spill tile; the tiles follow in
  * the block as beams reach them. */
-static polyc_status grid_lay_out(polyc_ctx *ctx, double x0, double y0, double w_m, double h_m)
+static polyc_status grid_lay_out(polyc_ctx *ctx, double x0, double y0, double w_m, double h_m,
+                                 uint32_t tile_cap)
 {
     polyc__grid *g = &ctx->grid;
     float cell = ctx->cfg.cell_m;
@@ -312,11 +313,12 @@ static polyc_status grid_lay_out(polyc_ctx *ctx, double x0, double y0, double w_
     g->tiles_x = (g->width + POLYC__TILE_SIDE - 1) / POLYC__TILE_SIDE;
     g->tiles_y = (g->height + POLYC__TILE_SIDE - 1) / POLYC__TILE_SIDE;
 
-    size_t budget = polyc__grid_budget_bytes(&ctx->lim);
     size_t dir_n = (size_t)g->tiles_x * (size_t)g->tiles_y;
     size_t dir_bytes = polyc__bytes(dir_n, sizeof(uint32_t));
     size_t fixed = polyc__add(polyc__add(dir_bytes, wanted_bytes(dir_n)),
                               polyc__bytes(1, sizeof(polyc__tile))); /* + the spill tile */
+    size_t budget = tile_cap ? polyc__add(fixed, polyc__bytes(tile_cap, sizeof(polyc__tile)))
+                             : polyc__grid_budget_bytes(&ctx->lim);
     if (dir_bytes == 0 || fixed >= budget)
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "grid extent too large for limits.max_grid_cells");
     g->dir = polyc__alloc_zero(&ctx->arena, dir_n, sizeof(uint32_t));
@@ -389,7 +391,7 @@ polyc_status polyc__grid_build(polyc_ctx *ctx)
     if (w_m > ext || h_m > ext)
         return polyc__fail(ctx, POLYC_ERR_EXTENT,
                            "the data span more than config.max_extent_m (a far-away scan?)");
-    polyc_status st = grid_lay_out(ctx, ctx->ext.min_x - pad, ctx->ext.min_y - pad, w_m, h_m);
+    polyc_status st = grid_lay_out(ctx, ctx->ext.min_x - pad, ctx->ext.min_y - pad, w_m, h_m, 0);
     if (st != POLYC_OK)
         return st;
     for (uint32_t si = 0; si < ctx->scan_count; si++)
@@ -401,10 +403,11 @@ polyc_status polyc__grid_build(polyc_ctx *ctx)
     return POLYC_OK;
 }
 
-polyc_status polyc__grid_online_init(polyc_ctx *ctx, double side_m)
+polyc_status polyc__grid_online_init(polyc_ctx *ctx, double side_m, uint32_t max_cells)
 {
     memset(&ctx->grid, 0, sizeof ctx->grid);
-    return grid_lay_out(ctx, -0.5 * side_m, -0.5 * side_m, side_m, side_m);
+    uint32_t tiles = (max_cells + POLYC__TILE_CELLS - 1) / POLYC__TILE_CELLS;
+    return grid_lay_out(ctx, -0.5 * side_m, -0.5 * side_m, side_m, side_m, tiles);
 }
 
 polyc_status polyc__grid_add_scan(polyc_ctx *ctx, const polyc__scan *s, int take_back)

@@ -181,6 +181,7 @@ typedef struct polyc__acc_learn {
     void *samples, *cells;         /* scratch (online: kept) */
     uint32_t n, cap;
     uint32_t *ring_n;              /* online: per cell, the samples it has seen */
+    float alpha;                   /* online: the error term's, for the weights */
 } polyc__acc_learn;
 /* the weights (all 1), after the prior's cells are laid out; 0: no room */
 int polyc__accuracy_begin(polyc__acc_learn *L, polyc__prior *p, polyc__arena *a,
@@ -196,7 +197,7 @@ void polyc__accuracy_sample(polyc__acc_learn *L, float x, float y, float nx, flo
 void polyc__accuracy_finish(polyc__acc_learn *L, polyc__arena *a, float alpha);
 /* online: the per-cell sums and rings, kept (after polyc__accuracy_begin);
  * samples are then paired as they come; 0: no room */
-int polyc__accuracy_online(polyc__acc_learn *L, polyc__arena *a);
+int polyc__accuracy_online(polyc__acc_learn *L, polyc__arena *a, float alpha);
 /* the weights from the pairs so far */
 void polyc__accuracy_weigh(polyc__acc_learn *L, float alpha);
 /* what polyc__accuracy_finish allocates at most (L->cap samples), on a
@@ -212,11 +213,10 @@ size_t polyc__prior_bytes(const polyc_limits *lim);
  * with `spare` bytes or more of the block free beyond what the later stages
  * are budgeted, also the table of smoothed counts (p->smooth). */
 polyc_status polyc__prior_build(polyc_ctx *ctx, polyc__prior *p, size_t spare);
-/* online: the prior and the accuracy over the whole grid, carved from a;
- * 0: no room. Its rows' totals before a search: polyc__prior_online_sums. */
+/* online: the prior and the accuracy over the whole grid, carved from a
+ * (the rows' totals and the weights kept as scans come); 0: no room */
 int polyc__prior_online(const polyc_ctx *ctx, polyc__prior *p, polyc__acc_learn *acc,
                         polyc__arena *a);
-void polyc__prior_online_sums(polyc__prior *p);
 /* prior_learn.c: the counts from every scan, into p (laid out, rows handed
  * out as cells get evidence); cache: cache_cap beams' endpoints (NULL: none);
  * acc: the accuracy's samples (NULL: none) */
@@ -260,6 +260,8 @@ float polyc__spacing_at(const polyc__spacing *sp, float x, float y);
  * (the pose and every reflected endpoint, frame shifted by ox, oy) grows
  * box[4] = min x, min y, max x, max y (have: it holds something) */
 int polyc__pose_ok(double x, double y, double th);
+/* api.c: what is wrong with a scan's geometry (a static message), or NULL */
+const char *polyc__scan_problem(const polyc_scan *s);
 void polyc__extent_add(const polyc_scan *s, double ox, double oy, double *box, int *have);
 
 /* grid.c */
@@ -271,7 +273,7 @@ void polyc__grid_reserve(polyc__arena *a, const polyc_limits *lim);
 polyc_status polyc__grid_build(polyc_ctx *ctx);
 /* online: a grid over a square of side_m centred on the frame origin, with
  * no tile yet; one scan counted into it, or taken back (a pose correction) */
-polyc_status polyc__grid_online_init(polyc_ctx *ctx, double side_m);
+polyc_status polyc__grid_online_init(polyc_ctx *ctx, double side_m, uint32_t max_cells);
 polyc_status polyc__grid_add_scan(polyc_ctx *ctx, const polyc__scan *s, int take_back);
 polyc__tile *polyc__grid_tile(const polyc__grid *g, int32_t ix, int32_t iy);
 /* NULL for cells outside the grid or in tiles not stored (no beam ends in a

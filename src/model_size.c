@@ -163,7 +163,8 @@ int polyc__op_remove_vertices(polyc__opt *o, uint32_t since)
     return removed;
 }
 
-/* Per segment: summed cost and weight of its points, and its farthest point. */
+/* Per segment (in the region): summed cost and weight of its points, and
+ * its farthest point. */
 static void segment_stats(polyc__opt *o)
 {
     for (int32_t v = 0; v < o->s->v_high; v++) {
@@ -172,9 +173,13 @@ static void segment_stats(polyc__opt *o)
         o->size.seg_far[v] = POLYC__NONE;
         o->size.seg_far_d[v] = -1.0f;
     }
-    for (int32_t i = 0; i < o->d.np; i++) {
+    int32_t np = polyc__region_points(o, polyc__in_region);
+    const int32_t *list = np >= 0 ? o->region_pt : NULL;
+    np = np >= 0 ? np : o->d.np;
+    for (int32_t j = 0; j < np; j++) {
+        int32_t i = list ? list[j] : j;
         int32_t sg = o->d.pt_seg[i];
-        if (sg == POLYC__NONE)
+        if (sg == POLYC__NONE || !polyc__in_region(o, sg))
             continue;
         float w = o->d.pts[i].w, c = (float)o->d.pt_cost[i];
         o->size.seg_sum[sg] += c;

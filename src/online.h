@@ -20,7 +20,7 @@ typedef struct polyc__cell_sums {
  * points, and the version that last changed it. */
 typedef struct polyc__pub {
     uint32_t id, hash;
-    uint64_t version;
+    uint64_t born, version;        /* the versions that added it and last changed it */
 } polyc__pub;
 
 typedef struct polyc__online {
@@ -30,9 +30,13 @@ typedef struct polyc__online {
     uint32_t *slot;
     polyc__cell_sums *sums;
     uint32_t sums_n;
+    uint32_t sums_free;            /* 1 + a free entry (a list through their n), 0: none */
     uint32_t *pose_bits;           /* bit per directory entry: a pose lay in the tile */
     float min_step_rad;            /* smallest |angle step| seen */
     float *spacing_dist;           /* the spacing table (spacing.c), per directory entry */
+    int spacing_stale;             /* a pose fell in a new tile since it was made */
+    uint32_t spacing_scans;        /* the scan count when it was made */
+    int spacing_now;               /* make it again now if stale (the finishing call) */
 
     /* the backlog: per directory entry 0, or 1 + the scan count when the
      * tile changed first since it was last re-optimised; and their list */
@@ -54,8 +58,21 @@ typedef struct polyc__online {
     /* an update's scratch: the contour cells to trace, the points */
     int32_t *cells;
     uint32_t cells_cap;
+    float *learn_cache;            /* the prior's endpoint cache, one scan */
     polyc__point *pts_tmp;
     float *view_tmp;
+    uint32_t *fresh_tile;          /* per new point: its tile's directory entry */
+    int32_t *fresh_bucket;         /* per new point: its bucket */
+    /* the points' spare arrays (online_data.c swaps them in) and, per
+     * point, its tile's directory entry; per bucket a fill position; per
+     * stored tile the endpoints its points hold */
+    polyc__point *alt_pts;
+    float *alt_view;
+    int32_t *alt_seg;
+    double *alt_cost;
+    uint32_t *alt_tile, *pt_tile, *alt_start, *bucket_fill;
+    double *tile_raw;
+    uint32_t *tile_new;            /* per stored tile: endpoints in or out since its refresh */
 
     polyc__opt opt;                /* the optimiser (its arrays in the block) */
     int opt_ready;                 /* it holds the map (0 before the first update) */
@@ -71,6 +88,14 @@ typedef struct polyc__online {
 
 /* online.c: the context's limits for the stages, from the online limits */
 void polyc__online_stage_limits(const polyc_online_limits *ol, polyc_limits *lim);
+/* online.c: every stored tile into the backlog (the finishing call) */
+void polyc__online_backlog_all(polyc_ctx *ctx);
+/* online_data.c: the points of the n taken tiles (the first n of the
+ * backlog, marked) made again from the sums */
+polyc_status polyc__online_refresh_tiles(polyc_ctx *ctx, uint32_t n);
+/* online_data.c: the polylines with ids above after_id (traced by this
+ * update) into the hash and the books */
+polyc_status polyc__online_add_lines(polyc_ctx *ctx, uint32_t after_id);
 /* online_round.c */
 polyc_status polyc__online_round(polyc_ctx *ctx, uint64_t work, int all, uint64_t *spent);
 /* online_changes.c: publishes the store as the context's result, a new

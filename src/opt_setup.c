@@ -20,7 +20,8 @@ static int32_t loc_soa_cap(const polyc_limits *lim)
 /* The optimiser's own arrays for P points and V vertices, then each
  * group's scratch by its file (the points, the spatial hash and the best
  * model are carved by theirs). */
-static int opt_carve(polyc__arena *a, polyc__opt *o, int32_t P, int32_t V, int viewed, int32_t lsoa_cap)
+static int opt_carve(polyc__arena *a, polyc__opt *o, int32_t P, int32_t V, int viewed, int32_t lsoa_cap,
+                     int online)
 {
     int ok = 1;
     POLYC__CARVE(ok, a, o->d.pt_seg, P);
@@ -30,6 +31,9 @@ static int opt_carve(polyc__arena *a, polyc__opt *o, int32_t P, int32_t V, int v
     if (viewed)
         POLYC__CARVE(ok, a, o->seg_side, 2 * (size_t)V);
     POLYC__CARVE(ok, a, o->seg_in, V);
+    o->region_pt = NULL;
+    if (online)
+        POLYC__CARVE(ok, a, o->region_pt, P);
     POLYC__CARVE(ok, a, o->split_due, V);
     POLYC__CARVE(ok, a, o->v_work, V);
     POLYC__CARVE(ok, a, o->v_touch, V);
@@ -48,7 +52,7 @@ void polyc__optimizer_reserve(polyc__arena *a, const polyc_config *cfg, const po
     polyc__spacing_reserve(a, lim);
     polyc__hash_reserve(a, &o, lim);
     polyc__points_reserve(a, cfg, lim);
-    opt_carve(a, &o, P > 0 ? P : 1, V, lim->max_scans > 1, loc_soa_cap(lim));
+    opt_carve(a, &o, P > 0 ? P : 1, V, lim->max_scans > 1, loc_soa_cap(lim), 0);
     polyc__flat_reserve(a, V);
 }
 
@@ -122,7 +126,7 @@ int polyc__opt_carve_online(polyc_ctx *ctx, polyc__arena *a, polyc__opt *o)
     int32_t V = polyc__max_vertices(&ctx->lim), P = polyc__points_bound(o->cfg, &ctx->lim);
     polyc__rays_init(&o->rays, ctx);
     int ok = polyc__hash_lay_out(o, a) && polyc__points_carve_online(a, o, &on->pts_tmp, &on->view_tmp) &&
-             opt_carve(a, o, P > 0 ? P : 1, V, 1, loc_soa_cap(&ctx->lim));
+             opt_carve(a, o, P > 0 ? P : 1, V, 1, loc_soa_cap(&ctx->lim), 1);
     if (!a->base) { /* a counting arena: nothing is written */
         polyc__flat_reserve(a, V);
         return ok;
@@ -130,6 +134,10 @@ int polyc__opt_carve_online(polyc_ctx *ctx, polyc__arena *a, polyc__opt *o)
     if (!ok || !polyc__flat_init(a, &o->best, (uint32_t)polyc__line_cap(V), (uint32_t)V))
         return 0;
     polyc__hash_clear(o);
+    polyc__points_spans(o, 0);
+    /* no points yet: every bucket empty */
+    memset(o->h.pt_start, 0, ((size_t)o->h.bx * (size_t)o->h.by + 1) * sizeof(uint32_t));
+    memset(o->acost, 0, (size_t)V * sizeof(double));
     memset(o->v_work, 0, (size_t)V * sizeof(uint32_t));
     memset(o->v_touch, 0, (size_t)V * sizeof(uint32_t));
     memset(o->seg_in, 0, (size_t)V);
@@ -143,9 +151,7 @@ polyc_status polyc__opt_refresh(polyc__opt *o)
 {
     polyc_ctx *ctx = o->ctx;
     polyc__online *on = ctx->online;
-    polyc__prior_online_sums(&on->prior);
-    polyc__accuracy_weigh(&on->acc, ctx->cfg.alpha);
-    o->prior = on->prior;
+    o->prior = on->prior; /* its totals and weights are kept as scans come */
     polyc_status st = polyc__spacing_build(ctx, &o->spacing);
     if (st != POLYC_OK)
         return st;
@@ -178,7 +184,7 @@ polyc_status polyc__opt_setup(polyc_ctx *ctx, polyc__opt *o)
         return st;
     o->d.log_n = log(o->d.n > 1.0 ? o->d.n : 1.0);
     int32_t P = o->d.np > 0 ? o->d.np : 1;
-    if (!opt_carve(&ctx->arena, o, P, V, o->d.pt_view != NULL, loc_soa_cap(&ctx->lim)))
+    if (!opt_carve(&ctx->arena, o, P, V, o->d.pt_view != NULL, loc_soa_cap(&ctx->lim), 0))
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the optimiser");
     memset(o->v_work, 0, (size_t)V * sizeof(uint32_t));
     memset(o->v_touch, 0, (size_t)V * sizeof(uint32_t));

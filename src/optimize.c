@@ -78,7 +78,7 @@ static polyc_status polish(polyc__opt *o, double best)
 /* One iteration's operators after the noise, in their order; `since`: the
  * stamp after which edits are looked at again (0: all), `climb`: the
  * first climb's. Returns the stamp taken after the first climb. */
-static uint32_t operators(polyc__opt *o, uint32_t since, uint32_t climb)
+uint32_t polyc__operators(polyc__opt *o, uint32_t since, uint32_t climb)
 {
     if (o->pol.restructure) {
         polyc__op_overlaps(o);      /* A */
@@ -157,7 +157,7 @@ polyc_status polyc__search(polyc__opt *o, polyc_progress_fn progress, void *user
         }
         uint32_t since = it == 0 || noise > 0.0 ? 0 : prev_start;
         prev_start = start;
-        prev_mark = operators(o, since, o->pol.climb_since_prev && it > 0 ? prev_mark : since);
+        prev_mark = polyc__operators(o, since, o->pol.climb_since_prev && it > 0 ? prev_mark : since);
         if (o->h.out_of_entries)
             return restore_best(o, polyc__fail(ctx, POLYC_ERR_NOMEM, "spatial hash full"));
         POLYC__CHECKS_ITERATION(o);

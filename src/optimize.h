@@ -163,6 +163,12 @@ typedef struct polyc__opt {
     polyc__eval_scratch ev;
     polyc__split_scratch split;
     polyc__size_scratch size;
+
+    /* an online update's region: only segments edited at or after this
+     * stamp are split, trimmed or given vertices (0: the whole map); the
+     * points those operators look at (change.c, polyc__region_points) */
+    uint32_t region_since;
+    int32_t *region_pt;
 } polyc__opt;
 
 #define POLYC__CAND_MAX 48
@@ -195,6 +201,17 @@ inline int polyc__edited_since(const polyc__opt *o, int32_t v, uint32_t since)
 int polyc__change_carve(polyc__arena *a, polyc__change *c, int32_t V);
 /* change.c: lists the buckets a segment's points can be in for rescoring */
 void polyc__chg_mark_region(polyc__opt *o, int32_t seg);
+/* Whether segment v is in the online update's region (always, without one). */
+static inline int polyc__in_region(const polyc__opt *o, int32_t v)
+{
+    return o->region_since == 0 || o->v_touch[v] >= o->region_since ||
+           o->v_touch[o->s->v[v].next] >= o->region_since;
+}
+/* change.c: in an online update's region, lists in o->region_pt the points
+ * in the buckets where the points of the segments `want` takes can be, and
+ * returns their count; without a region, -1 (look at every point) */
+typedef int (*polyc__seg_pred)(const polyc__opt *o, int32_t v);
+int32_t polyc__region_points(polyc__opt *o, polyc__seg_pred want);
 int polyc__eval_carve(polyc__arena *a, polyc__eval_scratch *ev, int32_t P, int32_t lsoa_cap);
 /* operators.c: split and trim scratch; model_size.c: vertex removal's */
 int polyc__split_carve(polyc__arena *a, polyc__split_scratch *sp, int32_t P, int32_t V);
@@ -208,6 +225,10 @@ int polyc__size_carve(polyc__arena *a, polyc__size_scratch *sz, int32_t V);
 /* segments one edit replaces, at most (corners: a chain of 3 and its two ends) */
 #define POLYC__EDIT_SEGS 6
 
+/* optimize.c: one iteration's operators after the noise; `since`: the
+ * stamp after which edits are looked at again (0: all), `climb`: the first
+ * climb's; returns the stamp taken after the first climb */
+uint32_t polyc__operators(polyc__opt *o, uint32_t since, uint32_t climb);
 /* optimize.c: carves the state from the arena after the trace, scores it */
 polyc_status polyc__opt_setup(polyc_ctx *ctx, polyc__opt *o);
 
@@ -216,6 +237,17 @@ int32_t polyc__points_bound(const polyc_config *cfg, const polyc_limits *lim);
 /* whether the points carry the direction they were seen from (pt_view) */
 int polyc__points_viewed(const polyc_ctx *ctx);
 polyc_status polyc__points_collect(polyc__opt *o);
+/* the span of a weighted point and the support distance (exact: one
+ * point per endpoint) */
+void polyc__points_spans(polyc__opt *o, int exact);
+/* a point's weight by the accuracy where it lies */
+void polyc__point_weigh(const polyc__prior *prior, polyc__point *p);
+/* online: the weighted points of the tiles at directory entries dirs (nd
+ * of them), unsorted, into out, view and tile (its directory entry), at
+ * most cap; returns their count (-1: more than cap); tile_raw (by tile
+ * storage index) gets each tile's endpoints */
+int32_t polyc__points_of_tiles(polyc__opt *o, const uint32_t *dirs, uint32_t nd, polyc__point *out,
+                               float *view, uint32_t *tile, int32_t cap, double *tile_raw);
 /* online: the points (in o->d) and their unsorted copy, carved once */
 int polyc__points_carve_online(polyc__arena *a, polyc__opt *o, polyc__point **tmp, float **tmp_view);
 /* the points' allocations under the limits, on a counting arena */

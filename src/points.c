@@ -69,46 +69,53 @@ static float block_centre(double origin, int32_t i, float cell)
     return (float)(origin + ((double)i + 0.5 * BLOCK_SIDE) * (double)cell);
 }
 
-/* Marks the blocks that hold data, from the counters (the grid counts a
- * hit only in the end cell of a reflection, the cell endpoint_of finds, so
- * a cell with hits that passes the data rule holds an endpoint that
- * endpoint_of accepts, and only such cells do: the same marks as a pass
- * over the beams, without computing every endpoint once more), and numbers
- * them in tile order; returns their count. */
+/* Marks the blocks of tile t that hold data, from the counters (the grid
+ * counts a hit only in the end cell of a reflection, the cell endpoint_of
+ * finds, so a cell with hits that passes the data rule holds an endpoint
+ * that endpoint_of accepts, and only such cells do: the same marks as a
+ * pass over the beams, without computing every endpoint once more). */
+static void mark_tile(const polyc_ctx *ctx, polyc__tile *t)
+{
+    const int32_t side = POLYC__TILE_SIDE, block = ~(int32_t)(BLOCK_SIDE - 1);
+    memset(t->mark, 0, sizeof t->mark);
+    for (int32_t r = 0; r < side; r++) {
+        /* most rows have no hit at all: one test for the row first */
+        uint64_t any = 0, word;
+        for (size_t at = 0; at < sizeof t->hits / POLYC__TILE_SIDE; at += sizeof word) {
+            memcpy(&word, (const char *)(t->hits + r * side) + at, sizeof word);
+            any |= word;
+        }
+        for (int32_t c = 0; any != 0 && c < side; c++)
+            if (t->hits[r * side + c] != 0 && cell_holds_data(ctx, t, r * side + c))
+                t->mark[r & block] |= 1u << (c & block);
+    }
+}
+
+/* Numbers tile t's marked blocks from n; returns the next number. */
+static uint32_t number_tile(polyc__tile *t, uint32_t n)
+{
+    t->mark_base = n;
+    uint32_t in_tile = 0;
+    for (int r = 0; r < POLYC__TILE_SIDE; r++) {
+        t->mark_row[r] = (uint16_t)in_tile;
+        uint32_t bits = t->mark[r];
+        while (bits) {
+            bits &= bits - 1;
+            in_tile++;
+        }
+    }
+    return n + in_tile;
+}
+
+/* Every tile's blocks marked and numbered in storage order; their count. */
 static uint32_t mark_blocks(polyc_ctx *ctx)
 {
     polyc__grid *g = &ctx->grid;
-    const int32_t side = POLYC__TILE_SIDE, block = ~(int32_t)(BLOCK_SIDE - 1);
-    for (uint32_t k = 0; k < g->tile_count; k++) {
-        polyc__tile *t = &g->tiles[k];
-        memset(t->mark, 0, sizeof t->mark);
-        for (int32_t r = 0; r < side; r++) {
-            /* most rows have no hit at all: one test for the row first */
-            uint64_t any = 0, word;
-            for (size_t at = 0; at < sizeof t->hits / POLYC__TILE_SIDE; at += sizeof word) {
-                memcpy(&word, (const char *)(t->hits + r * side) + at, sizeof word);
-                any |= word;
-            }
-            for (int32_t c = 0; any != 0 && c < side; c++)
-                if (t->hits[r * side + c] != 0 && cell_holds_data(ctx, t, r * side + c))
-                    t->mark[r & block] |= 1u << (c & block);
-        }
-    }
     uint32_t n = 0;
-    for (uint32_t k = 0; k < g->tile_count; k++) {
-        polyc__tile *t = &g->tiles[k];
-        t->mark_base = n;
-        uint32_t in_tile = 0;
-        for (int r = 0; r < POLYC__TILE_SIDE; r++) {
-            t->mark_row[r] = (uint16_t)in_tile;
-            uint32_t bits = t->mark[r];
-            while (bits) {
-                bits &= bits - 1;
-                in_tile++;
-            }
-        }
-        n += in_tile;
-    }
+    for (uint32_t k = 0; k < g->tile_count; k++)
+        mark_tile(ctx, &g->tiles[k]);
+    for (uint32_t k = 0; k < g->tile_count; k++)
+        n = number_tile(&g->tiles[k], n);
     return n;
 }
 
@@ -125,34 +132,38 @@ static uint32_t block_number(const polyc__tile *t, int32_t bx, int32_t by)
     return t->mark_base + t->mark_row[by & 31] + c;
 }
 
-/* Means and central moments from the sums; the cell of each point is found
- * again by walking the directory in the numbering order of the marks. */
+/* Means and central moments from the sums of the points of the tile at
+ * directory entry d, in the numbering order of its marks. */
+static void finish_tile(const polyc_ctx *ctx, int32_t d, polyc__point *tmp)
+{
+    const polyc__grid *g = &ctx->grid;
+    double ox = g->origin_x_m - ctx->frame_x, oy = g->origin_y_m - ctx->frame_y;
+    const polyc__tile *t = &g->tiles[g->dir[d] - 1];
+    int32_t tx = (d % g->tiles_x) << POLYC__TILE_SHIFT, ty = (d / g->tiles_x) << POLYC__TILE_SHIFT;
+    uint32_t k = t->mark_base;
+    for (int r = 0; r < POLYC__TILE_SIDE; r++)
+        for (int c = 0; t->mark[r] != 0 && c < POLYC__TILE_SIDE; c++) { /* most rows: none */
+            if (!((t->mark[r] >> c) & 1u))
+                continue;
+            polyc__point *p = &tmp[k++];
+            float mx = p->x / p->w, my = p->y / p->w;
+            p->cxx -= p->w * mx * mx;
+            p->cxy -= p->w * mx * my;
+            p->cyy -= p->w * my * my;
+            if (p->cxx < 0.0f) p->cxx = 0.0f;
+            if (p->cyy < 0.0f) p->cyy = 0.0f;
+            p->x = block_centre(ox, tx + c, g->cell_m) + mx;
+            p->y = block_centre(oy, ty + r, g->cell_m) + my;
+        }
+}
+
 static void finish_moments(polyc_ctx *ctx, polyc__point *tmp)
 {
-    polyc__grid *g = &ctx->grid;
-    double ox = g->origin_x_m - ctx->frame_x, oy = g->origin_y_m - ctx->frame_y;
+    const polyc__grid *g = &ctx->grid;
     int32_t dir_n = g->tiles_x * g->tiles_y;
-    for (int32_t d = 0; d < dir_n; d++) {
-        if (!g->dir[d])
-            continue;
-        const polyc__tile *t = &g->tiles[g->dir[d] - 1];
-        int32_t tx = (d % g->tiles_x) << POLYC__TILE_SHIFT, ty = (d / g->tiles_x) << POLYC__TILE_SHIFT;
-        uint32_t k = t->mark_base;
-        for (int r = 0; r < POLYC__TILE_SIDE; r++)
-            for (int c = 0; t->mark[r] != 0 && c < POLYC__TILE_SIDE; c++) { /* most rows: none */
-                if (!((t->mark[r] >> c) & 1u))
-                    continue;
-                polyc__point *p = &tmp[k++];
-                float mx = p->x / p->w, my = p->y / p->w;
-                p->cxx -= p->w * mx * mx;
-                p->cxy -= p->w * mx * my;
-                p->cyy -= p->w * my * my;
-                if (p->cxx < 0.0f) p->cxx = 0.0f;
-                if (p->cyy < 0.0f) p->cyy = 0.0f;
-                p->x = block_centre(ox, tx + c, g->cell_m) + mx;
-                p->y = block_centre(oy, ty + r, g->cell_m) + my;
-            }
-    }
+    for (int32_t d = 0; d < dir_n; d++)
+        if (g->dir[d])
+            finish_tile(ctx, d, tmp);
 }
 
 /* One weighted point per marked block, from the endpoints. */
@@ -194,51 +205,95 @@ static polyc_status collect_cells(polyc__opt *o, polyc__point *tmp, float *view,
     return POLYC_OK;
 }
 
-/* The same from the cells' sums (online: the scans are not kept). A
- * cell's offsets move to its block's centre by (dx, dy): the sums of
- * products gain the cross terms. */
+/* The sums of the cells of the tile at directory entry d (online: the
+ * scans are not kept) into its marked blocks' points. A cell's offsets
+ * move to its block's centre by (dx, dy): the sums of products gain the
+ * cross terms. Returns the endpoints taken. */
+static double sum_tile(const polyc_ctx *ctx, int32_t d, polyc__point *tmp, float *view)
+{
+    const polyc__online *on = ctx->online;
+    const polyc__grid *g = &ctx->grid;
+    const float half = 0.5f * (float)(BLOCK_SIDE - 1);
+    uint32_t k = g->dir[d] - 1;
+    const polyc__tile *t = &g->tiles[k];
+    const uint32_t *slot = on->slot + (size_t)k * POLYC__TILE_CELLS;
+    double raw = 0.0;
+    for (int idx = 0; idx < POLYC__TILE_CELLS; idx++) {
+        if (!slot[idx] || !t->hits[idx] || !cell_holds_data(ctx, t, idx))
+            continue;
+        const polyc__cell_sums *c = &on->sums[slot[idx] - 1];
+        int32_t ix = idx & (POLYC__TILE_SIDE - 1), iy = idx >> POLYC__TILE_SHIFT;
+        int32_t bx = ix & ~(int32_t)(BLOCK_SIDE - 1), by = iy & ~(int32_t)(BLOCK_SIDE - 1);
+        float dx = ((float)(ix - bx) - half) * g->cell_m, dy = ((float)(iy - by) - half) * g->cell_m;
+        float w = (float)c->n;
+        uint32_t at = block_number(t, bx, by);
+        polyc__point *p = &tmp[at];
+        view[2 * at] += c->vx;
+        view[2 * at + 1] += c->vy;
+        p->w += w;
+        p->x += c->fx + w * dx;
+        p->y += c->fy + w * dy;
+        p->cxx += c->fxx + 2.0f * dx * c->fx + w * dx * dx;
+        p->cxy += c->fxy + dx * c->fy + dy * c->fx + w * dx * dy;
+        p->cyy += c->fyy + 2.0f * dy * c->fy + w * dy * dy;
+        raw += (double)w;
+    }
+    return raw;
+}
+
 static polyc_status collect_sums(polyc__opt *o, polyc__point *tmp, float *view, int32_t cap,
                                  int32_t *n_out)
 {
     polyc_ctx *ctx = o->ctx;
-    const polyc__online *on = ctx->online;
     polyc__grid *g = &ctx->grid;
     uint32_t n = mark_blocks(ctx);
     if (n > (uint32_t)cap)
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "more weighted data points than limits.max_points");
     memset(tmp, 0, (size_t)n * sizeof *tmp);
     memset(view, 0, (size_t)n * 2 * sizeof *view);
-    const float half = 0.5f * (float)(BLOCK_SIDE - 1);
     int32_t dir_n = g->tiles_x * g->tiles_y;
-    for (int32_t d = 0; d < dir_n; d++) {
-        if (!g->dir[d])
-            continue;
-        uint32_t k = g->dir[d] - 1;
-        const polyc__tile *t = &g->tiles[k];
-        const uint32_t *slot = on->slot + (size_t)k * POLYC__TILE_CELLS;
-        for (int idx = 0; idx < POLYC__TILE_CELLS; idx++) {
-            if (!slot[idx] || !t->hits[idx] || !cell_holds_data(ctx, t, idx))
-                continue;
-            const polyc__cell_sums *c = &on->sums[slot[idx] - 1];
-            int32_t ix = idx & (POLYC__TILE_SIDE - 1), iy = idx >> POLYC__TILE_SHIFT;
-            int32_t bx = ix & ~(int32_t)(BLOCK_SIDE - 1), by = iy & ~(int32_t)(BLOCK_SIDE - 1);
-            float dx = ((float)(ix - bx) - half) * g->cell_m, dy = ((float)(iy - by) - half) * g->cell_m;
-            float w = (float)c->n;
-            uint32_t at = block_number(t, bx, by);
-            polyc__point *p = &tmp[at];
-            view[2 * at] += c->vx;
-            view[2 * at + 1] += c->vy;
-            p->w += w;
-            p->x += c->fx + w * dx;
-            p->y += c->fy + w * dy;
-            p->cxx += c->fxx + 2.0f * dx * c->fx + w * dx * dx;
-            p->cxy += c->fxy + dx * c->fy + dy * c->fx + w * dx * dy;
-            p->cyy += c->fyy + 2.0f * dy * c->fy + w * dy * dy;
+    polyc__online *on = ctx->online;
+    for (int32_t d = 0; d < dir_n; d++)
+        if (g->dir[d]) {
+            /* tile k's points are numbered up to tile k + 1's first */
+            uint32_t k = g->dir[d] - 1;
+            uint32_t end = k + 1 < g->tile_count ? g->tiles[k + 1].mark_base : n;
+            for (uint32_t i = g->tiles[k].mark_base; i < end; i++)
+                on->fresh_tile[i] = (uint32_t)d;
+            on->tile_raw[k] = sum_tile(ctx, d, tmp, view);
         }
-    }
     finish_moments(ctx, tmp);
     *n_out = (int32_t)n;
     return POLYC_OK;
+}
+
+int32_t polyc__points_of_tiles(polyc__opt *o, const uint32_t *dirs, uint32_t nd, polyc__point *out,
+                               float *view, uint32_t *tile, int32_t cap, double *tile_raw)
+{
+    polyc_ctx *ctx = o->ctx;
+    polyc__grid *g = &ctx->grid;
+    uint32_t n = 0;
+    for (uint32_t j = 0; j < nd; j++)
+        if (g->dir[dirs[j]]) {
+            polyc__tile *t = &g->tiles[g->dir[dirs[j]] - 1];
+            mark_tile(ctx, t);
+            uint32_t next = number_tile(t, n);
+            if (next > (uint32_t)cap)
+                return -1;
+            for (uint32_t i = n; i < next; i++)
+                tile[i] = dirs[j];
+            n = next;
+        }
+    memset(out, 0, (size_t)n * sizeof *out);
+    memset(view, 0, (size_t)n * 2 * sizeof *view);
+    for (uint32_t j = 0; j < nd; j++)
+        if (g->dir[dirs[j]]) {
+            tile_raw[g->dir[dirs[j]] - 1] = sum_tile(ctx, (int32_t)dirs[j], out, view);
+            finish_tile(ctx, (int32_t)dirs[j], out);
+        }
+    for (uint32_t i = 0; i < n; i++)
+        polyc__point_weigh(&o->prior, &out[i]);
+    return (int32_t)n;
 }
 
 static polyc_status collect_raw(polyc__opt *o, polyc__point *tmp, float *view, int32_t cap,
@@ -327,6 +382,19 @@ static polyc_status collect_occupied(polyc__opt *o, polyc__point *tmp, int32_t c
     return POLYC_OK;
 }
 
+/* Where the scans disagree beyond the sensor's accuracy, their points
+ * weigh less (accuracy.c); the BIC's n stays the count of endpoints. */
+void polyc__point_weigh(const polyc__prior *prior, polyc__point *p)
+{
+    float f = polyc__accuracy_weight(prior, p->x, p->y);
+    if (f < 1.0f) {
+        p->w *= f;
+        p->cxx *= f;
+        p->cxy *= f;
+        p->cyy *= f;
+    }
+}
+
 int polyc__points_viewed(const polyc_ctx *ctx)
 {
     return !ctx->from_grid && ctx->lim.max_scans > 1;
@@ -347,6 +415,17 @@ static int points_carve(polyc__arena *a, int32_t cap, int viewed, polyc__point *
     *pts = polyc__alloc(a, (size_t)cap, sizeof(polyc__point));
     *view = viewed ? polyc__alloc(a, (size_t)cap, 2 * sizeof(float)) : NULL;
     return *pts && (!viewed || *view);
+}
+
+/* The span of one weighted point: gaps between points shorter than it say
+ * nothing (split); and how near a point supports the map. */
+void polyc__points_spans(polyc__opt *o, int exact)
+{
+    const polyc_ctx *ctx = o->ctx;
+    o->d.point_span_m = ctx->from_grid ? ctx->grid.cell_m
+                      : exact        ? 0.0f
+                                     : ctx->grid.cell_m * (float)BLOCK_SIDE;
+    o->d.support_m = polyc__maxf(POLYC__SUPPORT_M, o->d.point_span_m);
 }
 
 /* online: the points and their unsorted copy, carved once */
@@ -404,15 +483,7 @@ polyc_status polyc__points_collect(polyc__opt *o)
     for (int32_t i = 0; i < n; i++) {
         h->pt_start[polyc__bucket_of(h, tmp[i].x, tmp[i].y) + 1]++;
         total += (double)tmp[i].w;
-        /* where the scans disagree beyond the sensor's accuracy, their
-         * points weigh less (accuracy.c); n stays the count of endpoints */
-        float f = polyc__accuracy_weight(&o->prior, tmp[i].x, tmp[i].y);
-        if (f < 1.0f) {
-            tmp[i].w *= f;
-            tmp[i].cxx *= f;
-            tmp[i].cxy *= f;
-            tmp[i].cyy *= f;
-        }
+        polyc__point_weigh(&o->prior, &tmp[i]);
     }
     for (int32_t b = 0; b < nb; b++)
         h->pt_start[b + 1] += h->pt_start[b];
@@ -420,6 +491,8 @@ polyc_status polyc__points_collect(polyc__opt *o)
         int32_t b = polyc__bucket_of(h, tmp[i].x, tmp[i].y);
         uint32_t at = h->pt_start[b]++;
         o->d.pts[at] = tmp[i];
+        if (ctx->online)
+            ctx->online->pt_tile[at] = ctx->online->fresh_tile[i];
         if (tmp_view) {
             o->d.pt_view[2 * at] = tmp_view[2 * i];
             o->d.pt_view[2 * at + 1] = tmp_view[2 * i + 1];
@@ -431,12 +504,7 @@ polyc_status polyc__points_collect(polyc__opt *o)
     ctx->arena.used = mark;
     o->d.np = n;
     o->d.n = total;
-    /* the span of one weighted point: gaps between points shorter than it
-     * say nothing (split) */
-    o->d.point_span_m = ctx->from_grid ? ctx->grid.cell_m
-                      : exact        ? 0.0f
-                                     : ctx->grid.cell_m * (float)BLOCK_SIDE;
-    o->d.support_m = polyc__maxf(POLYC__SUPPORT_M, o->d.point_span_m);
+    polyc__points_spans(o, exact);
     ctx->stats.data_points = (uint64_t)total;
     ctx->stats.weighted_points = (uint32_t)n;
     return POLYC_OK;

@@ -83,12 +83,22 @@ static int record(prior_pass *q, float x, float y, int bin, uint32_t inc)
     if (*row == 0) { /* the block holds a row for every cell */
         *row = ++p->rows;
         memset(p->hist + (size_t)(*row - 1) * BINS, 0, BINS * sizeof(uint16_t));
+        if (p->total) /* online: the totals are kept as counts come */
+            p->total[*row - 1] = 0;
     }
     uint16_t *c = p->hist + (size_t)(*row - 1) * BINS;
-    if (c[bin] > UINT16_MAX - inc)
-        for (int k = 0; k < BINS; k++)
+    if (c[bin] > UINT16_MAX - inc) {
+        uint32_t n = 0;
+        for (int k = 0; k < BINS; k++) {
             c[k] = (uint16_t)(c[k] >> 1);
+            n += c[k];
+        }
+        if (p->total)
+            p->total[*row - 1] = n;
+    }
     c[bin] = (uint16_t)(c[bin] + inc);
+    if (p->total)
+        p->total[*row - 1] += inc;
     return 1;
 }
 

@@ -244,6 +244,12 @@ static int32_t cut_tips(polyc__opt *o, int32_t nv)
  * whose ends and points are what they were when it was last found whole
  * is whole still (the search calls this several times an iteration, and
  * between two calls most segments did not change). */
+/* split looks at the segments due (in the region) */
+static int split_wants(const polyc__opt *o, int32_t v)
+{
+    return o->split_due[v] && polyc__in_region(o, v);
+}
+
 int polyc__op_split(polyc__opt *o)
 {
     polyc__store *s = o->s;
@@ -251,19 +257,24 @@ int polyc__op_split(polyc__opt *o)
     int32_t *off = o->split.split_off;
     float *t = o->split.split_t;
     const uint8_t *due = o->split_due;
+    int32_t np = polyc__region_points(o, split_wants);
+    const int32_t *list = np >= 0 ? o->region_pt : NULL;
+    np = np >= 0 ? np : o->d.np;
     for (int32_t v = 0; v <= nv; v++)
         off[v] = 0;
-    for (int32_t i = 0; i < o->d.np; i++) {
+    for (int32_t j = 0; j < np; j++) {
+        int32_t i = list ? list[j] : j;
         int32_t sg = o->d.pt_seg[i];
-        if (sg != POLYC__NONE && due[sg] && supports(o, i, sg))
+        if (sg != POLYC__NONE && split_wants(o, sg) && supports(o, i, sg))
             off[sg + 1]++;
     }
     for (int32_t v = 0; v < nv; v++)
         off[v + 1] += off[v];
     /* fill: positions along the segment, metres */
-    for (int32_t i = 0; i < o->d.np; i++) {
+    for (int32_t j = 0; j < np; j++) {
+        int32_t i = list ? list[j] : j;
         int32_t sg = o->d.pt_seg[i];
-        if (sg == POLYC__NONE || !due[sg] || !supports(o, i, sg))
+        if (sg == POLYC__NONE || !split_wants(o, sg) || !supports(o, i, sg))
             continue;
         const polyc__vertex *a = &s->v[sg], *b = &s->v[a->next];
         float dx = b->x - a->x, dy = b->y - a->y;
@@ -279,7 +290,7 @@ int polyc__op_split(polyc__opt *o)
     float gap_min = o->cfg->split_gap_m;
     for (int32_t v = 0; v < nv; v++) {
         const polyc__vertex *a = &s->v[v];
-        if (!due[v] || a->line == POLYC__NONE || a->next == POLYC__NONE)
+        if (!due[v] || a->line == POLYC__NONE || a->next == POLYC__NONE || !polyc__in_region(o, v))
             continue;
         const polyc__vertex *b = &s->v[a->next];
         float len = sqrtf((b->x - a->x) * (b->x - a->x) + (b->y - a->y) * (b->y - a->y));
@@ -351,14 +362,25 @@ static int trim_loses_returns(const polyc__opt *o, int32_t v, float x, float y)
  * farthest projection of the points of its segment that lie within
  * POLYC__SUPPORT_M of it (of all its points in a single scan, whose beams
  * place its ends), plus half a beam spacing (at least 1 cm). */
+/* trimming looks at the end segments (in the region) */
+static int trim_wants(const polyc__opt *o, int32_t v)
+{
+    const polyc__vertex *a = &o->s->v[v];
+    return (a->prev == POLYC__NONE || o->s->v[a->next].next == POLYC__NONE) && polyc__in_region(o, v);
+}
+
 int polyc__op_trim_ends(polyc__opt *o)
 {
     polyc__store *s = o->s;
     int32_t nv = s->v_high;
+    int32_t np = polyc__region_points(o, trim_wants);
+    const int32_t *list = np >= 0 ? o->region_pt : NULL;
+    np = np >= 0 ? np : o->d.np;
     /* per end segment: farthest projection (metres from the inner vertex) */
     for (int32_t v = 0; v < nv; v++)
         o->split.split_t[v] = o->split.trim_head[v] = -1.0f;
-    for (int32_t i = 0; i < o->d.np; i++) {
+    for (int32_t j = 0; j < np; j++) {
+        int32_t i = list ? list[j] : j;
         int32_t sg = o->d.pt_seg[i];
         if (sg == POLYC__NONE || (!o->rays.on && !supports(o, i, sg)))
             continue;
@@ -381,7 +403,7 @@ int polyc__op_trim_ends(polyc__opt *o)
     int changed = 0;
     for (int32_t v = 0; v < nv; v++) {
         const polyc__vertex *a = &s->v[v];
-        if (a->line == POLYC__NONE || a->next == POLYC__NONE)
+        if (a->line == POLYC__NONE || a->next == POLYC__NONE || !polyc__in_region(o, v))
             continue;
         int32_t w = a->next;
         float ax = a->x, ay = a->y, bx = s->v[w].x, by = s->v[w].y;

@@ -1,0 +1,502 @@
+/* online.c - an online context: sized from an area, it takes scans one at
+ * a time into what the batch stages would compute from all of them (the
+ * grid's counts, each cell's endpoint sums, the contour, the angle prior
+ * and the accuracy), remembers the tiles they changed (the backlog), and
+ * keeps the scans the caller asks it to, so that their poses can be
+ * corrected. Takes: scans, corrections. Gives: the state online_round.c
+ * re-optimises the map from. */
+#include "online.h"
+#include "walk.h"
+
+#include <math.h>
+#include <string.h>
+
+/* A tile joins the backlog when the endpoints that came in (or went out)
+ * since its points were last made reach this share of those it held then:
+ * where the map is seen again and again, a scan changes a tile's data by a
+ * few per cent, too little to move a vertex, and the update leaves it;
+ * where the robot sees something new, the first endpoints count whole. */
+#define CHANGE_SHARE 0.25
+/* and at least this many endpoints: a few far returns a scan (a sparse
+ * tile) wait for the next */
+#define CHANGE_MIN 16u
+
+/* Endpoints and poses must stay this far inside the area: vertices may
+ * wander a little past the data (the spatial hash's own margin is 2 m). */
+#define AREA_MARGIN_M 1.0
+
+void polyc__online_stage_limits(const polyc_online_limits *ol, polyc_limits *lim)
+{
+    memset(lim, 0, sizeof *lim);
+    /* the current scan's slot and the kept ones' (at least two: the stages
+     * size for scans, not for a single scan's chains) */
+    lim->max_scans = 2 + ol->keep_scans;
+    /* the stages size their bucket and point arrays from max_beams: here
+     * the data cells stand for the beams of a batch context */
+    uint64_t beams = (uint64_t)ol->max_scan_beams + ol->keep_beams + ol->max_points;
+    lim->max_beams = beams > 0x7fffffffu ? 0x7fffffffu : (uint32_t)beams;
+    lim->max_grid_cells = ol->max_grid_cells;
+    lim->max_vertices = ol->max_vertices;
+    /* a weighted point gathers the data cells of a 2 x 2 block: half of
+     * them is room for blocks of under two cells on average (intel's hold
+     * 2.5, freiburg-079's 7) */
+    lim->max_points = ol->max_points / 2 > 16 ? ol->max_points / 2 : 16;
+}
+
+static int limits_ok(const polyc_online_limits *ol)
+{
+    return ol->area_m > 1.0 && ol->area_m <= 1e5 && ol->max_grid_cells >= POLYC__TILE_CELLS &&
+           ol->max_grid_cells <= 0x40000000u && ol->max_vertices >= 16 &&
+           ol->max_vertices <= 0x10000000u && ol->max_points >= 16 && ol->max_points <= 0x10000000u &&
+           ol->max_scan_beams > 0 && ol->max_scan_beams <= 0x1000000u &&
+           ol->keep_beams <= 0x10000000u && ol->keep_scans <= 0x1000000u && ol->reserved == 0;
+}
+
+polyc_status polyc_online_limits_for_area(const polyc_config *config, double area_m,
+                                          uint32_t max_scan_beams, polyc_online_limits *out)
+{
+    if (!config || !out)
+        return POLYC_ERR_NULL;
+    if (polyc_config_check(config, NULL) != POLYC_OK)
+        return POLYC_ERR_CONFIG;
+    memset(out, 0, sizeof *out);
+    if (!(area_m > 1.0 && area_m <= 1e5) || max_scan_beams == 0)
+        return POLYC_ERR_CONFIG;
+    double side = ceil(area_m / (double)config->cell_m / POLYC__TILE_SIDE);
+    double tiles = side * side;
+    /* a building's walls reach a quarter of the square's tiles at most
+     * (intel: 817 of its 2,254 bounding-box tiles hold a hit); a small
+     * square is taken whole */
+    double stored = tiles <= 256.0 ? tiles : fmax(256.0, ceil(tiles / 4.0));
+    double cells = fmin(stored * POLYC__TILE_CELLS, 0x40000000);
+    /* endpoints fall in one cell in 15 of a stored tile on intel (57,712
+     * cells in 851 tiles), one in 5 on freiburg-079 (143,127 in 720, long
+     * range in a small building): room for one in 4; vertices one per 64
+     * such cells */
+    double points = fmin(fmax(cells / 4.0, 4096.0), 0x10000000);
+    out->area_m = area_m;
+    out->max_grid_cells = (uint32_t)cells;
+    out->max_points = (uint32_t)points;
+    out->max_vertices = (uint32_t)(points / 64.0) + 2048;
+    out->max_scan_beams = max_scan_beams;
+    return POLYC_OK;
+}
+
+/* Everything an online context carves, in the block's order, on the block
+ * or on the size query's counting arena (nothing is written then); the
+ * grid's tiles come last, as beams reach them. ctx->cfg and ctx->lim are set. */
+static int lay_out(polyc_ctx *ctx, polyc__online *on, polyc__arena *a)
+{
+    const polyc_online_limits *ol = &on->lim;
+    int ok = 1;
+    uint32_t slots = ctx->lim.max_scans;
+    POLYC__CARVE(ok, a, ctx->scans, slots);
+    POLYC__CARVE(ok, a, ctx->ranges, (size_t)ol->max_scan_beams + ol->keep_beams);
+    POLYC__CARVE(ok, a, on->kept_id, ol->keep_scans + 1);
+    int32_t V = polyc__max_vertices(&ctx->lim);
+    if (!ok || !polyc__store_init(a, &ctx->store, V))
+        return 0;
+    int32_t lines = polyc__line_cap(V);
+    if (a->base)
+        ok &= polyc__flat_init(a, &ctx->flat, (uint32_t)lines, (uint32_t)V);
+    else
+        polyc__flat_reserve(a, V);
+    polyc__online_pub_carve(a, on, lines);
+    ok &= on->pub && on->pub_next && on->gone;
+    /* the grid's geometry first (its directory is carved last) */
+    polyc__arena probe;
+    polyc__arena_counting(&probe);
+    polyc__arena saved = ctx->arena;
+    ctx->arena = probe;
+    polyc_status st = polyc__grid_online_init(ctx, ol->area_m, ol->max_grid_cells);
+    ctx->arena = saved;
+    if (st != POLYC_OK)
+        return 0;
+    size_t dir_n = (size_t)ctx->grid.tiles_x * (size_t)ctx->grid.tiles_y;
+    uint32_t tile_cap = ctx->grid.tile_cap;
+    ok &= polyc__prior_online(ctx, &on->prior, &on->acc, a);
+    POLYC__CARVE_ZERO(ok, a, on->slot, (size_t)tile_cap * POLYC__TILE_CELLS);
+    POLYC__CARVE(ok, a, on->sums, ol->max_points);
+    POLYC__CARVE_ZERO(ok, a, on->pose_bits, dir_n / 32 + 1);
+    POLYC__CARVE(ok, a, on->spacing_dist, dir_n);
+    POLYC__CARVE_ZERO(ok, a, on->dirty_since, dir_n);
+    POLYC__CARVE(ok, a, on->dirty, dir_n);
+    on->cells_cap = ol->max_points + 1;
+    POLYC__CARVE(ok, a, on->cells, 2 * (size_t)on->cells_cap);
+    POLYC__CARVE(ok, a, on->learn_cache, 3 * (size_t)ol->max_scan_beams);
+    ok = ok && polyc__opt_carve_online(ctx, a, &on->opt);
+    if (!ok)
+        return 0;
+    size_t P = (size_t)polyc__points_bound(&ctx->cfg, &ctx->lim), nb = (size_t)on->opt.h.bx * (size_t)on->opt.h.by;
+    POLYC__CARVE(ok, a, on->alt_pts, P);
+    POLYC__CARVE(ok, a, on->alt_view, 2 * P);
+    POLYC__CARVE(ok, a, on->alt_seg, P);
+    POLYC__CARVE(ok, a, on->alt_cost, P);
+    POLYC__CARVE(ok, a, on->alt_tile, P);
+    POLYC__CARVE(ok, a, on->pt_tile, P);
+    POLYC__CARVE(ok, a, on->fresh_tile, P);
+    POLYC__CARVE(ok, a, on->fresh_bucket, P);
+    POLYC__CARVE(ok, a, on->alt_start, nb + 1);
+    POLYC__CARVE(ok, a, on->bucket_fill, nb);
+    POLYC__CARVE_ZERO(ok, a, on->tile_raw, tile_cap);
+    POLYC__CARVE_ZERO(ok, a, on->tile_new, tile_cap);
+    if (!ok)
+        return 0;
+    saved = ctx->arena;
+    ctx->arena = *a;
+    st = polyc__grid_online_init(ctx, ol->area_m, ol->max_grid_cells);
+    *a = ctx->arena;
+    ctx->arena = saved;
+    if (st != POLYC_OK)
+        return 0;
+    /* the tiles, and above them an update's scratch: the trace's walk */
+    a->peak = polyc__add(a->used, polyc__add(polyc__bytes(tile_cap, sizeof(polyc__tile)),
+                                             polyc__bytes(2 * (size_t)on->cells_cap + 2,
+                                                          sizeof(int32_t))));
+    return 1;
+}
+
+static size_t header_bytes(void)
+{
+    return polyc__add(polyc__bytes(1, sizeof(polyc_ctx)), polyc__bytes(1, sizeof(polyc__online)));
+}
+
+size_t polyc_online_memory_size(const polyc_config *config, const polyc_online_limits *limits)
+{
+    if (!config || !limits || polyc_config_check(config, NULL) != POLYC_OK || !limits_ok(limits))
+        return 0;
+    polyc_ctx ctx;
+    polyc__online on;
+    memset(&ctx, 0, sizeof ctx);
+    memset(&on, 0, sizeof on);
+    ctx.cfg = *config;
+    on.lim = *limits;
+    ctx.online = &on;
+    polyc__online_stage_limits(limits, &ctx.lim);
+    polyc__arena_counting(&ctx.arena);
+    polyc__arena a;
+    polyc__arena_counting(&a);
+    if (!lay_out(&ctx, &on, &a))
+        return 0;
+    size_t n = polyc__add(polyc__add(header_bytes(), 32), a.peak);
+    return n == SIZE_MAX ? 0 : n;
+}
+
+polyc_status polyc_online_init(void *block, size_t size, const polyc_config *config,
+                               const polyc_online_limits *limits, polyc_ctx **out)
+{
+    if (!out)
+        return POLYC_ERR_NULL;
+    *out = NULL;
+    if (!block || !config || !limits)
+        return POLYC_ERR_NULL;
+    if (polyc_config_check(config, NULL) != POLYC_OK || !limits_ok(limits))
+        return POLYC_ERR_CONFIG;
+    size_t need = polyc_online_memory_size(config, limits);
+    if (need == 0)
+        return POLYC_ERR_CONFIG;
+    if (size < need)
+        return POLYC_ERR_NOMEM;
+    uintptr_t p = ((uintptr_t)block + 15u) & ~(uintptr_t)15u;
+    size_t skew = (size_t)(p - (uintptr_t)block);
+    polyc_ctx *ctx = (polyc_ctx *)p;
+    memset(ctx, 0, sizeof *ctx);
+    polyc__online *on = (polyc__online *)((unsigned char *)p + polyc__bytes(1, sizeof(polyc_ctx)));
+    memset(on, 0, sizeof *on);
+    ctx->magic = POLYC__MAGIC;
+    ctx->cfg = *config;
+    ctx->online = on;
+    on->lim = *limits;
+    polyc__online_stage_limits(limits, &ctx->lim);
+    size_t head = header_bytes();
+    ctx->arena.base = (unsigned char *)p + head;
+    ctx->arena.size = size - skew - head;
+    polyc__arena a = ctx->arena;
+    if (!lay_out(ctx, on, &a))
+        return POLYC_ERR_NOMEM;
+    ctx->arena = a;
+    ctx->arena.peak = ctx->arena.used;
+    ctx->flat.count = 0;
+    ctx->frame_dir.cos = 1.0;
+    ctx->stats.memory_size_bytes = size;
+    ctx->stage = POLYC__STAGE_SCANS;
+    ctx->err.scan = -1;
+    *out = ctx;
+    return POLYC_OK;
+}
+
+/* ---- one scan in (or out) ---- */
+
+static void mark_dirty(polyc__online *on, size_t d)
+{
+    if (on->dirty_since[d] == 0) {
+        on->dirty_since[d] = on->scans + 1;
+        on->dirty[on->dirty_n++] = (uint32_t)d;
+    }
+}
+
+void polyc__online_backlog_all(polyc_ctx *ctx)
+{
+    const polyc__grid *g = &ctx->grid;
+    size_t dir_n = (size_t)g->tiles_x * (size_t)g->tiles_y;
+    for (size_t d = 0; d < dir_n; d++)
+        if (g->dir[d])
+            mark_dirty(ctx->online, d);
+}
+
+/* The tile index of cell (ix, iy) inside the grid, or -1. */
+static int64_t tile_of(const polyc__grid *g, int32_t ix, int32_t iy)
+{
+    if (ix < 0 || iy < 0 || ix >= g->width || iy >= g->height)
+        return -1;
+    return (int64_t)(iy >> POLYC__TILE_SHIFT) * g->tiles_x + (ix >> POLYC__TILE_SHIFT);
+}
+
+/* Each endpoint into its cell's sums (sign -1: out again); the tiles they
+ * fall in join the backlog. 0 when the sums are used up. */
+static int sum_endpoints(polyc_ctx *ctx, const polyc__scan *s, float sign)
+{
+    polyc__online *on = ctx->online;
+    const polyc__grid *g = &ctx->grid;
+    int ok = 1;
+    for (uint32_t i = 0; i < s->count; i++) {
+        polyc__beam b;
+        if (!polyc__beam_path(ctx, s, i, &b) || !b.hit)
+            continue;
+        float fx = floorf(b.ex), fy = floorf(b.ey);
+        int32_t ix = (int32_t)fx, iy = (int32_t)fy;
+        int64_t d = tile_of(g, ix, iy);
+        if (d < 0 || g->dir[d] == 0)
+            continue;
+        uint32_t k = g->dir[d] - 1;
+        if (++on->tile_new[k] >= CHANGE_MIN && (double)on->tile_new[k] >= CHANGE_SHARE * on->tile_raw[k])
+            mark_dirty(on, (size_t)d);
+        uint32_t *slot = &on->slot[(size_t)(g->dir[d] - 1) * POLYC__TILE_CELLS + (size_t)polyc__cell_index(ix, iy)];
+        if (*slot == 0) {
+            if (sign < 0.0f)
+                continue;
+            uint32_t e;
+            if (on->sums_free) {
+                e = on->sums_free - 1;
+                on->sums_free = on->sums[e].n;
+            } else if (on->sums_n < on->lim.max_points) {
+                e = on->sums_n++;
+            } else {
+                ok = 0;
+                continue;
+            }
+            memset(&on->sums[e], 0, sizeof on->sums[0]);
+            *slot = e + 1;
+        }
+        polyc__cell_sums *c = &on->sums[*slot - 1];
+        float ox = (b.ex - fx - 0.5f) * g->cell_m, oy = (b.ey - fy - 0.5f) * g->cell_m;
+        c->fx += sign * ox;
+        c->fy += sign * oy;
+        c->fxx += sign * ox * ox;
+        c->fxy += sign * ox * oy;
+        c->fyy += sign * oy * oy;
+        c->vx += sign * (b.sx - b.ex) * g->cell_m;
+        c->vy += sign * (b.sy - b.ey) * g->cell_m;
+        c->n = sign > 0.0f ? c->n + 1 : (c->n > 0 ? c->n - 1 : 0);
+        if (c->n == 0) { /* its last endpoint went (a correction): the entry is free */
+            c->n = on->sums_free;
+            on->sums_free = *slot;
+            *slot = 0;
+        }
+    }
+    return ok;
+}
+
+/* Labels the first occupied cell along each beam as contour, on the grid
+ * as it stands with this scan counted (the batch casts once more on the
+ * final grid). */
+static void label_contour(polyc_ctx *ctx, const polyc__scan *s)
+{
+    const polyc__grid *g = &ctx->grid;
+    float thr = ctx->cfg.contour_threshold;
+    for (uint32_t i = 0; i < s->count; i++) {
+        polyc__beam b;
+        if (!polyc__beam_path(ctx, s, i, &b))
+            continue;
+        polyc__walk w;
+        polyc__walk_start(&w, &b);
+        int32_t cx = w.ex, cy = w.ey;
+        while (w.n > 0) {
+            polyc__tile *t = polyc__grid_tile(g, w.ix, w.iy);
+            if (t && polyc__cell_occupied(t, polyc__cell_index(w.ix, w.iy), thr)) {
+                cx = w.ix;
+                cy = w.iy;
+                break;
+            }
+            polyc__walk_step(&w);
+        }
+        polyc__tile *t = polyc__grid_tile(g, cx, cy);
+        if (t && polyc__cell_occupied(t, polyc__cell_index(cx, cy), thr))
+            t->contour[cy & (POLYC__TILE_SIDE - 1)] |= 1u << (cx & (POLYC__TILE_SIDE - 1));
+    }
+}
+
+/* The scan's beams into the grid, its endpoints into the sums, its first
+ * occupied cells into the contour, its lines into the prior; or, with
+ * take_back, its counts and sums out again (the prior and the contour keep
+ * what it gave: see docs/algorithm.md, "Online"). */
+static polyc_status accumulate(polyc_ctx *ctx, const polyc__scan *s, uint32_t number, int take_back)
+{
+    polyc__online *on = ctx->online;
+    const polyc__grid *g = &ctx->grid;
+    polyc_status st = polyc__grid_add_scan(ctx, s, take_back);
+    int sums_ok = sum_endpoints(ctx, s, take_back ? -1.0f : 1.0f);
+    if (take_back)
+        return st;
+    label_contour(ctx, s);
+    polyc__prior_learn_scan(ctx, &on->prior, s, number, on->learn_cache, on->lim.max_scan_beams, &on->acc);
+    int64_t d = tile_of(g, (int32_t)floorf((float)((double)s->x_m - (g->origin_x_m - ctx->frame_x)) * g->inv_cell),
+                        (int32_t)floorf((float)((double)s->y_m - (g->origin_y_m - ctx->frame_y)) * g->inv_cell));
+    if (d >= 0 && !((on->pose_bits[d >> 5] >> (d & 31)) & 1u)) {
+        on->pose_bits[d >> 5] |= 1u << (d & 31);
+        on->spacing_stale = 1;
+    }
+    if (s->count > 1 && (on->min_step_rad == 0.0f || fabsf(s->step_rad) < on->min_step_rad))
+        on->min_step_rad = fabsf(s->step_rad);
+    on->last_x = s->x_m;
+    on->last_y = s->y_m;
+    if (st == POLYC_OK && !sums_ok)
+        st = polyc__fail(ctx, POLYC_ERR_NOMEM, "more cells with endpoints than limits.max_points");
+    return st;
+}
+
+/* Whether the scan at its pose lies inside the area (frame metres). */
+static int inside_area(const polyc_ctx *ctx, const polyc_scan *s)
+{
+    double box[4] = {0.0, 0.0, 0.0, 0.0};
+    int have = 0;
+    polyc__extent_add(s, ctx->frame_x, ctx->frame_y, box, &have);
+    double half = 0.5 * ctx->online->lim.area_m - AREA_MARGIN_M;
+    return !have || (box[0] > -half && box[1] > -half && box[2] < half && box[3] < half);
+}
+
+/* The stored form of a scan (pose relative to the frame). */
+static void store_scan(polyc_ctx *ctx, polyc__scan *d, const polyc_scan *s, uint32_t first)
+{
+    d->x_m = (float)(s->pose_x_m - ctx->frame_x);
+    d->y_m = (float)(s->pose_y_m - ctx->frame_y);
+    d->theta_rad = (float)remainder(s->pose_theta_rad, 6.283185307179586);
+    d->start_rad = s->start_angle_rad;
+    d->step_rad = s->angle_step_rad;
+    d->min_m = s->min_range_m;
+    d->max_m = s->max_range_m;
+    d->first = first;
+    d->count = s->beam_count;
+}
+
+polyc_status polyc_online_add_scan(polyc_ctx *ctx, const polyc_scan *s, int keep, uint32_t *scan_id)
+{
+    polyc_status cst = polyc__check_ctx(ctx);
+    if (cst != POLYC_OK || !s)
+        return cst != POLYC_OK ? cst : POLYC_ERR_NULL;
+    ctx->err.msg = NULL;
+    polyc__online *on = ctx->online;
+    if (!on)
+        return polyc__fail(ctx, POLYC_ERR_STATE, "not an online context (polyc_online_init)");
+    if (s->beam_count && !s->range_m)
+        return polyc__fail(ctx, POLYC_ERR_NULL, "scan.range_m is NULL with beams");
+    const char *bad = polyc__scan_problem(s);
+    if (bad) {
+        ctx->err.scan = (int32_t)on->scans;
+        return polyc__fail(ctx, POLYC_ERR_SCAN, bad);
+    }
+    if (s->beam_count > on->lim.max_scan_beams)
+        return polyc__fail(ctx, POLYC_ERR_LIMIT, "a scan with more beams than limits.max_scan_beams");
+    if (keep && (on->kept_n >= on->lim.keep_scans || s->beam_count > on->lim.keep_beams - on->kept_beams))
+        return polyc__fail(ctx, POLYC_ERR_LIMIT, "no room to keep the scan (limits.keep_scans, keep_beams)");
+    if (!ctx->have_frame) {
+        ctx->frame_x = s->pose_x_m;
+        ctx->frame_y = s->pose_y_m;
+        ctx->grid.origin_x_m += ctx->frame_x; /* laid out around (0, 0) */
+        ctx->grid.origin_y_m += ctx->frame_y;
+        ctx->have_frame = 1;
+    }
+    if (!inside_area(ctx, s))
+        return polyc__fail(ctx, POLYC_ERR_EXTENT, "the scan reaches outside limits.area_m around the first pose");
+    /* the current scan is slot 0; a kept one has its own slot and ranges */
+    polyc__scan *d = &ctx->scans[0];
+    uint32_t first = 0;
+    if (keep) {
+        d = &ctx->scans[1 + on->kept_n];
+        first = on->lim.max_scan_beams + on->kept_beams;
+    }
+    store_scan(ctx, d, s, first);
+    for (uint32_t i = 0; i < s->beam_count; i++) {
+        float r = s->range_m[i];
+        if (!(r >= 0.0f))
+            ctx->stats.beams_skipped++;
+        else if (r >= s->min_range_m && r < s->max_range_m)
+            ctx->stats.hits++;
+        ctx->ranges[first + i] = r;
+    }
+    if (keep) {
+        on->kept_id[on->kept_n++] = on->scans;
+        on->kept_beams += s->beam_count;
+    }
+    polyc_status st = accumulate(ctx, d, on->scans, 0);
+    if (scan_id)
+        *scan_id = on->scans;
+    on->scans++;
+    on->pending++;
+    ctx->stats.scans = on->scans;
+    ctx->stats.beams += s->beam_count;
+    return st;
+}
+
+polyc_status polyc_online_correct(polyc_ctx *ctx, uint32_t scan_id, double pose_x_m,
+                                  double pose_y_m, double pose_theta_rad)
+{
+    polyc_status cst = polyc__check_ctx(ctx);
+    if (cst != POLYC_OK)
+        return cst;
+    ctx->err.msg = NULL;
+    polyc__online *on = ctx->online;
+    if (!on)
+        return polyc__fail(ctx, POLYC_ERR_STATE, "not an online context (polyc_online_init)");
+    uint32_t lo = 0, hi = on->kept_n;
+    while (lo < hi) { /* kept_id ascends */
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (on->kept_id[mid] < scan_id)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    if (lo >= on->kept_n || on->kept_id[lo] != scan_id)
+        return polyc__fail(ctx, POLYC_ERR_RANGE, "the scan was not kept (polyc_online_add_scan's keep)");
+    if (!polyc__pose_ok(pose_x_m, pose_y_m, pose_theta_rad))
+        return polyc__fail(ctx, POLYC_ERR_SCAN, "scan pose is not finite or beyond 1e7 m");
+    polyc__scan *d = &ctx->scans[1 + lo];
+    /* the scan as the caller gave it, at the new pose, for the area check */
+    polyc_scan moved;
+    memset(&moved, 0, sizeof moved);
+    moved.pose_x_m = pose_x_m;
+    moved.pose_y_m = pose_y_m;
+    moved.pose_theta_rad = pose_theta_rad;
+    moved.start_angle_rad = d->start_rad;
+    moved.angle_step_rad = d->step_rad;
+    moved.min_range_m = d->min_m;
+    moved.max_range_m = d->max_m;
+    moved.beam_count = d->count;
+    moved.range_m = ctx->ranges + d->first;
+    if (!inside_area(ctx, &moved))
+        return polyc__fail(ctx, POLYC_ERR_EXTENT, "the scan reaches outside limits.area_m around the first pose");
+    polyc_status st = accumulate(ctx, d, scan_id, 1);
+    float lx = on->last_x, ly = on->last_y;
+    store_scan(ctx, d, &moved, d->first);
+    if (st == POLYC_OK)
+        st = accumulate(ctx, d, scan_id, 0);
+    on->last_x = lx; /* the robot is where the latest scan was */
+    on->last_y = ly;
+    on->pending++;
+    return st;
+}
+
+uint64_t polyc_online_version(const polyc_ctx *ctx)
+{
+    return polyc__check_ctx(ctx) == POLYC_OK && ctx->online ? ctx->online->version : 0;
+}

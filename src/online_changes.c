@@ -1,0 +1,153 @@
+/* online_changes.c - what an online map's versions changed: each update
+ * publishes the store as the result and compares it, polyline by polyline
+ * (by id, with a hash of its points), with the last publication; a changed
+ * map is a new version. Removals are remembered in a ring, so that a caller
+ * can ask what changed since any version it holds while the ring reaches
+ * back that far. Takes: the store. Gives: the result, versions, changes. */
+#include "online.h"
+
+#include <string.h>
+
+void polyc__online_pub_carve(polyc__arena *a, polyc__online *on, int32_t lines)
+{
+    on->pub = polyc__alloc(a, (size_t)lines, sizeof(polyc__pub));
+    on->pub_next = polyc__alloc(a, (size_t)lines, sizeof(polyc__pub));
+    on->gone_cap = (uint32_t)lines;
+    on->gone = polyc__alloc(a, on->gone_cap, sizeof(polyc_change));
+}
+
+/* FNV-1a over the polyline's coordinates and whether it is closed. */
+static uint32_t hash_of(const polyc__flat *f, uint32_t i)
+{
+    uint32_t h = 2166136261u;
+    const unsigned char *b = (const unsigned char *)(f->xy + 2 * (size_t)f->start[i]);
+    size_t n = (size_t)(f->start[i + 1] - f->start[i]) * 2 * sizeof(float);
+    for (size_t k = 0; k < n; k++)
+        h = (h ^ b[k]) * 16777619u;
+    return (h ^ f->closed[i]) * 16777619u;
+}
+
+/* Sorts by id: ids of a publication are few and mostly in order already
+ * (the store hands out slots in order), so insertion. */
+static void sort_by_id(polyc__pub *p, uint32_t n)
+{
+    for (uint32_t i = 1; i < n; i++) {
+        polyc__pub x = p[i];
+        uint32_t j = i;
+        for (; j > 0 && p[j - 1].id > x.id; j--)
+            p[j] = p[j - 1];
+        p[j] = x;
+    }
+}
+
+static void remember_removal(polyc__online *on, uint32_t id, uint64_t version)
+{
+    if (on->gone_n == on->gone_cap) { /* the oldest is forgotten */
+        on->forgot_through = on->gone[on->gone_first].version;
+        on->gone_first = (on->gone_first + 1) % on->gone_cap;
+        on->gone_n--;
+    }
+    polyc_change *c = &on->gone[(on->gone_first + on->gone_n) % on->gone_cap];
+    c->id = id;
+    c->kind = POLYC_CHANGE_REMOVED;
+    c->version = version;
+    on->gone_n++;
+}
+
+polyc_status polyc__online_publish(polyc_ctx *ctx, uint32_t *changed)
+{
+    polyc__online *on = ctx->online;
+    polyc__export_result(ctx);
+    ctx->opt_result_valid = 1;
+    ctx->stage = POLYC__STAGE_OPTIMIZED; /* the results are readable */
+    const polyc__flat *f = &ctx->flat;
+    uint64_t v = on->version + 1;
+    polyc__pub *next = on->pub_next;
+    for (uint32_t i = 0; i < f->count; i++) {
+        next[i].id = f->id[i];
+        next[i].hash = hash_of(f, i);
+        next[i].born = next[i].version = v;
+    }
+    sort_by_id(next, f->count);
+    /* both sorted by id: a merge */
+    uint32_t a = 0, b = 0, n = 0;
+    while (a < on->pub_n || b < f->count) {
+        if (b >= f->count || (a < on->pub_n && on->pub[a].id < next[b].id)) {
+            remember_removal(on, on->pub[a].id, v);
+            a++;
+            n++;
+        } else if (a >= on->pub_n || next[b].id < on->pub[a].id) {
+            b++; /* added */
+            n++;
+        } else {
+            next[b].born = on->pub[a].born;
+            if (next[b].hash == on->pub[a].hash)
+                next[b].version = on->pub[a].version;
+            else
+                n++;
+            a++;
+            b++;
+        }
+    }
+    on->pub_next = on->pub;
+    on->pub = next;
+    on->pub_n = f->count;
+    if (n > 0) /* else every entry kept its version */
+        on->version = v;
+    *changed = n;
+    return POLYC_OK;
+}
+
+polyc_status polyc_online_changes(const polyc_ctx *ctx, uint64_t since, polyc_change *out,
+                                  uint32_t cap, uint32_t *count)
+{
+    polyc_status cst = polyc__check_ctx(ctx);
+    if (cst != POLYC_OK || !count)
+        return cst != POLYC_OK ? cst : POLYC_ERR_NULL;
+    *count = 0;
+    const polyc__online *on = ctx->online;
+    if (!on)
+        return POLYC_ERR_STATE;
+    if (since < on->forgot_through)
+        return POLYC_ERR_RANGE;
+    uint32_t n = 0;
+    for (uint32_t i = 0; i < on->pub_n; i++)
+        n += on->pub[i].version > since;
+    for (uint32_t k = 0; k < on->gone_n; k++)
+        n += on->gone[(on->gone_first + k) % on->gone_cap].version > since;
+    *count = n;
+    if (!out || cap < n)
+        return POLYC_OK;
+    /* the live ones are sorted by id; the removed ones merged in by id */
+    uint32_t m = 0;
+    for (uint32_t i = 0; i < on->pub_n; i++) {
+        const polyc__pub *p = &on->pub[i];
+        if (p->version <= since)
+            continue;
+        out[m].id = p->id;
+        out[m].kind = p->born > since ? POLYC_CHANGE_ADDED : POLYC_CHANGE_MODIFIED;
+        out[m].version = p->version;
+        m++;
+    }
+    for (uint32_t k = 0; k < on->gone_n; k++) {
+        const polyc_change *g = &on->gone[(on->gone_first + k) % on->gone_cap];
+        if (g->version <= since)
+            continue;
+        uint32_t j = m++;
+        for (; j > 0 && out[j - 1].id > g->id; j--)
+            out[j] = out[j - 1];
+        out[j] = *g;
+    }
+    return POLYC_OK;
+}
+
+polyc_status polyc_polyline_id(const polyc_ctx *ctx, uint32_t index, uint32_t *id)
+{
+    polyc_status cst = polyc__check_ctx(ctx);
+    if (cst != POLYC_OK || !id)
+        return cst != POLYC_OK ? cst : POLYC_ERR_NULL;
+    if (index >= ctx->flat.count)
+        return POLYC_ERR_RANGE;
+    *id = ctx->flat.id[index];
+    return POLYC_OK;
+}

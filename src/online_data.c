@@ -1,0 +1,152 @@
+/* online_data.c - an online update's data: the weighted points of the
+ * tiles it takes are made again from their cells' sums and take the place
+ * of their old ones (the other tiles' points, and their segments, stay);
+ * the polylines the update traced join the spatial hash, the points near
+ * them re-assigned as after any edit. Takes: the optimiser of an online
+ * context, the taken tiles. Gives: the optimiser's data and books, exact
+ * for what it holds. */
+#include "online.h"
+
+#include <math.h>
+#include <string.h>
+
+/* The arrays of the points, swapped with their spares when the points are
+ * made again. */
+static void swap_points(polyc__opt *o, polyc__online *on)
+{
+    polyc__point *p = o->d.pts;
+    o->d.pts = on->alt_pts;
+    on->alt_pts = p;
+    float *v = o->d.pt_view;
+    o->d.pt_view = on->alt_view;
+    on->alt_view = v;
+    int32_t *sg = o->d.pt_seg;
+    o->d.pt_seg = on->alt_seg;
+    on->alt_seg = sg;
+    double *c = o->d.pt_cost;
+    o->d.pt_cost = on->alt_cost;
+    on->alt_cost = c;
+    uint32_t *t = on->pt_tile;
+    on->pt_tile = on->alt_tile;
+    on->alt_tile = t;
+    uint32_t *st = o->h.pt_start;
+    o->h.pt_start = on->alt_start;
+    on->alt_start = st;
+}
+
+/* The taken tiles are marked TAKEN in dirty_since (online_round.c). */
+static int taken(const polyc__online *on, uint32_t d)
+{
+    return on->dirty_since[d] == UINT32_MAX;
+}
+
+polyc_status polyc__online_refresh_tiles(polyc_ctx *ctx, uint32_t n_taken)
+{
+    polyc__online *on = ctx->online;
+    polyc__opt *o = &on->opt;
+    polyc__hash *h = &o->h;
+    o->prior = on->prior; /* its totals and weights are kept as scans come */
+    polyc_status st = polyc__spacing_build(ctx, &o->spacing);
+    if (st != POLYC_OK)
+        return st;
+    /* the new points of the taken tiles, unsorted; the endpoints the BIC
+     * counts, the taken tiles' as they are now */
+    int32_t cap = polyc__points_bound(o->cfg, &ctx->lim);
+    const polyc__grid *g = &ctx->grid;
+    for (uint32_t j = 0; j < n_taken; j++)
+        if (g->dir[on->dirty[j]]) {
+            o->d.n -= on->tile_raw[g->dir[on->dirty[j]] - 1];
+            on->tile_new[g->dir[on->dirty[j]] - 1] = 0;
+        }
+    int32_t nf = polyc__points_of_tiles(o, on->dirty, n_taken, on->pts_tmp, on->view_tmp,
+                                        on->fresh_tile, cap, on->tile_raw);
+    if (nf < 0)
+        return polyc__fail(ctx, POLYC_ERR_NOMEM, "more weighted data points than limits.max_points");
+    for (uint32_t j = 0; j < n_taken; j++)
+        if (g->dir[on->dirty[j]])
+            o->d.n += on->tile_raw[g->dir[on->dirty[j]] - 1];
+    /* old points of the taken tiles out of the error and the count */
+    int32_t nb = h->bx * h->by;
+    uint32_t *count = on->alt_start;
+    memset(count, 0, ((size_t)nb + 1) * sizeof(uint32_t));
+    int32_t kept = 0;
+    for (int32_t b = 0; b < nb; b++)
+        for (uint32_t i = h->pt_start[b]; i < h->pt_start[b + 1]; i++) {
+            if (!taken(on, on->pt_tile[i])) {
+                count[b + 1]++;
+                kept++;
+                continue;
+            }
+            o->err -= o->d.pt_cost[i];
+            if (o->d.pt_seg[i] != POLYC__NONE)
+                o->split_due[o->d.pt_seg[i]] = 1;
+        }
+    if (kept + nf > cap)
+        return polyc__fail(ctx, POLYC_ERR_NOMEM, "more weighted data points than limits.max_points");
+    for (int32_t j = 0; j < nf; j++) {
+        on->fresh_bucket[j] = polyc__bucket_of(h, on->pts_tmp[j].x, on->pts_tmp[j].y);
+        count[on->fresh_bucket[j] + 1]++;
+    }
+    for (int32_t b = 0; b < nb; b++)
+        count[b + 1] += count[b];
+    /* into the spare arrays, bucket by bucket: the kept points, then the new */
+    uint32_t *at = on->bucket_fill;
+    memcpy(at, count, (size_t)nb * sizeof(uint32_t));
+    for (int32_t b = 0; b < nb; b++)
+        for (uint32_t i = h->pt_start[b]; i < h->pt_start[b + 1]; i++) {
+            if (taken(on, on->pt_tile[i]))
+                continue;
+            uint32_t k = at[b]++;
+            on->alt_pts[k] = o->d.pts[i];
+            on->alt_view[2 * k] = o->d.pt_view[2 * i];
+            on->alt_view[2 * k + 1] = o->d.pt_view[2 * i + 1];
+            on->alt_seg[k] = o->d.pt_seg[i];
+            on->alt_cost[k] = o->d.pt_cost[i];
+            on->alt_tile[k] = on->pt_tile[i];
+        }
+    for (int32_t j = 0; j < nf; j++) {
+        uint32_t k = at[on->fresh_bucket[j]]++;
+        on->alt_pts[k] = on->pts_tmp[j];
+        on->alt_view[2 * k] = on->view_tmp[2 * j];
+        on->alt_view[2 * k + 1] = on->view_tmp[2 * j + 1];
+        on->alt_seg[k] = POLYC__NONE - 1; /* new: assigned below */
+        on->alt_tile[k] = on->fresh_tile[j];
+    }
+    swap_points(o, on);
+    o->d.np = kept + nf;
+    for (int32_t i = 0; i < o->d.np; i++)
+        if (o->d.pt_seg[i] == POLYC__NONE - 1) {
+            o->d.pt_cost[i] = polyc__nearest(o, i, NULL, 0, &o->d.pt_seg[i]);
+            o->err += o->d.pt_cost[i];
+            if (o->d.pt_seg[i] != POLYC__NONE)
+                o->split_due[o->d.pt_seg[i]] = 1;
+        }
+    o->d.log_n = log(o->d.n > 1.0 ? o->d.n : 1.0);
+    ctx->stats.weighted_points = (uint32_t)o->d.np;
+    ctx->stats.data_points = (uint64_t)o->d.n;
+    return POLYC_OK;
+}
+
+polyc_status polyc__online_add_lines(polyc_ctx *ctx, uint32_t after_id)
+{
+    polyc__opt *o = &ctx->online->opt;
+    const polyc__store *s = o->s;
+    for (int32_t l = 0; l < s->l_high; l++) {
+        const polyc__line *ln = &s->l[l];
+        if (ln->closed == POLYC__NONE || ln->count == 0 || ln->id <= after_id)
+            continue;
+        /* a polyline at a time: its vertices' angles fit the change's books */
+        polyc__chg_begin(o);
+        int32_t v = ln->head;
+        for (int32_t k = 0; k < ln->count; k++) {
+            if (!polyc__chg_seg_in(o, v))
+                return polyc__fail(ctx, POLYC_ERR_NOMEM, "spatial hash full (limits.max_vertices)");
+            o->acost[v] = 0.0; /* a new vertex: no angle counted yet */
+            polyc__chg_dirty(o, v);
+            o->split_due[v] = 1;
+            v = s->v[v].next;
+        }
+        polyc__chg_commit(o);
+    }
+    return POLYC_OK;
+}

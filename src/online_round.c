@@ -1,0 +1,299 @@
+/* online_round.c - an update of an online map: the backlog's tiles nearest
+ * the robot and oldest first, as many as the work budget allows; their
+ * contour cells that no polyline explains traced into new polylines; the
+ * data refreshed from the cells' sums; the search's operators run on what
+ * lies in and next to those tiles (the rest of the map is only looked at
+ * by the operators that scan it whole, and stays where it is unless they
+ * gain); and the finishing call, which runs the batch search from the map.
+ * Takes: the online state (online.h). Gives: the map in the store. */
+#include "cost.h"
+#include "online.h"
+
+#include <math.h>
+#include <string.h>
+
+/* A contour cell this near the map is explained by it: no new polyline
+ * (the operators move the map onto its data). */
+#define EXPLAINED_M 0.10f
+/* The work of a tile: its cells with endpoints, and this for the tile. */
+#define TILE_WORK 64u
+/* A tile waiting in the backlog gains this on the nearer ones per scan
+ * added since it changed: nearest first, but none waits for ever. */
+#define AGE_M_PER_SCAN 0.25f
+/* An update starts a round when the backlog holds this many tiles, or a
+ * tile in it has waited this many scans: a round's fixed costs (the passes
+ * over the map's ends, the region's books) and the climbs of the vertices
+ * near the robot are then paid once for several scans, not for each. */
+#define ROUND_TILES 4u
+#define ROUND_WAIT_SCANS 8u
+/* The tile taken in a round is marked so in dirty_since until it is done. */
+#define TAKEN UINT32_MAX
+
+static float tile_key(const polyc_ctx *ctx, uint32_t d)
+{
+    const polyc__grid *g = &ctx->grid;
+    const polyc__online *on = ctx->online;
+    float tile_m = g->cell_m * (float)POLYC__TILE_SIDE;
+    float ox = (float)(g->origin_x_m - ctx->frame_x), oy = (float)(g->origin_y_m - ctx->frame_y);
+    float cx = ox + ((float)(d % (uint32_t)g->tiles_x) + 0.5f) * tile_m;
+    float cy = oy + ((float)(d / (uint32_t)g->tiles_x) + 0.5f) * tile_m;
+    float dx = cx - on->last_x, dy = cy - on->last_y;
+    float age = (float)(on->scans + 1 - on->dirty_since[d]);
+    return sqrtf(dx * dx + dy * dy) - AGE_M_PER_SCAN * age;
+}
+
+static uint32_t tile_work(const polyc_ctx *ctx, uint32_t d)
+{
+    const polyc__grid *g = &ctx->grid;
+    if (!g->dir[d])
+        return TILE_WORK;
+    const uint32_t *slot = ctx->online->slot + (size_t)(g->dir[d] - 1) * POLYC__TILE_CELLS;
+    uint32_t n = TILE_WORK;
+    for (int i = 0; i < POLYC__TILE_CELLS; i++)
+        n += slot[i] != 0;
+    return n;
+}
+
+/* Moves the tiles to take to the front of the backlog (all of them, or
+ * by key until `work` is spent; ties by directory index) and marks them;
+ * returns how many, with the units in *units. */
+static uint32_t take_tiles(polyc_ctx *ctx, uint64_t work, int all, uint64_t *units)
+{
+    polyc__online *on = ctx->online;
+    uint32_t taken = 0;
+    *units = 0;
+    while (taken < on->dirty_n && (all || taken == 0 || *units < work)) {
+        uint32_t best = taken;
+        if (!all) {
+            float best_key = tile_key(ctx, on->dirty[taken]);
+            for (uint32_t i = taken + 1; i < on->dirty_n; i++) {
+                float k = tile_key(ctx, on->dirty[i]);
+                if (k < best_key || (k == best_key && on->dirty[i] < on->dirty[best])) {
+                    best_key = k;
+                    best = i;
+                }
+            }
+        }
+        uint32_t d = on->dirty[best];
+        on->dirty[best] = on->dirty[taken];
+        on->dirty[taken++] = d;
+        *units += tile_work(ctx, d);
+    }
+    for (uint32_t i = 0; i < taken; i++)
+        on->dirty_since[on->dirty[i]] = TAKEN;
+    return taken;
+}
+
+/* Whether some segment of the map passes within r of (x, y). */
+static int near_map(const polyc__opt *o, float x, float y, float r)
+{
+    const polyc__hash *h = &o->h;
+    const polyc__store *s = o->s;
+    int32_t bx, by, around[9];
+    polyc__bucket_xy(h, x, y, &bx, &by);
+    int n = polyc__buckets_around(h, bx, by, around);
+    for (int k = 0; k < n; k++)
+        for (int32_t e = h->seg_head[around[k]]; e != POLYC__NONE; e = h->entries[e].next) {
+            const polyc__vertex *a = &s->v[h->entries[e].seg], *b = &s->v[a->next];
+            if (polyc__seg_dist2(x, y, a->x, a->y, b->x, b->y) <= r * r)
+                return 1;
+        }
+    return 0;
+}
+
+/* The taken tiles' contour cells that are occupied now and that no
+ * polyline explains, marked and listed for the trace; returns their count. */
+static uint32_t unexplained_cells(polyc_ctx *ctx, uint32_t taken)
+{
+    polyc__online *on = ctx->online;
+    polyc__grid *g = &ctx->grid;
+    const polyc__opt *o = &on->opt;
+    float thr = ctx->cfg.contour_threshold;
+    double ox = g->origin_x_m - ctx->frame_x, oy = g->origin_y_m - ctx->frame_y;
+    for (uint32_t k = 0; k < g->tile_count; k++)
+        memset(g->tiles[k].mark, 0, sizeof g->tiles[k].mark);
+    uint32_t n = 0;
+    for (uint32_t i = 0; i < taken; i++) {
+        uint32_t d = on->dirty[i];
+        if (!g->dir[d])
+            continue;
+        polyc__tile *t = &g->tiles[g->dir[d] - 1];
+        int32_t tx = (int32_t)(d % (uint32_t)g->tiles_x) << POLYC__TILE_SHIFT;
+        int32_t ty = (int32_t)(d / (uint32_t)g->tiles_x) << POLYC__TILE_SHIFT;
+        for (int r = 0; r < POLYC__TILE_SIDE; r++)
+            for (int c = 0; t->contour[r] != 0 && c < POLYC__TILE_SIDE; c++) {
+                int idx = (r << POLYC__TILE_SHIFT) | c;
+                if (!((t->contour[r] >> c) & 1u) || !polyc__cell_occupied(t, idx, thr) || n >= on->cells_cap)
+                    continue;
+                float x = (float)(ox + ((double)(tx + c) + 0.5) * (double)g->cell_m);
+                float y = (float)(oy + ((double)(ty + r) + 0.5) * (double)g->cell_m);
+                if (o->s->l_live > 0 && near_map(o, x, y, EXPLAINED_M))
+                    continue;
+                t->mark[r] |= 1u << c;
+                on->cells[2 * n] = tx + c;
+                on->cells[2 * n + 1] = ty + r;
+                n++;
+            }
+    }
+    return n;
+}
+
+/* Stamps the vertices of the segments that pass through a taken tile (or
+ * within the search radius of it) as edited at `since`: the operators that
+ * look at what changed since a stamp take them. */
+static void stamp_region(polyc_ctx *ctx, uint32_t taken, uint32_t since)
+{
+    polyc__online *on = ctx->online;
+    polyc__opt *o = &on->opt;
+    const polyc__grid *g = &ctx->grid;
+    const polyc__hash *h = &o->h;
+    float tile_m = g->cell_m * (float)POLYC__TILE_SIDE, pad = o->R;
+    float ox = (float)(g->origin_x_m - ctx->frame_x), oy = (float)(g->origin_y_m - ctx->frame_y);
+    for (uint32_t k = 0; k < taken; k++) {
+        uint32_t d = on->dirty[k];
+        float x0 = ox + (float)(d % (uint32_t)g->tiles_x) * tile_m - pad;
+        float y0 = oy + (float)(d / (uint32_t)g->tiles_x) * tile_m - pad;
+        float x1 = x0 + tile_m + 2.0f * pad, y1 = y0 + tile_m + 2.0f * pad;
+        int32_t bx0, by0, bx1, by1;
+        polyc__bucket_xy(h, x0, y0, &bx0, &by0);
+        polyc__bucket_xy(h, x1, y1, &bx1, &by1);
+        for (int32_t by = by0; by <= by1; by++)
+            for (int32_t bx = bx0; bx <= bx1; bx++)
+                for (int32_t e = h->seg_head[by * h->bx + bx]; e != POLYC__NONE; e = h->entries[e].next) {
+                    int32_t a = h->entries[e].seg, b = o->s->v[a].next;
+                    if (o->v_touch[a] == since && o->v_touch[b] == since)
+                        continue;
+                    const polyc__vertex *va = &o->s->v[a], *vb = &o->s->v[b];
+                    if (polyc__maxf(va->x, vb->x) < x0 || polyc__minf(va->x, vb->x) > x1 ||
+                        polyc__maxf(va->y, vb->y) < y0 || polyc__minf(va->y, vb->y) > y1)
+                        continue;
+                    o->v_touch[a] = o->v_touch[b] = since;
+                    o->split_due[a] = 1;
+                }
+    }
+}
+
+polyc_status polyc__online_round(polyc_ctx *ctx, uint64_t work, int all, uint64_t *spent)
+{
+    polyc__online *on = ctx->online;
+    polyc__opt *o = &on->opt;
+    uint32_t taken = take_tiles(ctx, work, all, spent);
+    polyc_status st = polyc__online_refresh_tiles(ctx, taken);
+    if (st != POLYC_OK)
+        return st;
+    on->opt_ready = 1;
+    uint32_t since = ++o->touch_stamp;
+    uint32_t n = unexplained_cells(ctx, taken);
+    if (n > 0) {
+        uint32_t last_id = o->s->last_id;
+        ctx->contour_xy = on->cells;
+        ctx->contour_count = n;
+        st = polyc__trace_more(ctx);
+        ctx->contour_count = 0;
+        if (st == POLYC_OK)
+            st = polyc__online_add_lines(ctx, last_id);
+        if (st != POLYC_OK)
+            return st;
+    }
+    stamp_region(ctx, taken, since);
+    o->region_since = since;
+    uint8_t add = o->pol.add_vertices;
+    o->pol.add_vertices = 0;
+    polyc__operators(o, since, since);
+    o->pol.add_vertices = add;
+    o->region_since = 0;
+    POLYC__CHECKS_ITERATION(o);
+    for (uint32_t i = 0; i < taken; i++)
+        on->dirty_since[on->dirty[i]] = 0;
+    on->dirty_n -= taken;
+    memmove(on->dirty, on->dirty + taken, (size_t)on->dirty_n * sizeof on->dirty[0]);
+    on->pending = 0;
+    if (o->h.out_of_entries)
+        return polyc__fail(ctx, POLYC_ERR_NOMEM, "spatial hash full (limits.max_vertices)");
+    return POLYC_OK;
+}
+
+static polyc_status online_ctx(polyc_ctx *ctx)
+{
+    polyc_status cst = polyc__check_ctx(ctx);
+    if (cst != POLYC_OK)
+        return cst;
+    ctx->err.msg = NULL;
+    if (!ctx->online)
+        return polyc__fail(ctx, POLYC_ERR_STATE, "not an online context (polyc_online_init)");
+    if (ctx->online->scans == 0)
+        return polyc__fail(ctx, POLYC_ERR_STATE, "no scan added yet");
+    return POLYC_OK;
+}
+
+static void report(polyc_ctx *ctx, uint64_t work, uint32_t changed, polyc_online_report *out)
+{
+    polyc__online *on = ctx->online;
+    ctx->stats.bic = on->opt_ready ? polyc__bic(&on->opt) : 0.0;
+    ctx->stats.error_sq_m2 = on->opt_ready ? on->opt.err : 0.0;
+    if (!out)
+        return;
+    memset(out, 0, sizeof *out);
+    out->version = on->version;
+    out->work = work;
+    out->scans = on->scans;
+    out->pending_scans = on->pending;
+    out->backlog_tiles = on->dirty_n;
+    out->changed = changed;
+    out->polylines = ctx->flat.count;
+    out->vertices = ctx->flat.points;
+    out->bic = ctx->stats.bic;
+}
+
+polyc_status polyc_online_update(polyc_ctx *ctx, uint64_t work, polyc_online_report *out)
+{
+    polyc_status st = online_ctx(ctx);
+    if (st != POLYC_OK)
+        return st;
+    if (work == 0)
+        return polyc__fail(ctx, POLYC_ERR_CONFIG, "a work budget of 0 (POLYC_ONLINE_WORK_DEFAULT is the default)");
+    polyc__online *on = ctx->online;
+    uint64_t spent = 0;
+    uint32_t changed = 0;
+    uint32_t oldest = on->scans + 1;
+    for (uint32_t i = 0; i < on->dirty_n; i++)
+        oldest = on->dirty_since[on->dirty[i]] < oldest ? on->dirty_since[on->dirty[i]] : oldest;
+    if (on->dirty_n >= ROUND_TILES || (on->dirty_n > 0 && on->scans + 1 - oldest >= ROUND_WAIT_SCANS)) {
+        st = polyc__online_round(ctx, work, 0, &spent);
+        polyc_status pst = polyc__online_publish(ctx, &changed);
+        if (st == POLYC_OK)
+            st = pst;
+    }
+    on->pending = 0;
+    report(ctx, spent, changed, out);
+    return st;
+}
+
+polyc_status polyc_online_finish(polyc_ctx *ctx, polyc_progress_fn progress, void *user,
+                                 polyc_online_report *out)
+{
+    polyc_status st = online_ctx(ctx);
+    if (st != POLYC_OK)
+        return st;
+    polyc__online *on = ctx->online;
+    uint64_t spent = 0;
+    /* every tile: what no polyline explains anywhere is traced */
+    polyc__online_backlog_all(ctx);
+    st = polyc__online_round(ctx, UINT64_MAX, 1, &spent);
+    /* the data exact for the search: every point weighed as the accuracy
+     * stands now, the books from scratch */
+    on->spacing_now = 1;
+    if (st == POLYC_OK)
+        st = polyc__opt_refresh(&on->opt);
+    on->spacing_now = 0;
+    if (st == POLYC_OK && ctx->cfg.max_iterations > 0) {
+        polyc__guarded g = {ctx, progress, user};
+        st = polyc__search(&on->opt, progress ? polyc__guarded_progress : NULL, &g);
+    }
+    uint32_t changed = 0;
+    polyc_status pst = polyc__online_publish(ctx, &changed);
+    if (st == POLYC_OK)
+        st = pst;
+    report(ctx, spent, changed, out);
+    return st;
+}
