@@ -14,7 +14,9 @@
 #include "ctxblock.h"
 
 #define ONLINE_ATTEMPTS 3          /* the usual limits, then 4 and 16 times them */
-#define ONLINE_MARGIN_TILES 2.0    /* air round the area: tiles of 32 cells */
+#define ONLINE_EDGE_M 1.0          /* the library refuses data this near the area's
+                                      edge (docs/api.md, "Online") */
+#define ONLINE_AIR_CELLS 32.0      /* and a tile of air inside that */
 
 /* What --stats shows of the replay. */
 typedef struct replay {
@@ -40,7 +42,13 @@ static double log_area(const polyc_config *cfg, const scanlog *log, polyc_box *b
     }
     double reach = fmax(fmax(x0 - box->min_x_m, box->max_x_m - x0),
                         fmax(y0 - box->min_y_m, box->max_y_m - y0));
-    return 2.0 * reach + ONLINE_MARGIN_TILES * 32.0 * (double)cfg->cell_m;
+    return 2.0 * (reach + ONLINE_EDGE_M + ONLINE_AIR_CELLS * (double)cfg->cell_m);
+}
+
+/* a * 4, at most cap */
+static uint32_t times4(uint32_t a, double cap)
+{
+    return (uint32_t)fmin(4.0 * a, cap);
 }
 
 /* The block for lim in r->block and an online context on it; 0 or the exit
@@ -232,9 +240,12 @@ int online_map(const options *o, run *r, double t_start, mapout_times *t)
             rc = run_online(o, r, &cfg, ctx, size, retry, &rp, t);
         if (rc != RUN_AGAIN)
             break;
-        /* vertices and data cells are sized for a usual building */
-        lim.max_vertices = lim.max_vertices > UINT32_MAX / 4 ? UINT32_MAX : lim.max_vertices * 4;
-        lim.max_points = lim.max_points > UINT32_MAX / 4 ? UINT32_MAX : lim.max_points * 4;
+        /* grid cells, data cells and vertices are sized for a usual building:
+         * four times as many, up to the whole square and the library's caps */
+        double tiles = ceil(lim.area_m / (double)cfg.cell_m / 32.0);
+        lim.max_grid_cells = times4(lim.max_grid_cells, fmin(tiles * tiles * 1024.0, 0x40000000));
+        lim.max_points = times4(lim.max_points, 0x10000000);
+        lim.max_vertices = times4(lim.max_vertices, 0x10000000);
     }
     if (rc == 0)
         rc = write_map(o, r, &cfg, ctx, size, t, t_start);
