@@ -194,8 +194,8 @@ $(BUILD)/footprint8: examples/footprint.c $(EMB_OBJ)
 # test-fuzz-replay: the committed fuzz corpus through the fuzz targets, built
 # with $(CC). test-asan: unit tests, corpus replay and
 # the quick bad-input tests again in build-asan/ under ASan and UBSan.
-# test-valgrind: the tool over a sample log, its grid as a ROS map and a bad
-# log, no error or leak.
+# test-valgrind: the tool over a sample log (batch and --online), its grid as
+# a ROS map and a bad log, no error or leak.
 FUZZ_TARGETS = scanlog library mapyaml pgm
 FUZZ_REPLAY  = $(FUZZ_TARGETS:%=$(BUILD)/tests/fuzz_replay_%)
 $(BUILD)/tests/fuzz_replay_%: tests/fuzz_%.c tests/fuzz_replay.c $(TOOL_OBJ) $(BUILD)/libpolyc.a
@@ -220,6 +220,8 @@ test-valgrind: $(BUILD)/polyc
 	$(VALGRIND) --error-exitcode=1 $(BUILD)/polyc --stats --iterations 20 \
 	    -o $(BUILD)/valgrind.svg examples/office.log
 	$(VALGRIND) --error-exitcode=1 $(BUILD)/polyc convert -o $(BUILD)/valgrind.txt examples/office.log
+	$(VALGRIND) --error-exitcode=1 $(BUILD)/polyc --online --stats --iterations 5 \
+	    --frames $(BUILD)/valgrind_frames --every 100 -o $(BUILD)/valgrind.svg examples/office.log
 	$(VALGRIND) --error-exitcode=1 $(BUILD)/polyc grid -o $(BUILD)/valgrind_grid examples/office.log
 	$(VALGRIND) --error-exitcode=1 $(BUILD)/polyc --stats --iterations 5 -o $(BUILD)/valgrind.svg \
 	    $(BUILD)/valgrind_grid.yaml
@@ -228,6 +230,7 @@ test-valgrind: $(BUILD)/polyc
 	$(VALGRIND) --error-exitcode=99 $(BUILD)/polyc -o $(BUILD)/valgrind.svg $(BUILD)/valgrind_bad.log; \
 	    test $$? = 1
 	rm -f $(BUILD)/valgrind.svg $(BUILD)/valgrind.txt $(BUILD)/valgrind_bad.log $(BUILD)/valgrind_grid.*
+	rm -rf $(BUILD)/valgrind_frames
 
 # libFuzzer (`make fuzz FUZZ_TIME=600`; needs clang): every target in
 # build-fuzz/, run one after the other on a scratch corpus seeded from

@@ -27,7 +27,9 @@ static int struct_sizes_match(void)
            polyc_struct_size("polyc_polyline") == sizeof(polyc_polyline) &&
            polyc_struct_size("polyc_stats") == sizeof(polyc_stats) &&
            polyc_struct_size("polyc_iteration") == sizeof(polyc_iteration) &&
-           polyc_struct_size("polyc_occupancy_grid") == sizeof(polyc_occupancy_grid);
+           polyc_struct_size("polyc_occupancy_grid") == sizeof(polyc_occupancy_grid) &&
+           polyc_struct_size("polyc_online_limits") == sizeof(polyc_online_limits) &&
+           polyc_struct_size("polyc_online_report") == sizeof(polyc_online_report);
 }
 
 int main(int argc, char **argv)
