@@ -319,6 +319,8 @@ static polyc_status redo_stage(polyc_ctx *ctx, polyc__stage from, polyc__stage w
     if (cst != POLYC_OK)
         return cst;
     ctx->err.msg = NULL;
+    if (ctx->online) /* before the stage moves: the map stays readable */
+        return polyc__fail(ctx, POLYC_ERR_STATE, "an online context: use the polyc_online_* calls");
     if (ctx->from_grid && from < POLYC__STAGE_CONTOUR)
         from = POLYC__STAGE_CONTOUR;
     if (ctx->stage > from || want == POLYC__STAGE_GRID)

@@ -217,6 +217,7 @@ typedef struct count_pass {
     const uint32_t *wanted;
     polyc__tile *spill;
     void (*count)(polyc__count *a, polyc__count *b); /* count_inc, or count_dec */
+    uint32_t *on_hits;             /* online: per tile, misses counted in cells with hits */
 } count_pass;
 
 /* The tile of cell (ix, iy) inside the grid: stored (allocated on first use
@@ -273,8 +274,11 @@ static void count_beam(const count_pass *p, const polyc__beam *b)
         /* a stored tile: counted up to its edge (or the end cell) */
         int left;
         do {
-            if (polyc__walk_t(&w) < miss_end)
+            if (polyc__walk_t(&w) < miss_end) {
                 p->count(&t->misses[w.idx], &t->hits[w.idx]);
+                if (p->on_hits && t->hits[w.idx])
+                    p->on_hits[t - g->tiles]++;
+            }
             left = polyc__walk_step(&w);
         } while (!left && w.n > 0);
         if (left && w.n > 0 &&
@@ -349,10 +353,12 @@ static void want_hits(polyc_ctx *ctx, const polyc__scan *s)
 }
 
 /* Counts (or takes back) every beam of the scan. */
-static polyc_status count_scan(polyc_ctx *ctx, const polyc__scan *s, int take_back)
+static polyc_status count_scan(polyc_ctx *ctx, const polyc__scan *s, int take_back,
+                               uint32_t *on_hits)
 {
     polyc__grid *g = &ctx->grid;
     count_pass p;
+    p.on_hits = on_hits;
     p.g = g;
     p.a = &ctx->arena;
     p.wanted = g->wanted;
@@ -397,7 +403,7 @@ polyc_status polyc__grid_build(polyc_ctx *ctx)
     for (uint32_t si = 0; si < ctx->scan_count; si++)
         want_hits(ctx, &ctx->scans[si]);
     for (uint32_t si = 0; si < ctx->scan_count; si++)
-        if ((st = count_scan(ctx, &ctx->scans[si], 0)) != POLYC_OK)
+        if ((st = count_scan(ctx, &ctx->scans[si], 0, NULL)) != POLYC_OK)
             return st;
     grid_stats(ctx);
     return POLYC_OK;
@@ -410,11 +416,12 @@ polyc_status polyc__grid_online_init(polyc_ctx *ctx, double side_m, uint32_t max
     return grid_lay_out(ctx, -0.5 * side_m, -0.5 * side_m, side_m, side_m, tiles);
 }
 
-polyc_status polyc__grid_add_scan(polyc_ctx *ctx, const polyc__scan *s, int take_back)
+polyc_status polyc__grid_add_scan(polyc_ctx *ctx, const polyc__scan *s, int take_back,
+                                  uint32_t *on_hits)
 {
     if (!take_back)
         want_hits(ctx, s);
-    polyc_status st = count_scan(ctx, s, take_back);
+    polyc_status st = count_scan(ctx, s, take_back, on_hits);
     grid_stats(ctx);
     return st;
 }

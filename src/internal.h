@@ -272,9 +272,11 @@ size_t polyc__grid_budget_bytes(const polyc_limits *lim);
 void polyc__grid_reserve(polyc__arena *a, const polyc_limits *lim);
 polyc_status polyc__grid_build(polyc_ctx *ctx);
 /* online: a grid over a square of side_m centred on the frame origin, with
- * no tile yet; one scan counted into it, or taken back (a pose correction) */
+ * no tile yet; one scan counted into it, or taken back (a pose correction);
+ * on_hits (per tile, may be NULL) counts the misses in cells with hits */
 polyc_status polyc__grid_online_init(polyc_ctx *ctx, double side_m, uint32_t max_cells);
-polyc_status polyc__grid_add_scan(polyc_ctx *ctx, const polyc__scan *s, int take_back);
+polyc_status polyc__grid_add_scan(polyc_ctx *ctx, const polyc__scan *s, int take_back,
+                                  uint32_t *on_hits);
 polyc__tile *polyc__grid_tile(const polyc__grid *g, int32_t ix, int32_t iy);
 /* NULL for cells outside the grid or in tiles not stored (no beam ends in a
  * hit there: free space or never reached) */

@@ -140,6 +140,7 @@ static int lay_out(polyc_ctx *ctx, polyc__online *on, polyc__arena *a)
     POLYC__CARVE(ok, a, on->bucket_fill, nb);
     POLYC__CARVE_ZERO(ok, a, on->tile_raw, tile_cap);
     POLYC__CARVE_ZERO(ok, a, on->tile_new, tile_cap);
+    POLYC__CARVE_ZERO(ok, a, on->tile_miss, tile_cap);
     if (!ok)
         return 0;
     saved = ctx->arena;
@@ -232,6 +233,28 @@ static void mark_dirty(polyc__online *on, size_t d)
     if (on->dirty_since[d] == 0) {
         on->dirty_since[d] = on->scans + 1;
         on->dirty[on->dirty_n++] = (uint32_t)d;
+    }
+}
+
+/* A tile also joins the backlog when beams have passed through its cells
+ * with hits as often as it held endpoints at its last update: then the
+ * data rule may drop them (a person who walked by); looked at every
+ * MISS_CHECK_SCANS scans (a pass over the directory). */
+#define MISS_CHECK_SCANS 8u
+
+void polyc__online_backlog_misses(polyc_ctx *ctx)
+{
+    polyc__online *on = ctx->online;
+    if (on->scans % MISS_CHECK_SCANS != 0)
+        return;
+    const polyc__grid *g = &ctx->grid;
+    size_t dir_n = (size_t)g->tiles_x * (size_t)g->tiles_y;
+    for (size_t d = 0; d < dir_n; d++) {
+        if (!g->dir[d])
+            continue;
+        uint32_t k = g->dir[d] - 1;
+        if (on->tile_miss[k] >= CHANGE_MIN && (double)on->tile_miss[k] >= on->tile_raw[k])
+            mark_dirty(on, d);
     }
 }
 
@@ -344,7 +367,7 @@ static polyc_status accumulate(polyc_ctx *ctx, const polyc__scan *s, uint32_t nu
 {
     polyc__online *on = ctx->online;
     const polyc__grid *g = &ctx->grid;
-    polyc_status st = polyc__grid_add_scan(ctx, s, take_back);
+    polyc_status st = polyc__grid_add_scan(ctx, s, take_back, on->tile_miss);
     int sums_ok = sum_endpoints(ctx, s, take_back ? -1.0f : 1.0f);
     if (take_back)
         return st;

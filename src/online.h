@@ -73,6 +73,7 @@ typedef struct polyc__online {
     uint32_t *alt_tile, *pt_tile, *alt_start, *bucket_fill;
     double *tile_raw;
     uint32_t *tile_new;            /* per stored tile: endpoints in or out since its refresh */
+    uint32_t *tile_miss;           /* and misses counted in its cells with hits */
 
     polyc__opt opt;                /* the optimiser (its arrays in the block) */
     int opt_ready;                 /* it holds the map (0 before the first update) */
@@ -81,14 +82,17 @@ typedef struct polyc__online {
     uint64_t version;
     polyc__pub *pub, *pub_next;    /* sorted by id */
     uint32_t pub_n;
-    polyc_change *gone;            /* removals, oldest first (a ring of gone_cap) */
+    polyc__pub *gone;              /* removals (version: the removal's), oldest
+                                    * first, a ring of gone_cap */
     uint32_t gone_first, gone_n, gone_cap;
     uint64_t forgot_through;       /* removals of versions up to this are forgotten */
 } polyc__online;
 
 /* online.c: the context's limits for the stages, from the online limits */
 void polyc__online_stage_limits(const polyc_online_limits *ol, polyc_limits *lim);
-/* online.c: every stored tile into the backlog (the finishing call) */
+/* online.c: the tiles whose cells with hits beams have crossed often into
+ * the backlog (every few scans); every stored tile (the finishing call) */
+void polyc__online_backlog_misses(polyc_ctx *ctx);
 void polyc__online_backlog_all(polyc_ctx *ctx);
 /* online_data.c: the points of the n taken tiles (the first n of the
  * backlog, marked) made again from the sums */

@@ -13,7 +13,7 @@ void polyc__online_pub_carve(polyc__arena *a, polyc__online *on, int32_t lines)
     on->pub = polyc__alloc(a, (size_t)lines, sizeof(polyc__pub));
     on->pub_next = polyc__alloc(a, (size_t)lines, sizeof(polyc__pub));
     on->gone_cap = (uint32_t)lines;
-    on->gone = polyc__alloc(a, on->gone_cap, sizeof(polyc_change));
+    on->gone = polyc__alloc(a, on->gone_cap, sizeof(polyc__pub));
 }
 
 /* FNV-1a over the polyline's coordinates and whether it is closed. */
@@ -40,16 +40,15 @@ static void sort_by_id(polyc__pub *p, uint32_t n)
     }
 }
 
-static void remember_removal(polyc__online *on, uint32_t id, uint64_t version)
+static void remember_removal(polyc__online *on, const polyc__pub *p, uint64_t version)
 {
     if (on->gone_n == on->gone_cap) { /* the oldest is forgotten */
         on->forgot_through = on->gone[on->gone_first].version;
         on->gone_first = (on->gone_first + 1) % on->gone_cap;
         on->gone_n--;
     }
-    polyc_change *c = &on->gone[(on->gone_first + on->gone_n) % on->gone_cap];
-    c->id = id;
-    c->kind = POLYC_CHANGE_REMOVED;
+    polyc__pub *c = &on->gone[(on->gone_first + on->gone_n) % on->gone_cap];
+    *c = *p;
     c->version = version;
     on->gone_n++;
 }
@@ -59,6 +58,8 @@ polyc_status polyc__online_publish(polyc_ctx *ctx, uint32_t *changed)
     polyc__online *on = ctx->online;
     polyc__export_result(ctx);
     ctx->opt_result_valid = 1;
+    ctx->stats.memory_used_bytes = (uint64_t)(polyc__bytes(1, sizeof(polyc_ctx)) +
+                                              polyc__bytes(1, sizeof(polyc__online)) + ctx->arena.peak);
     ctx->stage = POLYC__STAGE_OPTIMIZED; /* the results are readable */
     const polyc__flat *f = &ctx->flat;
     uint64_t v = on->version + 1;
@@ -73,7 +74,7 @@ polyc_status polyc__online_publish(polyc_ctx *ctx, uint32_t *changed)
     uint32_t a = 0, b = 0, n = 0;
     while (a < on->pub_n || b < f->count) {
         if (b >= f->count || (a < on->pub_n && on->pub[a].id < next[b].id)) {
-            remember_removal(on, on->pub[a].id, v);
+            remember_removal(on, &on->pub[a], v);
             a++;
             n++;
         } else if (a >= on->pub_n || next[b].id < on->pub[a].id) {
@@ -113,8 +114,11 @@ polyc_status polyc_online_changes(const polyc_ctx *ctx, uint64_t since, polyc_ch
     uint32_t n = 0;
     for (uint32_t i = 0; i < on->pub_n; i++)
         n += on->pub[i].version > since;
-    for (uint32_t k = 0; k < on->gone_n; k++)
-        n += on->gone[(on->gone_first + k) % on->gone_cap].version > since;
+    /* a removal since `since` of a polyline born after it: never seen there */
+    for (uint32_t k = 0; k < on->gone_n; k++) {
+        const polyc__pub *g = &on->gone[(on->gone_first + k) % on->gone_cap];
+        n += g->version > since && g->born <= since;
+    }
     *count = n;
     if (!out || cap < n)
         return POLYC_OK;
@@ -130,13 +134,15 @@ polyc_status polyc_online_changes(const polyc_ctx *ctx, uint64_t since, polyc_ch
         m++;
     }
     for (uint32_t k = 0; k < on->gone_n; k++) {
-        const polyc_change *g = &on->gone[(on->gone_first + k) % on->gone_cap];
-        if (g->version <= since)
+        const polyc__pub *g = &on->gone[(on->gone_first + k) % on->gone_cap];
+        if (g->version <= since || g->born > since)
             continue;
         uint32_t j = m++;
         for (; j > 0 && out[j - 1].id > g->id; j--)
             out[j] = out[j - 1];
-        out[j] = *g;
+        out[j].id = g->id;
+        out[j].kind = POLYC_CHANGE_REMOVED;
+        out[j].version = g->version;
     }
     return POLYC_OK;
 }

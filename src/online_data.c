@@ -57,6 +57,7 @@ polyc_status polyc__online_refresh_tiles(polyc_ctx *ctx, uint32_t n_taken)
         if (g->dir[on->dirty[j]]) {
             o->d.n -= on->tile_raw[g->dir[on->dirty[j]] - 1];
             on->tile_new[g->dir[on->dirty[j]] - 1] = 0;
+            on->tile_miss[g->dir[on->dirty[j]] - 1] = 0;
         }
     int32_t nf = polyc__points_of_tiles(o, on->dirty, n_taken, on->pts_tmp, on->view_tmp,
                                         on->fresh_tile, cap, on->tile_raw);

@@ -173,6 +173,42 @@ static void stamp_region(polyc_ctx *ctx, uint32_t taken, uint32_t since)
     }
 }
 
+/* Polylines of the region with no data point within the support distance
+ * of any of their segments go: traced on what the grid held then (a person
+ * walking by), their points left the data when the tile was made again.
+ * (In a batch build every polyline starts on contour cells that hold data.) */
+static void drop_dataless(polyc__opt *o)
+{
+    const polyc__store *s = o->s;
+    float *has = o->size.seg_w;
+    for (int32_t v = 0; v < s->v_high; v++)
+        has[v] = 0.0f;
+    int32_t np = polyc__region_points(o, polyc__in_region);
+    double sup2 = (double)o->d.support_m * (double)o->d.support_m;
+    for (int32_t j = 0; j < np; j++) {
+        int32_t i = o->region_pt[j], sg = o->d.pt_seg[i];
+        if (sg != POLYC__NONE && o->d.pt_cost[i] <= sup2 * (double)o->d.pts[i].w)
+            has[sg] = 1.0f;
+    }
+    for (int32_t l = 0; l < s->l_high; l++) {
+        const polyc__line *ln = &s->l[l];
+        if (ln->closed == POLYC__NONE || ln->count == 0)
+            continue;
+        int in = 0, data = 0;
+        int32_t v = ln->head;
+        for (int32_t k = 0; k < ln->count; k++, v = s->v[v].next) {
+            in |= o->v_touch[v] >= o->region_since;
+            data |= has[v] != 0.0f;
+        }
+        if (!in || data)
+            continue;
+        polyc__chg_begin(o);
+        while (s->l[l].closed != POLYC__NONE && s->l[l].count > 0)
+            polyc__op_remove(o, s->l[l].head);
+        polyc__chg_commit(o);
+    }
+}
+
 polyc_status polyc__online_round(polyc_ctx *ctx, uint64_t work, int all, uint64_t *spent)
 {
     polyc__online *on = ctx->online;
@@ -200,6 +236,7 @@ polyc_status polyc__online_round(polyc_ctx *ctx, uint64_t work, int all, uint64_
     uint8_t add = o->pol.add_vertices;
     o->pol.add_vertices = 0;
     polyc__operators(o, since, since);
+    drop_dataless(o);
     o->pol.add_vertices = add;
     o->region_since = 0;
     POLYC__CHECKS_ITERATION(o);
@@ -255,6 +292,7 @@ polyc_status polyc_online_update(polyc_ctx *ctx, uint64_t work, polyc_online_rep
     polyc__online *on = ctx->online;
     uint64_t spent = 0;
     uint32_t changed = 0;
+    polyc__online_backlog_misses(ctx);
     uint32_t oldest = on->scans + 1;
     for (uint32_t i = 0; i < on->dirty_n; i++)
         oldest = on->dirty_since[on->dirty[i]] < oldest ? on->dirty_since[on->dirty[i]] : oldest;
