@@ -1,7 +1,8 @@
 #!/bin/sh
 # cli_online.sh - polyc --online (docs/formats.md, "Online"): the bundled
 # log replayed as a stream gives a valid map, the same one twice; --stats
-# shows the latencies; --frames writes one SVG every --every scans into a
+# shows the latencies, --trace the finish's iterations, --memory-mb caps the
+# block; --frames writes one SVG every --every scans into a
 # folder it makes, as -o writes (a symlink's target replaced); --work 0,
 # --frames without --online and --online with a map are refused.
 #   tests/cli_online.sh POLYC [LOG]
@@ -79,6 +80,16 @@ run --online --work 1 --format txt -o w1.txt "$LOG"
 [ $rc -eq 0 ] && [ -s w1.txt ] || bad "--work 1: exit $rc"
 refused work-zero '^polyc: --work needs a budget of 1 or more' --online --work 0 "$LOG"
 refused work-junk '^polyc: --work needs' --online --work x "$LOG"
+
+name=online-trace
+run --online --trace tr.txt -o map.svg "$LOG"
+[ $rc -eq 0 ] && [ "$(head -n 1 tr.txt)" = "# iteration bic best_bic vertices polylines noise_m" ] \
+    && [ "$(wc -l < tr.txt)" -ge 2 ] || bad "exit $rc, or no finish iterations in the trace"
+
+name=online-memory-cap
+run --online --memory-mb 1 -o capped.svg "$LOG"
+[ $rc -eq 3 ] && grep -q '^polyc: memory budget too small: need [0-9]* bytes' err.txt \
+    && [ ! -e capped.svg ] || bad "exit $rc, expected 3 and no output"
 
 name=frames
 run --online --frames fr --every 50 -o map.svg "$LOG"
