@@ -102,6 +102,10 @@ grep -q '<g id="path"' fr/frame-00050.svg || bad "no robot path in the frame"
 grep -q "50 of $scans scans" fr/frame-00050.svg || bad "the frame's title does not count its scans"
 [ "$(ls -A fr | grep -c '^\.polyc-')" -eq 0 ] || bad "temporary files left in fr"
 
+name=frames-leave-map
+run --online --frames fr7 --every 7 --format txt -o framed.txt "$LOG"
+[ $rc -eq 0 ] && cmp -s a.txt framed.txt || bad "exit $rc, or the map differs with frames"
+
 name=frames-default-every
 rm -rf fr
 run --online --frames fr -o map.svg "$LOG"
