@@ -71,13 +71,14 @@ polyc_status polyc_online_limits_for_area(const polyc_config *config, double are
     double cells = fmin(stored * POLYC__TILE_CELLS, 0x40000000);
     /* endpoints fall in one cell in 15 of a stored tile on intel (57,712
      * cells in 851 tiles), one in 5 on freiburg-079 (143,127 in 720, long
-     * range in a small building): room for one in 4; vertices one per 64
-     * such cells */
+     * range in a small building): room for one in 4 */
     double points = fmin(fmax(cells / 4.0, 4096.0), 0x10000000);
     out->area_m = area_m;
     out->max_grid_cells = (uint32_t)cells;
     out->max_points = (uint32_t)points;
-    out->max_vertices = (uint32_t)(points / 64.0) + 2048;
+    /* vertices: the contour traced afresh by the finishing call, a vertex
+     * per 16 data cells (intel's trace: 15,000 of them) */
+    out->max_vertices = (uint32_t)(points / 16.0) + 4096;
     out->max_scan_beams = max_scan_beams;
     return POLYC_OK;
 }
@@ -127,6 +128,10 @@ static int lay_out(polyc_ctx *ctx, polyc__online *on, polyc__arena *a)
     ok = ok && polyc__opt_carve_online(ctx, a, &on->opt);
     if (!ok)
         return 0;
+    if (a->base)
+        ok &= polyc__flat_init(a, &on->first, (uint32_t)lines, (uint32_t)V);
+    else
+        polyc__flat_reserve(a, V);
     size_t P = (size_t)polyc__points_bound(&ctx->cfg, &ctx->lim), nb = (size_t)on->opt.h.bx * (size_t)on->opt.h.by;
     POLYC__CARVE(ok, a, on->alt_pts, P);
     POLYC__CARVE(ok, a, on->alt_view, 2 * P);

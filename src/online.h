@@ -76,6 +76,7 @@ typedef struct polyc__online {
     uint32_t *tile_miss;           /* and misses counted in its cells with hits */
 
     polyc__opt opt;                /* the optimiser (its arrays in the block) */
+    polyc__flat first;             /* the finishing call: the first search's map */
     int opt_ready;                 /* it holds the map (0 before the first update) */
 
     /* publication */

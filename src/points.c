@@ -146,6 +146,8 @@ static void finish_tile(const polyc_ctx *ctx, int32_t d, polyc__point *tmp)
             if (!((t->mark[r] >> c) & 1u))
                 continue;
             polyc__point *p = &tmp[k++];
+            if (p->w <= 0.0f)
+                continue; /* online: cells with hits but no sums (they ran out) */
             float mx = p->x / p->w, my = p->y / p->w;
             p->cxx -= p->w * mx * mx;
             p->cxy -= p->w * mx * my;
@@ -241,6 +243,22 @@ static double sum_tile(const polyc_ctx *ctx, int32_t d, polyc__point *tmp, float
     return raw;
 }
 
+/* Online, a block whose cells hold hits but no sums (limits.max_points ran
+ * out as they came) has no point: the others move up. */
+static uint32_t drop_empty(polyc__point *pts, float *view, uint32_t *tile, uint32_t n)
+{
+    uint32_t m = 0;
+    for (uint32_t i = 0; i < n; i++) {
+        if (pts[i].w <= 0.0f)
+            continue;
+        pts[m] = pts[i];
+        view[2 * m] = view[2 * i];
+        view[2 * m + 1] = view[2 * i + 1];
+        tile[m++] = tile[i];
+    }
+    return m;
+}
+
 static polyc_status collect_sums(polyc__opt *o, polyc__point *tmp, float *view, int32_t cap,
                                  int32_t *n_out)
 {
@@ -263,7 +281,7 @@ static polyc_status collect_sums(polyc__opt *o, polyc__point *tmp, float *view, 
             on->tile_raw[k] = sum_tile(ctx, d, tmp, view);
         }
     finish_moments(ctx, tmp);
-    *n_out = (int32_t)n;
+    *n_out = (int32_t)drop_empty(tmp, view, on->fresh_tile, n);
     return POLYC_OK;
 }
 
@@ -291,6 +309,7 @@ int32_t polyc__points_of_tiles(polyc__opt *o, const uint32_t *dirs, uint32_t nd,
             tile_raw[g->dir[dirs[j]] - 1] = sum_tile(ctx, (int32_t)dirs[j], out, view);
             finish_tile(ctx, (int32_t)dirs[j], out);
         }
+    n = drop_empty(out, view, tile, n);
     for (uint32_t i = 0; i < n; i++)
         polyc__point_weigh(&o->prior, &out[i]);
     return (int32_t)n;
