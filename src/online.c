@@ -365,10 +365,11 @@ static void label_contour(polyc_ctx *ctx, const polyc__scan *s)
 }
 
 /* The scan's beams into the grid, its endpoints into the sums, its first
- * occupied cells into the contour, its lines into the prior; or, with
- * take_back, its counts and sums out again (the prior and the contour keep
- * what it gave: see docs/algorithm.md, "Online"). */
-static polyc_status accumulate(polyc_ctx *ctx, const polyc__scan *s, uint32_t number, int take_back)
+ * occupied cells into the contour and (learn) its lines into the prior; or,
+ * with take_back, its counts and sums out again (the prior and the contour
+ * keep what it gave: see docs/algorithm.md, "Online"). */
+static polyc_status accumulate(polyc_ctx *ctx, const polyc__scan *s, uint32_t number, int take_back,
+                               int learn)
 {
     polyc__online *on = ctx->online;
     const polyc__grid *g = &ctx->grid;
@@ -377,7 +378,9 @@ static polyc_status accumulate(polyc_ctx *ctx, const polyc__scan *s, uint32_t nu
     if (take_back)
         return st;
     label_contour(ctx, s);
-    polyc__prior_learn_scan(ctx, &on->prior, s, number, on->learn_cache, on->lim.max_scan_beams, &on->acc);
+    if (learn)
+        polyc__prior_learn_scan(ctx, &on->prior, s, number, on->learn_cache, on->lim.max_scan_beams,
+                                &on->acc);
     int64_t d = tile_of(g, (int32_t)floorf((float)((double)s->x_m - (g->origin_x_m - ctx->frame_x)) * g->inv_cell),
                         (int32_t)floorf((float)((double)s->y_m - (g->origin_y_m - ctx->frame_y)) * g->inv_cell));
     if (d >= 0 && !((on->pose_bits[d >> 5] >> (d & 31)) & 1u)) {
@@ -466,7 +469,7 @@ polyc_status polyc_online_add_scan(polyc_ctx *ctx, const polyc_scan *s, int keep
         on->kept_id[on->kept_n++] = on->scans;
         on->kept_beams += s->beam_count;
     }
-    polyc_status st = accumulate(ctx, d, on->scans, 0);
+    polyc_status st = accumulate(ctx, d, on->scans, 0, 1);
     if (scan_id)
         *scan_id = on->scans;
     on->scans++;
@@ -513,11 +516,11 @@ polyc_status polyc_online_correct(polyc_ctx *ctx, uint32_t scan_id, double pose_
     moved.range_m = ctx->ranges + d->first;
     if (!inside_area(ctx, &moved))
         return polyc__fail(ctx, POLYC_ERR_EXTENT, "the scan reaches outside limits.area_m around the first pose");
-    polyc_status st = accumulate(ctx, d, scan_id, 1);
+    polyc_status st = accumulate(ctx, d, scan_id, 1, 0);
     float lx = on->last_x, ly = on->last_y;
     store_scan(ctx, d, &moved, d->first);
     if (st == POLYC_OK)
-        st = accumulate(ctx, d, scan_id, 0);
+        st = accumulate(ctx, d, scan_id, 0, 0); /* the prior has its lines already */
     on->last_x = lx; /* the robot is where the latest scan was */
     on->last_y = ly;
     on->pending++;

@@ -4,6 +4,7 @@
  */
 #include "pipeline.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -124,6 +125,84 @@ int pipeline_run_grid(pipeline *p, const polyc_config *config, const polyc_occup
         step(p, polyc_build(p->ctx, NULL, NULL), "polyc_build"))
         return -1;
     *ms = pipeline_now_ms() - t;
+    return 0;
+}
+
+/* One attempt of pipeline_run_online on p->online_limits: 0, -1 with
+ * failed_at, or -2 when the block's malloc failed (no use doubling). */
+static int online_once(pipeline *p, const polyc_scan *scans, uint32_t n, double *ms)
+{
+    double t;
+    uint32_t i;
+    free(p->block);
+    p->block = NULL;
+    p->ctx = NULL;
+    p->block_size = polyc_online_memory_size(&p->config, &p->online_limits);
+    if (p->block_size == 0)
+        return step(p, POLYC_ERR_CONFIG, "polyc_online_memory_size");
+    if ((p->block = malloc(p->block_size)) == NULL)
+        return step(p, POLYC_ERR_NOMEM, "malloc of the block") - 1;
+    t = pipeline_now_ms();
+    if (step(p, polyc_online_init(p->block, p->block_size, &p->config, &p->online_limits,
+                                  &p->ctx),
+             "polyc_online_init"))
+        return -1;
+    for (i = 0; i < n; i++)
+        if (step(p, polyc_online_add_scan(p->ctx, &scans[i], 0, NULL), "polyc_online_add_scan") ||
+            step(p, polyc_online_update(p->ctx, POLYC_ONLINE_WORK_DEFAULT, NULL),
+                 "polyc_online_update"))
+            return -1;
+    if (step(p, polyc_online_finish(p->ctx, NULL, NULL, NULL), "polyc_online_finish"))
+        return -1;
+    *ms = pipeline_now_ms() - t;
+    return 0;
+}
+
+/* 2 x, at most cap */
+static uint32_t twice(uint32_t a, double cap)
+{
+    return (uint32_t)fmin(2.0 * (double)a, cap);
+}
+
+int pipeline_run_online(pipeline *p, const polyc_config *config, const polyc_scan *scans,
+                        uint32_t n, double *ms)
+{
+    polyc_box box = {HUGE_VAL, HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+    double x0, y0, reach, tiles;
+    uint32_t i, beams = 0;
+    int rc;
+    memset(p, 0, sizeof *p);
+    p->config = *config;
+    *ms = 0.0;
+    if (n == 0)
+        return step(p, POLYC_ERR_STATE, "no scans");
+    x0 = scans[0].pose_x_m;
+    y0 = scans[0].pose_y_m;
+    for (i = 0; i < n; i++) {
+        polyc_scan_extent(&p->config, &scans[i], &box);
+        if (scans[i].beam_count > beams)
+            beams = scans[i].beam_count;
+    }
+    reach = fmax(fmax(x0 - box.min_x_m, box.max_x_m - x0),
+                 fmax(y0 - box.min_y_m, box.max_y_m - y0));
+    if (step(p, polyc_online_limits_for_area(&p->config, 2.0 * (reach + PIPELINE_ONLINE_MARGIN_M),
+                                             beams, &p->online_limits),
+             "polyc_online_limits_for_area"))
+        return -1;
+    /* the grid cells of the whole square at most (32 x 32-cell tiles) */
+    tiles = ceil(p->online_limits.area_m / (double)p->config.cell_m / 32.0);
+    while ((rc = online_once(p, scans, n, ms)) != 0) {
+        if (rc == -2 || p->status != POLYC_ERR_NOMEM ||
+            p->online_doublings == PIPELINE_ONLINE_DOUBLINGS)
+            return -1;
+        p->online_limits.max_grid_cells =
+            twice(p->online_limits.max_grid_cells, fmin(tiles * tiles * 1024.0, 0x40000000));
+        p->online_limits.max_vertices = twice(p->online_limits.max_vertices, 0x10000000);
+        p->online_limits.max_points = twice(p->online_limits.max_points, 0x10000000);
+        p->online_doublings++;
+        p->failed_at = NULL;
+        p->status = POLYC_OK;
+    }
     return 0;
 }
 

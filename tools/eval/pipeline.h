@@ -1,6 +1,7 @@
 /* pipeline.h - the library's whole pipeline on a set of scans, as the
  * benchmark and the sweep run it: polyc_limits_for_scans, one malloc'ed
- * block of polyc_memory_size, init, add, grid, contour, trace, optimise.
+ * block of polyc_memory_size, init, add, grid, contour, trace, optimise;
+ * or the same scans through an online context (the sweep's --online).
  *
  * Memory: pipeline_open mallocs the block, pipeline_close frees it; the
  * scans must outlive the runs. int returns: 0, or -1 with failed_at (the
@@ -30,6 +31,10 @@ typedef struct pipeline {
     polyc_ctx *ctx;
     const char *failed_at;     /* the call that failed, NULL if none */
     polyc_status status;
+    /* pipeline_run_online: the limits of the last attempt, and how many
+       times they were doubled */
+    polyc_online_limits online_limits;
+    unsigned online_doublings;
 } pipeline;
 
 /* Limits for these scans and a block for them, under `config` (copied). */
@@ -46,6 +51,20 @@ int pipeline_run(pipeline *p, const polyc_scan *scans, uint32_t n, double *times
  * whatever the result. */
 int pipeline_run_grid(pipeline *p, const polyc_config *config, const polyc_occupancy_grid *grid,
                       double *ms);
+/* The scans through an online context, as a robot would feed them: limits
+ * (polyc_online_limits_for_area) for the square centred on the first pose
+ * that holds every pose and endpoint (polyc_scan_extent) with
+ * PIPELINE_ONLINE_MARGIN_M to spare and scans of the most beams, one
+ * malloc'ed block, init, each scan added (not kept) and an update of
+ * POLYC_ONLINE_WORK_DEFAULT after it, then polyc_online_finish. On
+ * POLYC_ERR_NOMEM the grid cells, vertices and data cells are doubled and
+ * the run starts again (up to PIPELINE_ONLINE_DOUBLINGS times). *ms gets the
+ * last attempt's time from polyc_online_init to the finished map. Call
+ * pipeline_close after, whatever the result. */
+#define PIPELINE_ONLINE_MARGIN_M 2.0
+#define PIPELINE_ONLINE_DOUBLINGS 4u
+int pipeline_run_online(pipeline *p, const polyc_config *config, const polyc_scan *scans,
+                        uint32_t n, double *ms);
 /* The current map as an array of polylines (malloc'ed; NULL on failure). */
 polyc_polyline *pipeline_lines(pipeline *p, uint32_t *count);
 

@@ -1,7 +1,7 @@
 /* sweep.c - the library's maps on simulated scenes of every kind and many
  * seeds, scored against each scene's own ground truth.
  *
- *   sweep [--seeds A-B] [--kinds a,b,...] [--save DIR] [--svg DIR] [--occupancy]
+ *   sweep [--seeds A-B] [--kinds a,b,...] [--save DIR] [--svg DIR] [--occupancy | --online]
  *
  * Takes nothing from disk: every scene is simulated (tools/eval/scansim.h), its
  * ground truth written to memory and read back by tools/eval/gtscore.h, its scans
@@ -10,6 +10,10 @@
  * then per kind and over all the median and the worst of every figure, and
  * whether each scene meets the targets. --occupancy maps each scene's
  * occupancy grid (tools/eval/occmap.h) through polyc_add_grid instead.
+ * --online maps each scene twice, in batch and scan by scan through an
+ * online context (pipeline_run_online), scores both alike and gives the
+ * online map's row with the batch map's core precision, vertices and time
+ * beside it.
  * Exit codes: 0 every scene ran (met its targets or not), 1 some scene
  * failed to run, 2 usage error.
  */
@@ -50,6 +54,9 @@
 #define OCC_MIN 65                 /* an occupied cell: value >= 100 x occupied_thresh */
 #define OCC_TARGET_CORE_M 0.012
 #define OCC_TARGET_COMPLETENESS 0.97
+/* --online: the target, core precision within 10 % of the batch map's */
+#define ONLINE_CORE_RATIO 1.10
+#define ONLINE_WORST_LISTED 5      /* scenes listed by their core ratio */
 
 static const char usage_text[] =
     "usage: sweep [options]\n"
@@ -72,6 +79,20 @@ static const char usage_text[] =
     "                   dcov and uns20 are measured against the occupied cells'\n"
     "                   centres, and the targets are P core > 12 mm, C compl <\n"
     "                   0.97, V verts > 1.5 x ideal, T any crossing\n"
+    "  --online         map each scene twice, in batch and scan by scan through an\n"
+    "                   online context (polyc_online_limits_for_area for the square\n"
+    "                   round the first pose that holds every pose and endpoint\n"
+    "                   with 2 m to spare, limits doubled on POLYC_ERR_NOMEM; an\n"
+    "                   update of POLYC_ONLINE_WORK_DEFAULT after each scan, then\n"
+    "                   polyc_online_finish). The row, its targets and its summary\n"
+    "                   are the online map's (ms: polyc_online_init to the\n"
+    "                   finished map; --svg draws the online map), with six more\n"
+    "                   columns: bcore (the batch map's core, mm), core/b (online\n"
+    "                   core / batch core), bverts (the batch map's vertices),\n"
+    "                   verts/b, bms (the batch ms), ms/b. The summary adds per\n"
+    "                   kind and over all on how many scenes core/b <= 1.10 and\n"
+    "                   the worst core/b and verts/b, and lists the five scenes\n"
+    "                   of the worst core/b. Not with --occupancy\n"
     "  -h, --help       this text\n"
     "Columns: scans, beams (all scans), ms (the pipeline from polyc_init to the\n"
     "optimised map), verts (map vertices), ideal, ratio (verts / ideal), rms\n"
@@ -103,15 +124,19 @@ typedef struct options {
     const char *save_dir;      /* NULL: none */
     const char *svg_dir;       /* NULL: none */
     int occupancy;             /* --occupancy */
+    int online;                /* --online */
 } options;
 
 /* ---- the figures ----------------------------------------------------------- */
 
 /* One entry per column: to add a figure, add it here, to `figures` and to
- * score_scene. */
+ * score_scene. The figures from FIG_BCORE on are --online's, set by
+ * sweep_scene from the batch map's row and printed only with --online. */
 enum figure { FIG_SCANS, FIG_BEAMS, FIG_MS, FIG_VERTS, FIG_IDEAL, FIG_RATIO, FIG_RMS,
               FIG_CORE, FIG_FIT, FIG_FLOOR, FIG_COMPL, FIG_GCOMPL, FIG_DCOV, FIG_CROSS,
-              FIG_UNS20, FIG_BAND, FIG_END20, FIG_END10, FIG_COUNT };
+              FIG_UNS20, FIG_BAND, FIG_END20, FIG_END10,
+              FIG_BCORE, FIG_CORE_RATIO, FIG_BVERTS, FIG_VERTS_RATIO, FIG_BMS, FIG_MS_RATIO,
+              FIG_COUNT };
 
 typedef struct figure_info {
     const char *name;
@@ -128,7 +153,15 @@ static const figure_info figures[FIG_COUNT] = {
     {"dcov", 6, 2, 1.0, 0},
     {"cross", 5, 0, 1.0, 0},   {"uns20", 5, 0, 1.0, 0},   {"band%", 6, 2, 100.0, 0},
     {"end20", 6, 4, 1.0, 1},   {"end10", 6, 4, 1.0, 1},
+    {"bcore", 6, 1, 1e3, 0},   {"core/b", 6, 3, 1.0, 0},  {"bverts", 6, 0, 1.0, 0},
+    {"verts/b", 7, 3, 1.0, 0}, {"bms", 7, 1, 1.0, 0},     {"ms/b", 6, 2, 1.0, 0},
 };
+
+/* The columns printed: all with --online, else up to FIG_BCORE. */
+static uint32_t shown_figures(const options *o)
+{
+    return o->online ? (uint32_t)FIG_COUNT : (uint32_t)FIG_BCORE;
+}
 
 /* Bits of the targets a scene misses. */
 enum { MISS_PRECISION = 1, MISS_COMPLETENESS = 2, MISS_VERTICES = 4, MISS_TOPOLOGY = 8,
@@ -140,6 +173,7 @@ typedef struct row {
     double fig[FIG_COUNT];     /* NAN: not available */
     unsigned missed;           /* MISS_* bits */
     int ok;                    /* the scene ran and was scored */
+    unsigned doublings;        /* --online: the limits doubled this many times */
 } row;
 
 /* ---- small helpers --------------------------------------------------------- */
@@ -367,10 +401,10 @@ static int write_svg(const char *path, const scansim_scene *sc, const gtscore_tr
     }
 }
 
-static void print_figures(const double *fig)
+static void print_figures(const double *fig, uint32_t shown)
 {
     uint32_t i;
-    for (i = 0; i < FIG_COUNT; i++) {
+    for (i = 0; i < shown; i++) {
         if (isnan(fig[i]))
             printf(" %*s", figures[i].width, "-");
         else
@@ -389,6 +423,49 @@ static void print_missed(unsigned missed)
            missed & MISS_TOPOLOGY ? "T" : "", missed & MISS_BAND ? "B" : "");
 }
 
+/* a / b; 1 when both are 0, NAN when only b is */
+static double ratio_of(double a, double b)
+{
+    if (b == 0.0)
+        return a == 0.0 ? 1.0 : (double)NAN;
+    return a / b;
+}
+
+/* --online: the scene's scans through an online context (pipeline.h), its
+ * map scored into r as score_scene scores the batch map, and the batch
+ * map's figures (the row `batch`) beside it. *lines and *count become the
+ * online map's (the caller frees them). */
+static int online_scene(const scansim_scene *sc, const gtscore_truth *truth, const row *batch,
+                        pipeline *q, polyc_polyline **lines, uint32_t *count, row *r,
+                        const char *label)
+{
+    polyc_config config;
+    double ms;
+    polyc_config_default(&config);
+    free(*lines);
+    *lines = NULL;
+    *count = 0;
+    if (pipeline_run_online(q, &config, sc->scans, sc->scan_count, &ms) != 0 ||
+        (*lines = pipeline_lines(q, count)) == NULL) {
+        printf("%s error in %s (online): %s (%s)\n", label,
+               q->failed_at ? q->failed_at : "pipeline_lines", polyc_status_str(q->status),
+               q->ctx ? polyc_last_error(q->ctx) : "");
+        return -1;
+    }
+    if (score_scene(sc, truth, *lines, *count, ms, NULL, r) != 0) {
+        printf("%s error: scoring the online map ran out of memory\n", label);
+        return -1;
+    }
+    r->fig[FIG_BCORE] = batch->fig[FIG_CORE];
+    r->fig[FIG_CORE_RATIO] = ratio_of(r->fig[FIG_CORE], batch->fig[FIG_CORE]);
+    r->fig[FIG_BVERTS] = batch->fig[FIG_VERTS];
+    r->fig[FIG_VERTS_RATIO] = ratio_of(r->fig[FIG_VERTS], batch->fig[FIG_VERTS]);
+    r->fig[FIG_BMS] = batch->fig[FIG_MS];
+    r->fig[FIG_MS_RATIO] = ratio_of(r->fig[FIG_MS], batch->fig[FIG_MS]);
+    r->doublings = q->online_doublings;
+    return 0;
+}
+
 /* Simulates, maps and scores one scene; prints its row. */
 static int sweep_scene(const options *o, const char *kind, uint64_t seed, row *r)
 {
@@ -396,9 +473,10 @@ static int sweep_scene(const options *o, const char *kind, uint64_t seed, row *r
     gtscore_truth truth;
     occmap occ;
     polyc_occupancy_grid grid;
-    pipeline p;
+    pipeline p, q;
     polyc_config config;
     polyc_polyline *lines = NULL;
+    row batch;
     double times[PIPELINE_STAGES], ms = 0.0;
     uint32_t count = 0, i;
     char err[512] = "", label[48];
@@ -410,6 +488,7 @@ static int sweep_scene(const options *o, const char *kind, uint64_t seed, row *r
     snprintf(label, sizeof label, "%-10s %4llu", kind, (unsigned long long)seed);
     memset(&truth, 0, sizeof truth);
     memset(&p, 0, sizeof p);
+    memset(&q, 0, sizeof q);
     memset(&occ, 0, sizeof occ);
     if (scansim_scene_builtin(&sc, kind, seed) != 0) {
         printf("%s error: out of memory\n", label);
@@ -452,13 +531,16 @@ static int sweep_scene(const options *o, const char *kind, uint64_t seed, row *r
         for (i = 0; i < PIPELINE_STAGES; i++)
             ms += times[i];
     }
-    if (score_scene(&sc, &truth, lines, count, ms, o->occupancy ? &grid : NULL, r) != 0) {
+    if (score_scene(&sc, &truth, lines, count, ms, o->occupancy ? &grid : NULL,
+                    o->online ? &batch : r) != 0) {
         printf("%s error: scoring ran out of memory\n", label);
         goto done;
     }
+    if (o->online && online_scene(&sc, &truth, &batch, &q, &lines, &count, r, label) != 0)
+        goto done;
     r->ok = 1;
     printf("%s", label);
-    print_figures(r->fig);
+    print_figures(r->fig, shown_figures(o));
     print_missed(r->missed);
     fflush(stdout);
     if (o->save_dir || o->svg_dir) {
@@ -478,6 +560,7 @@ static int sweep_scene(const options *o, const char *kind, uint64_t seed, row *r
     rc = 0;
 done:
     free(lines);
+    pipeline_close(&q);
     pipeline_close(&p);
     occmap_free(&occ);
     gtscore_truth_free(&truth);
@@ -487,8 +570,76 @@ done:
 
 /* ---- the summary -------------------------------------------------------------- */
 
+/* --online: over the rows of `kind` (NULL: all), on how many scenes the
+ * online map's core precision is within 10 % of the batch map's, the worst
+ * core ratio and the highest and lowest vertex ratio, with their scenes. */
+static void summarise_online(const row *rows, size_t n, const char *kind)
+{
+    size_t i, worst = n, most = n, least = n;
+    unsigned within = 0, scenes = 0;
+    for (i = 0; i < n; i++) {
+        const row *r = &rows[i];
+        if (!r->ok || (kind && strcmp(r->kind, kind) != 0))
+            continue;
+        scenes++;
+        within += r->fig[FIG_CORE_RATIO] <= ONLINE_CORE_RATIO;
+        /* a ratio that cannot be taken (batch core 0, online not) is the worst */
+        if (worst == n || !(r->fig[FIG_CORE_RATIO] <= rows[worst].fig[FIG_CORE_RATIO]))
+            worst = i;
+        if (most == n || r->fig[FIG_VERTS_RATIO] > rows[most].fig[FIG_VERTS_RATIO])
+            most = i;
+        if (least == n || r->fig[FIG_VERTS_RATIO] < rows[least].fig[FIG_VERTS_RATIO])
+            least = i;
+    }
+    printf("%-10s %4s", "", "");
+    if (!scenes) {
+        printf(" online/batch: no scene\n");
+        return;
+    }
+    printf(" online/batch: core within %.0f %% on %u/%u, worst %.3f (%s %llu: %.1f mm against "
+           "%.1f); verts worst %.3f (%s %llu: %.0f against %.0f), lowest %.3f (%s %llu)\n",
+           100.0 * (ONLINE_CORE_RATIO - 1.0), within, scenes, rows[worst].fig[FIG_CORE_RATIO],
+           rows[worst].kind, (unsigned long long)rows[worst].seed,
+           1e3 * rows[worst].fig[FIG_CORE], 1e3 * rows[worst].fig[FIG_BCORE],
+           rows[most].fig[FIG_VERTS_RATIO], rows[most].kind,
+           (unsigned long long)rows[most].seed, rows[most].fig[FIG_VERTS],
+           rows[most].fig[FIG_BVERTS], rows[least].fig[FIG_VERTS_RATIO], rows[least].kind,
+           (unsigned long long)rows[least].seed);
+}
+
+/* qsort: the rows by their core ratio, worst (highest, or none) first */
+static int compare_core_ratio(const void *a, const void *b)
+{
+    double x = (*(const row *const *)a)->fig[FIG_CORE_RATIO];
+    double y = (*(const row *const *)b)->fig[FIG_CORE_RATIO];
+    if (isnan(x) || isnan(y))
+        return isnan(y) - isnan(x);
+    return (x < y) - (x > y);
+}
+
+/* --online: the ONLINE_WORST_LISTED scenes of the worst core ratio. */
+static void list_worst_online(const row *rows, size_t n)
+{
+    const row **by = malloc((n ? n : 1u) * sizeof *by);
+    size_t i, m = 0;
+    if (!by)
+        return;
+    for (i = 0; i < n; i++)
+        if (rows[i].ok)
+            by[m++] = &rows[i];
+    qsort(by, m, sizeof *by, compare_core_ratio);
+    printf("\nthe worst core/b (online core against batch core):\n");
+    for (i = 0; i < m && i < ONLINE_WORST_LISTED; i++)
+        printf("  %-10s %4llu  %6.1f mm against %6.1f mm  core/b %.3f  verts %.0f against %.0f\n",
+               by[i]->kind, (unsigned long long)by[i]->seed, 1e3 * by[i]->fig[FIG_CORE],
+               1e3 * by[i]->fig[FIG_BCORE], by[i]->fig[FIG_CORE_RATIO], by[i]->fig[FIG_VERTS],
+               by[i]->fig[FIG_BVERTS]);
+    free(by);
+}
+
 /* Median and worst of each figure over the rows of `kind` (NULL: all). */
-static void summarise(const row *rows, size_t n, const char *kind, const char *label)
+static void summarise(const options *o, const row *rows, size_t n, const char *kind,
+                      const char *label)
 {
     double median[FIG_COUNT], worst[FIG_COUNT], *v = malloc((n ? n : 1u) * sizeof *v);
     unsigned passed = 0, scenes = 0;
@@ -515,11 +666,13 @@ static void summarise(const row *rows, size_t n, const char *kind, const char *l
         }
     free(v);
     printf("%-10s %4s", label, "med");
-    print_figures(median);
+    print_figures(median, shown_figures(o));
     printf("  %u/%u ok\n", passed, scenes);
     printf("%-10s %4s", "", "worst");
-    print_figures(worst);
+    print_figures(worst, shown_figures(o));
     printf("\n");
+    if (o->online)
+        summarise_online(rows, n, kind);
 }
 
 /* ---- main ------------------------------------------------------------------- */
@@ -589,12 +742,14 @@ static int parse_options(int argc, char **argv, options *o)
             o->save_dir = argv[++i];
         } else if (strcmp(a, "--occupancy") == 0) {
             o->occupancy = 1;
+        } else if (strcmp(a, "--online") == 0) {
+            o->online = 1;
         } else if (strcmp(a, "--svg") == 0 && i + 1 < argc) {
             o->svg_dir = argv[++i];
         } else
             return -1;
     }
-    return 0;
+    return o->online && o->occupancy ? -1 : 0;
 }
 
 int main(int argc, char **argv)
@@ -602,9 +757,9 @@ int main(int argc, char **argv)
     options o;
     row *rows;
     size_t n, k = 0;
-    unsigned kind;
+    unsigned kind, doubled = 0;
     uint64_t seed;
-    double t0 = pipeline_now_ms(), pipeline_ms = 0.0;
+    double t0 = pipeline_now_ms(), pipeline_ms = 0.0, batch_ms = 0.0;
     int failed = 0;
     uint32_t f;
 
@@ -627,15 +782,21 @@ int main(int argc, char **argv)
                100.0 * OCC_CELL_M, 1e3 * OCC_TARGET_CORE_M, OCC_TARGET_COMPLETENESS,
                TARGET_RATIO);
     else
-        printf("libpolyc %u.%u.%u sweep: seeds %llu-%llu, targets: P core <= max(%.2f x fit, fit + "
+        printf("libpolyc %u.%u.%u sweep%s: seeds %llu-%llu, targets: P core <= max(%.2f x fit, fit + "
                "%.1f mm), C compl >= %.2f, V verts <= %.1f x ideal, T dcov <= %.2f m, 0 cross, "
                "0 uns20, B band15 <= %.0f %% of the map\n",
                polyc_version() / 10000u, polyc_version() / 100u % 100u, polyc_version() % 100u,
-               (unsigned long long)o.seed_first, (unsigned long long)o.seed_last,
-               TARGET_FIT_FACTOR, 1e3 * TARGET_FIT_MARGIN_M, TARGET_COMPLETENESS, TARGET_RATIO,
+               o.online ? " --online" : "", (unsigned long long)o.seed_first,
+               (unsigned long long)o.seed_last, TARGET_FIT_FACTOR, 1e3 * TARGET_FIT_MARGIN_M, TARGET_COMPLETENESS, TARGET_RATIO,
                TARGET_DCOV_M, 100.0 * TARGET_BAND);
+    if (o.online)
+        printf("online: each scene's scans one by one through polyc_online_add_scan, "
+               "polyc_online_update (work %u) after each, then polyc_online_finish; the rows, "
+               "targets and summaries are the online map's; bcore, bverts, bms: the batch "
+               "map's; core/b within %.0f %% is the target\n",
+               POLYC_ONLINE_WORK_DEFAULT, 100.0 * (ONLINE_CORE_RATIO - 1.0));
     printf("%-10s %4s", "kind", "seed");
-    for (f = 0; f < FIG_COUNT; f++)
+    for (f = 0; f < shown_figures(&o); f++)
         printf(" %*s", figures[f].width, figures[f].name);
     printf("  missed\n");
     for (kind = 0; kind < o.kind_count; kind++)
@@ -644,12 +805,22 @@ int main(int argc, char **argv)
                 failed = 1;
     printf("\n");
     for (kind = 0; kind < o.kind_count; kind++)
-        summarise(rows, n, o.kinds[kind], o.kinds[kind]);
-    summarise(rows, n, NULL, "all");
-    for (k = 0; k < n; k++)
+        summarise(&o, rows, n, o.kinds[kind], o.kinds[kind]);
+    summarise(&o, rows, n, NULL, "all");
+    if (o.online)
+        list_worst_online(rows, n);
+    for (k = 0; k < n; k++) {
         pipeline_ms += rows[k].ok ? rows[k].fig[FIG_MS] : 0.0;
-    printf("\n%zu scenes in %.1f s, %.1f s of it in the pipeline (the ms column)\n", n,
-           (pipeline_now_ms() - t0) / 1e3, pipeline_ms / 1e3);
+        batch_ms += rows[k].ok && o.online ? rows[k].fig[FIG_BMS] : 0.0;
+        doubled += rows[k].ok && rows[k].doublings > 0;
+    }
+    if (o.online)
+        printf("\n%zu scenes in %.1f s, %.1f s of it online (the ms column), %.1f s in batch "
+               "(bms); the online limits were doubled on %u\n", n,
+               (pipeline_now_ms() - t0) / 1e3, pipeline_ms / 1e3, batch_ms / 1e3, doubled);
+    else
+        printf("\n%zu scenes in %.1f s, %.1f s of it in the pipeline (the ms column)\n", n,
+               (pipeline_now_ms() - t0) / 1e3, pipeline_ms / 1e3);
     free(rows);
     return failed ? EXIT_FAILED : 0;
 }
