@@ -28,8 +28,8 @@
  * made 666 rounds and 1.06 s of updates; 8 or 16 made 371 rounds, 0.70 s
  * and a lower final BIC (67,393 against 69,307); 16 or 32, 180 rounds but
  * 1.05 s (the rounds grew) and a p99 of 8 ms. */
-#define ROUND_TILES 8u
-#define ROUND_WAIT_SCANS 16u
+#define ROUND_TILES 4u
+#define ROUND_WAIT_SCANS 8u
 /* The tile taken in a round is marked so in dirty_since until it is done. */
 #define TAKEN UINT32_MAX
 
