@@ -21,6 +21,9 @@
  * tile) wait for the next */
 #define CHANGE_MIN 16u
 
+/* The hash's bound, in beams of 16 buckets: 69,632 buckets. */
+#define ONLINE_HASH_BEAMS 4096u
+
 /* Endpoints and poses must stay this far inside the area: vertices may
  * wander a little past the data (the spatial hash's own margin is 2 m). */
 #define AREA_MARGIN_M 1.0
@@ -31,10 +34,12 @@ void polyc__online_stage_limits(const polyc_online_limits *ol, polyc_limits *lim
     /* the current scan's slot and the kept ones' (at least two: the stages
      * size for scans, not for a single scan's chains) */
     lim->max_scans = 2 + ol->keep_scans;
-    /* the stages size their bucket and point arrays from max_beams: here
-     * the data cells stand for the beams of a batch context */
-    uint64_t beams = (uint64_t)ol->max_scan_beams + ol->keep_beams + ol->max_points;
-    lim->max_beams = beams > 0x7fffffffu ? 0x7fffffffu : (uint32_t)beams;
+    /* the spatial hash takes at most 16 buckets a beam of max_beams (and
+     * fewer for a small grid): an update's pass over the points' order
+     * walks every bucket, so their count stays bounded whatever the area
+     * (on a 500 m square, a bucket per 0.4 m made intel's updates 7 times
+     * slower than on its 50 m one) */
+    lim->max_beams = ONLINE_HASH_BEAMS;
     lim->max_grid_cells = ol->max_grid_cells;
     lim->max_vertices = ol->max_vertices;
     /* a weighted point gathers the data cells of a 2 x 2 block: half of
@@ -64,14 +69,15 @@ polyc_status polyc_online_limits_for_area(const polyc_config *config, double are
         return POLYC_ERR_CONFIG;
     double side = ceil(area_m / (double)config->cell_m / POLYC__TILE_SIDE);
     double tiles = side * side;
-    /* a building's walls reach a quarter of the square's tiles at most
-     * (intel: 817 of its 2,254 bounding-box tiles hold a hit); a small
-     * square is taken whole */
-    double stored = tiles <= 256.0 ? tiles : fmax(256.0, ceil(tiles / 4.0));
+    /* the tiles a building's walls reach: intel 851 of its 50 m square's
+     * 3,906, freiburg-campus 15,399 of its 524 m square's 429,025; a small
+     * square is taken whole, a large one for a sixteenth (at least 1,024) */
+    double stored = tiles <= 1024.0 ? tiles : fmax(1024.0, ceil(tiles / 16.0));
     double cells = fmin(stored * POLYC__TILE_CELLS, 0x40000000);
     /* endpoints fall in one cell in 15 of a stored tile on intel (57,712
      * cells in 851 tiles), one in 5 on freiburg-079 (143,127 in 720, long
-     * range in a small building): room for one in 4 */
+     * range in a small building): room for one in 4 (the tool doubles the
+     * limits of a map that needs more) */
     double points = fmin(fmax(cells / 4.0, 4096.0), 0x10000000);
     out->area_m = area_m;
     out->max_grid_cells = (uint32_t)cells;
@@ -349,18 +355,37 @@ static void label_contour(polyc_ctx *ctx, const polyc__scan *s)
         polyc__walk w;
         polyc__walk_start(&w, &b);
         int32_t cx = w.ex, cy = w.ey;
-        while (w.n > 0) {
-            polyc__tile *t = polyc__grid_tile(g, w.ix, w.iy);
-            if (t && polyc__cell_occupied(t, polyc__cell_index(w.ix, w.iy), thr)) {
+        /* tile by tile: over tiles no beam wanted (no hit, so no occupied
+         * cell) in one move, as the grid's count does */
+        const polyc__tile *t = NULL;
+        int in = w.n > 0 && polyc__walk_enter(&w, g->width, g->height);
+        while (in && w.n > 0) {
+            if (!(t = polyc__grid_tile(g, w.ix, w.iy))) {
+                int to = polyc__walk_skip_tiles(&w, g->width, g->height, g->tiles_x, g->wanted);
+                if (to <= 0)
+                    break; /* the end cell next, or out of the grid */
+                in = polyc__walk_enter(&w, g->width, g->height);
+                continue;
+            }
+            int left = 0, found = 0;
+            do {
+                if (polyc__cell_occupied(t, w.idx, thr)) {
+                    found = 1;
+                    break;
+                }
+                left = polyc__walk_step(&w);
+            } while (!left && w.n > 0);
+            if (found) {
                 cx = w.ix;
                 cy = w.iy;
                 break;
             }
-            polyc__walk_step(&w);
+            if (left && w.n > 0)
+                in = polyc__walk_enter(&w, g->width, g->height);
         }
-        polyc__tile *t = polyc__grid_tile(g, cx, cy);
-        if (t && polyc__cell_occupied(t, polyc__cell_index(cx, cy), thr))
-            t->contour[cy & (POLYC__TILE_SIDE - 1)] |= 1u << (cx & (POLYC__TILE_SIDE - 1));
+        polyc__tile *e = polyc__grid_tile(g, cx, cy);
+        if (e && polyc__cell_occupied(e, polyc__cell_index(cx, cy), thr))
+            e->contour[cy & (POLYC__TILE_SIDE - 1)] |= 1u << (cx & (POLYC__TILE_SIDE - 1));
     }
 }
 

@@ -1,6 +1,7 @@
 /* bench.c - measure libpolyc on the shared data sets (not in the repo).
  *
- *   bench [--runs N] [--only NAMES] [--single K] [--iterations N] [--occupancy-only] DATA_DIR
+ *   bench [--runs N] [--only NAMES] [--single K] [--iterations N] [--occupancy-only]
+ *         [--no-online | --online-only] DATA_DIR
  *
  * Takes DATA_DIR/sim/NAME.log (+ NAME.gt.txt ground truth) and
  * DATA_DIR/carmen/NAME.log. Prints one table: per scene the input size, the
@@ -8,13 +9,15 @@
  * tools/eval/gtscore), a second table of topology figures (tools/eval/gttopo), then a
  * single-scan section on the real logs, then the occupancy-map section (the
  * library and a findContours-style baseline on grids, and a speed row on a
- * 2,000 x 2,000-cell map file). Logs are read
+ * 2,000 x 2,000-cell map file), then the online section (each log replayed
+ * scan by scan through the online API, beside its batch build). Logs are read
  * with tools/scanlog, the same reader as the CLI. Exit codes: 0 ok, 1 some
  * scene failed, 2 usage or no data directory.
  *
  * This file: the options, the scenes, the helpers the sections share and
  * main. The sections: bench_table.c (the first two tables), bench_single.c
- * (single scans), bench_occupancy.c (occupancy maps); bench.h joins them.
+ * (single scans), bench_occupancy.c (occupancy maps), bench_online.c (the
+ * online API); bench.h joins them.
  */
 #include <dirent.h>
 #include <errno.h>
@@ -44,6 +47,8 @@ static const char usage_text[] =
     "                   grazing_cells, data_min_m (default: the library's)\n"
     "  --seed N         the optimiser's PRNG seed (default: the library's)\n"
     "  --occupancy-only only the occupancy-map section\n"
+    "  --no-online      no online section\n"
+    "  --online-only    only the online section (its batch builds: one run each)\n"
     "  -h, --help       this text\n"
     "Columns: stage times in ms (parse = reading the log, add = polyc_add_scan,\n"
     "grid, contour, trace, optimise, output = JSON to /dev/null); block and used\n"
@@ -82,7 +87,21 @@ static const char usage_text[] =
     "polylines. maze: a 2,000 x 2,000-cell maze at 5 cm written as PGM + YAML to\n"
     "a temporary folder, then read, converted to cells, mapped and written as JSON\n"
     "(to /dev/null) as `polyc map.yaml` does, each timed (target: under 1 s); it\n"
-    "runs unless --only leaves out `maze`.\n"
+    "runs unless --only leaves out `maze`.\n";
+/* (two strings: C99 compilers need only take 4,095 characters in one) */
+static const char usage_online[] =
+    "Online (last section, docs/evaluation.md): each scene replayed scan by scan,\n"
+    "polyc_online_add_scan then polyc_online_update at the default work budget:\n"
+    "add = one add, a+u = one add and its update (median, p99, max, ms); total =\n"
+    "all adds, updates and polyc_online_finish (ms); xbatch = total / the batch\n"
+    "build's library time (add to optimise, the main table's median); finish =\n"
+    "polyc_online_finish (ms); backlog = the most tiles an update left; checkpoints\n"
+    "every 100 scans (at most 10 a log, evenly spread): the online map's\n"
+    "crossings and double cover (worst), its BIC against a batch build of the\n"
+    "scans so far (worst ratio, and at which scan). Then the final online map\n"
+    "beside the batch map (lines, verts, BIC, band15, cross, dcov, uns20, end20;\n"
+    "sims: core, compl), intel's block and 10 passes in the block of one, and\n"
+    "intel's scans with a pose drift corrected by polyc_online_correct.\n"
     "Exit: 0 ok; 1 a scene failed (its row says why); 2 usage error, or\n"
     "DATA_DIR missing: 'bench: data directory DIR not found (pass DATA=path)'.\n";
 
@@ -264,10 +283,12 @@ static int parse_options(int argc, char **argv, options *o)
     o->iterations = -1;
     o->gamma = o->grazing = o->data_min = -1.0;
     o->seed = -1;
+    o->online = 1;
     for (i = 1; i < argc; i++) {
         const char *a = argv[i];
         if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
             fputs(usage_text, stdout);
+            fputs(usage_online, stdout);
             exit(0);
         } else if (strcmp(a, "--runs") == 0 && i + 1 < argc) {
             if (parse_count(argv[++i], 1, MAX_RUNS, &v))
@@ -299,6 +320,10 @@ static int parse_options(int argc, char **argv, options *o)
             o->seed = v;
         } else if (strcmp(a, "--occupancy-only") == 0) {
             o->occupancy_only = 1;
+        } else if (strcmp(a, "--no-online") == 0) {
+            o->online = 0;
+        } else if (strcmp(a, "--online-only") == 0) {
+            o->online_only = 1;
         } else if (strcmp(a, "--only") == 0 && i + 1 < argc) {
             o->only = argv[++i];
         } else if (a[0] == '-' || o->data) {
@@ -307,6 +332,8 @@ static int parse_options(int argc, char **argv, options *o)
             o->data = a;
         }
     }
+    if (o->online_only && (o->occupancy_only || !o->online))
+        return -1; /* --online-only with --occupancy-only or --no-online */
     return o->data ? 0 : -1;
 }
 
@@ -316,11 +343,13 @@ int main(int argc, char **argv)
     options o;
     scene *list = NULL;
     size_t count = 0, cap = 0;
+    bench_figures *batch;
     DIR *dir;
     int failed = 0;
 
     if (parse_options(argc, argv, &o) != 0) {
         fputs(usage_text, stderr);
+        fputs(usage_online, stderr);
         return EXIT_USAGE;
     }
     dir = opendir(o.data);
@@ -337,12 +366,24 @@ int main(int argc, char **argv)
         free(list);
         return EXIT_USAGE;
     }
-    if (!o.occupancy_only && bench_table_section(&o, list, count) != 0)
+    /* the main table's batch figures, for the online section */
+    batch = calloc(count ? count : 1u, sizeof *batch);
+    if (!batch) {
+        fprintf(stderr, "bench: out of memory\n");
+        free(list);
+        return EXIT_FAILED;
+    }
+    if (!o.occupancy_only && !o.online_only &&
+        bench_table_section(&o, list, count, batch) != 0)
         failed = 1;
-    if (!o.occupancy_only && o.single > 0 && bench_single_section(&o, list, count) != 0)
+    if (!o.occupancy_only && !o.online_only && o.single > 0 &&
+        bench_single_section(&o, list, count) != 0)
         failed = 1;
-    if (bench_occupancy_section(&o, list, count) != 0)
+    if (!o.online_only && bench_occupancy_section(&o, list, count) != 0)
         failed = 1;
+    if (!o.occupancy_only && o.online && bench_online_section(&o, list, count, batch) != 0)
+        failed = 1;
+    free(batch);
     printf("\npeak RSS of the process: %.1f MiB\n", bench_peak_rss_mib());
     free(list);
     return failed ? EXIT_FAILED : 0;

@@ -1,12 +1,15 @@
 /* bench.h - what the bench's files share: bench.c (options, scenes, main),
  * bench_table.c (the main table and the topology table), bench_single.c
- * (single scans of the real logs), bench_occupancy.c (occupancy maps). */
+ * (single scans of the real logs), bench_occupancy.c (occupancy maps),
+ * bench_online.c (the online API, scan by scan). */
 #ifndef POLYC_BENCH_H
 #define POLYC_BENCH_H
 
 #include <stddef.h>
 #include <stdint.h>
 
+#include "gtband.h"
+#include "gttopo.h"
 #include "pipeline.h"
 #include "polyc.h"
 #include "scanlog.h"
@@ -31,6 +34,8 @@ typedef struct options {
     double grazing, data_min;  /* < 0: library default */
     long seed;                 /* < 0: library default */
     int occupancy_only;        /* only the occupancy-map section */
+    int online;                /* the online section (--no-online: 0) */
+    int online_only;           /* only the online section */
     const char *data;
 } options;
 
@@ -41,6 +46,20 @@ typedef struct scene {
     char gt_path[1536];        /* sim only */
 } scene;
 
+/* A map's figures as the online section sets them side by side: the batch
+ * build's (filled by bench_table_section) and the online map's. */
+typedef struct bench_figures {
+    int ok;                    /* 0: no map, or not scored */
+    double lib_ms;             /* the library's time (batch: add to optimise,
+                                  the median over the runs) */
+    uint64_t block_bytes;      /* the context's block */
+    uint32_t lines, vertices;
+    double bic;                /* polyc_stats.bic */
+    gttopo_score topo;         /* against the log's scan endpoints */
+    gtband_score band;
+    double core_m;             /* sim scenes: core precision (CORE_M); < 0: none */
+    double completeness;       /* sim scenes; < 0: none */
+} bench_figures;
 
 /* ---- bench.c ---- */
 
@@ -58,11 +77,18 @@ double bench_write_output(const pipeline *p, const polyc_polyline *lines, uint32
 
 /* ---- the sections: each prints its table; 0, or -1 if a scene failed ---- */
 
-/* Every scene timed and scored, then the topology table. */
-int bench_table_section(const options *o, const scene *list, size_t count);
+/* Every scene timed and scored, then the topology table. batch (NULL, or
+ * count entries) gets each scene's batch figures. */
+int bench_table_section(const options *o, const scene *list, size_t count, bench_figures *batch);
 /* Single-scan maps from o->single scans of each real log. */
 int bench_single_section(const options *o, const scene *list, size_t count);
 /* Occupancy grids mapped by the library and by the baseline; the maze. */
 int bench_occupancy_section(const options *o, const scene *list, size_t count);
+/* Each scene replayed scan by scan through the online API beside its batch
+ * build (batch: the main table's figures, count entries; NULL or an entry
+ * not ok: built here, one run), then intel's memory and pose-correction
+ * rows. */
+int bench_online_section(const options *o, const scene *list, size_t count,
+                         const bench_figures *batch);
 
 #endif /* POLYC_BENCH_H */

@@ -108,9 +108,9 @@ static void accuracy(const scene *s, const scanlog *log, const polyc_polyline *l
     }
 }
 
-static int bench_scene(const options *o, const scene *s, topo_row *row)
+static int bench_scene(const options *o, const scene *s, topo_row *row, bench_figures *batch)
 {
-    double times[MAX_RUNS][ST_COUNT], column[MAX_RUNS], med[ST_COUNT];
+    double times[MAX_RUNS][ST_COUNT], column[MAX_RUNS], med[ST_COUNT], lib[MAX_RUNS];
     scanlog log;
     pipeline p;
     polyc_polyline *lines = NULL;
@@ -165,6 +165,22 @@ static int bench_scene(const options *o, const scene *s, topo_row *row)
     }
     polyc_get_stats(p.ctx, &stats);
     accuracy(s, &log, lines, count, &acc, row);
+    if (batch) {
+        /* the online section's comparison: the library's time, add to optimise */
+        for (r = 0; r < o->runs; r++)
+            for (lib[r] = 0.0, k = ST_ADD; k <= ST_OPT; k++)
+                lib[r] += times[r][k];
+        batch->ok = row->ok;
+        batch->lib_ms = bench_median(lib, o->runs);
+        batch->block_bytes = stats.memory_size_bytes;
+        batch->lines = acc.lines;
+        batch->vertices = acc.vertices;
+        batch->bic = stats.bic;
+        batch->topo = row->score;
+        batch->band = row->band;
+        batch->core_m = row->core_m;
+        batch->completeness = acc.has_truth ? acc.score.completeness : -1.0;
+    }
 
     printf("%-24s %6u %8llu | %7.1f %6.1f %7.1f %7.1f %7.1f %8.1f %6.1f %8.1f | %8.2f %8.2f "
            "%7.1f | %6u %7u ",
@@ -231,7 +247,7 @@ static void print_topology(const topo_row *rows, size_t count)
     fflush(stdout);
 }
 
-int bench_table_section(const options *o, const scene *list, size_t count)
+int bench_table_section(const options *o, const scene *list, size_t count, bench_figures *batch)
 {
     topo_row *rows = calloc(count ? count : 1u, sizeof *rows);
     int failed = 0;
@@ -241,7 +257,7 @@ int bench_table_section(const options *o, const scene *list, size_t count)
     }
     print_header(o);
     for (size_t i = 0; i < count; i++)
-        if (bench_scene(o, &list[i], &rows[i]) != 0)
+        if (bench_scene(o, &list[i], &rows[i], batch ? &batch[i] : NULL) != 0)
             failed = 1;
     print_topology(rows, count);
     free(rows);
