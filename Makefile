@@ -13,12 +13,12 @@ LDLIBS  = -lm
 LIB_SRC  = $(wildcard src/*.c)
 LIB_OBJ  = $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
 # tools/: the shipped tool (POLYC_SRC: main, command line, input, run,
-# messages) and its modules (log reader, map files, SVG/JSON/TXT output,
+# the online replay, messages) and its modules (log reader, map files, SVG/JSON/TXT output,
 # the library's block), which the tests, the bench and the binding use too.
 # tools/eval/: the evaluation harness (bench, sweep, simulator, ground-truth
 # and topology scores), which the tests and the benchmark use and the tool
 # does not.
-POLYC_SRC = tools/polyc.c tools/cli.c tools/options.c tools/load.c tools/run.c
+POLYC_SRC = tools/polyc.c tools/cli.c tools/options.c tools/load.c tools/run.c tools/online.c
 POLYC_OBJ = $(POLYC_SRC:tools/%.c=$(BUILD)/tobj/%.o)
 TOOL_MOD = $(filter-out $(POLYC_SRC),$(wildcard tools/*.c))
 TOOL_OBJ = $(TOOL_MOD:tools/%.c=$(BUILD)/tobj/%.o)
@@ -189,12 +189,13 @@ $(BUILD)/footprint8: examples/footprint.c $(EMB_OBJ)
 	$(CC) $(WARN) $(OPT) $(CFLAGS) -Iinclude $^ -o $@ $(LDLIBS)
 
 # Robustness (docs/security.md). test-cli: every bad input of the tool
-# (tests/cli_bad_input.sh) and where it writes (tests/cli_output.sh: as root,
-# also as an ordinary user). test-fuzz-replay: the committed fuzz corpus through
-# the fuzz targets, built with $(CC). test-asan: unit tests, corpus replay and
+# (tests/cli_bad_input.sh), where it writes (tests/cli_output.sh: as root,
+# also as an ordinary user) and --online (tests/cli_online.sh).
+# test-fuzz-replay: the committed fuzz corpus through the fuzz targets, built
+# with $(CC). test-asan: unit tests, corpus replay and
 # the quick bad-input tests again in build-asan/ under ASan and UBSan.
-# test-valgrind: the tool over a sample log, its grid as a ROS map and a bad
-# log, no error or leak.
+# test-valgrind: the tool over a sample log (batch and --online), its grid as
+# a ROS map and a bad log, no error or leak.
 FUZZ_TARGETS = scanlog library mapyaml pgm
 FUZZ_REPLAY  = $(FUZZ_TARGETS:%=$(BUILD)/tests/fuzz_replay_%)
 $(BUILD)/tests/fuzz_replay_%: tests/fuzz_%.c tests/fuzz_replay.c $(TOOL_OBJ) $(BUILD)/libpolyc.a
@@ -206,6 +207,7 @@ CLI_TEST_ARGS ?=
 test-cli: $(BUILD)/polyc
 	tests/cli_bad_input.sh $(CLI_TEST_ARGS) $(BUILD)/polyc
 	tests/cli_output.sh $(BUILD)/polyc
+	tests/cli_online.sh $(BUILD)/polyc
 SAN_LIST  = address,undefined,float-cast-overflow
 SAN_FLAGS = -fsanitize=$(SAN_LIST) -fno-sanitize-recover=all
 test-asan:
@@ -218,6 +220,8 @@ test-valgrind: $(BUILD)/polyc
 	$(VALGRIND) --error-exitcode=1 $(BUILD)/polyc --stats --iterations 20 \
 	    -o $(BUILD)/valgrind.svg examples/office.log
 	$(VALGRIND) --error-exitcode=1 $(BUILD)/polyc convert -o $(BUILD)/valgrind.txt examples/office.log
+	$(VALGRIND) --error-exitcode=1 $(BUILD)/polyc --online --stats --iterations 5 \
+	    --frames $(BUILD)/valgrind_frames --every 100 -o $(BUILD)/valgrind.svg examples/office.log
 	$(VALGRIND) --error-exitcode=1 $(BUILD)/polyc grid -o $(BUILD)/valgrind_grid examples/office.log
 	$(VALGRIND) --error-exitcode=1 $(BUILD)/polyc --stats --iterations 5 -o $(BUILD)/valgrind.svg \
 	    $(BUILD)/valgrind_grid.yaml
@@ -226,6 +230,7 @@ test-valgrind: $(BUILD)/polyc
 	$(VALGRIND) --error-exitcode=99 $(BUILD)/polyc -o $(BUILD)/valgrind.svg $(BUILD)/valgrind_bad.log; \
 	    test $$? = 1
 	rm -f $(BUILD)/valgrind.svg $(BUILD)/valgrind.txt $(BUILD)/valgrind_bad.log $(BUILD)/valgrind_grid.*
+	rm -rf $(BUILD)/valgrind_frames
 
 # libFuzzer (`make fuzz FUZZ_TIME=600`; needs clang): every target in
 # build-fuzz/, run one after the other on a scratch corpus seeded from
@@ -318,11 +323,13 @@ $(BUILD)/sweep: tools/eval/sweep.c $(EVAL_OBJ) $(TOOL_OBJ) $(BUILD)/libpolyc.a
 
 # The README's pictures (docs/img/*.png but corridor.png, which is `make
 # sweep`'s): the tool's SVGs, from the bench build, rendered 700 px wide by
-# rsvg-convert (librsvg2-bin). intel.log is read from DATA.
+# rsvg-convert (librsvg2-bin). intel.log is read from DATA. online-strip.png:
+# intel replayed with --online, its frames after 200, 400, 600 and 910 scans
+# side by side (tools/eval/svgstrip.sh: one SVG of the four, rendered once).
 # `make images DATA=../shared/data`
 IMG_DIR = build-bench/img
 .PHONY: images
-images:
+images: images-online
 	$(MAKE) BUILD=build-bench OPT='-O3 -march=native -DNDEBUG' build-bench/polyc
 	@mkdir -p $(IMG_DIR)
 	build-bench/polyc -o $(IMG_DIR)/office.svg examples/office.log
@@ -334,6 +341,17 @@ images:
 	    rsvg-convert -w 700 -o docs/img/$$f.png $(IMG_DIR)/$$f.svg || exit 1; done
 	build-bench/polyc --points -o $(IMG_DIR)/fhw.svg $(DATA)/carmen/fhw.log
 	sh tools/eval/svgcrop.sh $(IMG_DIR)/fhw.svg docs/img/fhw-band.png 6 9 12 15 450
+
+# `make images-online DATA=../shared/data`: the strip alone
+.PHONY: images-online
+images-online:
+	$(MAKE) BUILD=build-bench OPT='-O3 -march=native -DNDEBUG' build-bench/polyc
+	@mkdir -p $(IMG_DIR)
+	rm -rf $(IMG_DIR)/online
+	build-bench/polyc --online --frames $(IMG_DIR)/online --every 10 \
+	    -o $(IMG_DIR)/intel-online.svg $(DATA)/carmen/intel.log
+	sh tools/eval/svgstrip.sh docs/img/online-strip.png 1400 \
+	    $(foreach n,00200 00400 00600 00910,$(IMG_DIR)/online/frame-$(n).svg)
 
 # Regenerate the bundled example (examples/office.*) with the simulator
 .PHONY: examples

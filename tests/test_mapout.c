@@ -366,6 +366,40 @@ static void test_svg_grid(void **state)
     free(block);
 }
 
+/* The robot's path: its poses joined, the last one a circle; a fixed view
+ * box is what the SVG shows (its comment on line 3), whatever is drawn. */
+static void test_svg_path_and_view(void **state)
+{
+    (void)state;
+    polyc_polyline lines[2];
+    mapout_map m = tiny_map(lines);
+    polyc_scan poses[3];
+    memset(poses, 0, sizeof poses);
+    for (int i = 0; i < 3; i++)
+        poses[i].pose_x_m = 0.5 * i;
+    m.path = poses;
+    m.path_count = 3;
+    char *out = render(mapout_svg, &m);
+    const char *p = strstr(out, "<g id=\"path\"");
+    assert_non_null(p);
+    assert_non_null(strstr(p, " L"));
+    assert_non_null(strstr(p, "<circle"));
+    assert_non_null(strstr(out, "the robot's path and pose"));
+    free(out);
+    polyc_box view = {-10.0, -5.0, 10.0, 5.0};
+    m.path = NULL;
+    m.view_m = &view;
+    out = render(mapout_svg, &m);
+    assert_null(strstr(out, "<g id=\"path\""));
+    double x0, x1, y0, y1;
+    p = strstr(out, "<!-- polyc map: x ");
+    assert_non_null(p);
+    assert_int_equal(sscanf(p, "<!-- polyc map: x %lf..%lf m, y %lf..%lf m", &x0, &x1, &y0, &y1), 4);
+    assert_true(x0 < -10.0 && x0 > -10.5 && x1 > 10.0 && x1 < 10.5);   /* 2 % of air */
+    assert_true(y0 < -5.0 && y0 > -5.5 && y1 > 5.0 && y1 < 5.5);
+    free(out);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -375,6 +409,7 @@ int main(void)
         cmocka_unit_test(test_svg),
         cmocka_unit_test(test_svg_points_and_empty),
         cmocka_unit_test(test_svg_grid),
+        cmocka_unit_test(test_svg_path_and_view),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

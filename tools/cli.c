@@ -18,6 +18,12 @@ double now_ms(void)
     return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6;
 }
 
+int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
 /* ---- progress: one line on a terminal ---- */
 
 /* Shown on stderr when it is a terminal (not with --quiet), once a run has

@@ -26,4 +26,9 @@ enum ctxblock_result {
 int ctxblock_make(const polyc_config *cfg, const polyc_limits *lim, double max_bytes,
                   void **block, size_t *size, polyc_ctx **ctx, polyc_status *init_status);
 
+/* The allocation alone, for a size from another query (an online context's,
+ * polyc_online_memory_size): CTXBLOCK_UNSIZED for size 0, CTXBLOCK_OVER_CAP,
+ * else *block (freed first) gets size bytes or CTXBLOCK_NOMEM. */
+int ctxblock_alloc(size_t size, double max_bytes, void **block);
+
 #endif /* POLYC_CTXBLOCK_H */

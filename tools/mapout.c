@@ -103,6 +103,7 @@ int mapout_json(FILE *f, const mapout_map *map)
 #define SVG_CHAR_EM 0.6                /* a sans-serif character's width, in font sizes */
 #define SVG_LINE_COLOUR "#17407a"      /* the map, unless --color-lines: dark blue */
 #define SVG_INK "#404040"              /* text, axes, the origin */
+#define SVG_PATH_COLOUR "#c0392b"      /* the robot's path and pose: red */
 #define SVG_FONT "font-family=\"sans-serif\" fill=\"" SVG_INK "\""
 
 /* --color-lines: distinct colours, cycled over the polylines. */
@@ -224,6 +225,14 @@ static void make_view(const mapout_map *map, view *v)
                     box_add(v, gx + (ix + 1) * c, gy + (iy + 1) * c);
                 }
     }
+    for (uint32_t i = 0; map->path && i < map->path_count; i++)
+        box_add(v, map->path[i].pose_x_m, map->path[i].pose_y_m);
+    if (map->view_m) {
+        v->x0 = map->view_m->min_x_m;
+        v->y0 = map->view_m->min_y_m;
+        v->x1 = map->view_m->max_x_m;
+        v->y1 = map->view_m->max_y_m;
+    }
     if (!(v->x0 <= v->x1)) {           /* nothing to show */
         v->x0 = v->y0 = -0.5;
         v->x1 = v->y1 = 0.5;
@@ -256,7 +265,8 @@ static void make_view(const mapout_map *map, view *v)
                       map->cell_m);
     if (map->stats && map->stats->iterations == 0 && n > 0 && (size_t)n < sizeof v->subtitle)
         snprintf(v->subtitle + n, sizeof v->subtitle - (size_t)n, ", not optimised");
-    v->legend_rows = 1 + (map->vertices != 0) + (map->scans != NULL) + 2 * (map->grid != NULL);
+    v->legend_rows = 1 + (map->vertices != 0) + (map->scans != NULL) + 2 * (map->grid != NULL) +
+                     (map->path && map->path_count);
 
     /* room for the y axis' labels on the left */
     size_t widest = 1;
@@ -401,6 +411,24 @@ static void svg_axes(FILE *f, const view *v)
     }
 }
 
+/* The robot's path (its poses joined) and its last pose: a circle with a
+ * stroke along its heading. */
+static void svg_path(FILE *f, const mapout_map *map, const view *v)
+{
+    fprintf(f, "<g id=\"path\" fill=\"none\" stroke=\"" SVG_PATH_COLOUR "\" stroke-width=\"%.2f\""
+               " stroke-linejoin=\"round\">\n<path stroke-opacity=\"0.6\" d=\"",
+            v->stroke / 2);
+    for (uint32_t i = 0; i < map->path_count; i++)
+        fprintf(f, "%s%.2f %.2f", i ? " L" : "M", px_x(v, map->path[i].pose_x_m),
+                px_y(v, map->path[i].pose_y_m));
+    const polyc_scan *s = &map->path[map->path_count - 1];
+    double x = px_x(v, s->pose_x_m), y = px_y(v, s->pose_y_m), r = 3 * v->stroke;
+    fprintf(f, "\"/>\n<circle cx=\"%.2f\" cy=\"%.2f\" r=\"%.2f\" stroke-width=\"%.2f\"/>"
+               "<path stroke-width=\"%.2f\" d=\"M%.2f %.2fl%.2f %.2f\"/>\n</g>\n",
+            x, y, r, v->stroke, v->stroke, x, y, 2 * r * cos(s->pose_theta_rad),
+            -2 * r * sin(s->pose_theta_rad));
+}
+
 static void svg_scalebar(FILE *f, const view *v)
 {
     double len_m = nice_length((v->x1 - v->x0) / 4);
@@ -444,6 +472,12 @@ static void svg_legend(FILE *f, const mapout_map *map, const view *v)
         fprintf(f, "<rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" height=\"%.2f\" fill=\"#707070\""
                    " fill-opacity=\"0.6\"/>\n<text x=\"%.2f\" y=\"%.2f\">scan endpoints</text>\n",
                 x + sw / 2 - 2, y - 0.35 * v->small - 2, 4.0, 4.0, tx, y);
+    }
+    if (map->path && map->path_count) {
+        y += row;
+        fprintf(f, "<path stroke=\"" SVG_PATH_COLOUR "\" stroke-width=\"%.2f\" d=\"M%.2f %.2fh%.2f\"/>\n"
+                   "<text x=\"%.2f\" y=\"%.2f\">the robot's path and pose</text>\n",
+                v->stroke / 2, x, y - 0.35 * v->small, sw, tx, y);
     }
     if (map->grid) {
         static const char *const what[2] = {"occupied grid cells", "contour cells"};
@@ -500,6 +534,8 @@ int mapout_svg(FILE *f, const mapout_map *map)
         }
     }
     fputs("</g>\n", f);
+    if (map->path && map->path_count)
+        svg_path(f, map, &v);
     svg_scalebar(f, &v);
     svg_legend(f, map, &v);
     fputs("</svg>\n", f);

@@ -23,6 +23,11 @@ typedef struct mapout_map {
     uint32_t scan_count;
     const polyc_ctx *grid;         /* --grid: draw this context's grid; NULL: off */
     float contour_threshold;       /* a grid cell is drawn if hits/(hits+misses) > this */
+    const polyc_scan *path;        /* the robot's path: these scans' poses joined, the
+                                      last one drawn as the robot; NULL: off */
+    uint32_t path_count;
+    const polyc_box *view_m;       /* the part of the plane shown (metres); NULL: what
+                                      is drawn */
     int vertices;                  /* --vertices: a dot on every vertex */
     int color_lines;               /* --color-lines: a colour per polyline (else one) */
     const char *title;             /* the title: this path's file name; NULL: "polyc map" */

@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "cli.h"
 #include "outfile.h"
@@ -21,7 +22,8 @@ static const struct {
     {"--occupied-thresh", OPT_OCCUPIED}, {"--free-thresh", OPT_FREE}, {"--stats", OPT_STATS},
     {"--no-optimize", OPT_NO_OPTIMIZE}, {"--exact-points", OPT_EXACT},
     {"--grid-trace", OPT_GRID_TRACE}, {"--points", OPT_POINTS}, {"--grid", OPT_GRID},
-    {"--vertices", OPT_VERTICES},     {"--color-lines", OPT_COLOR_LINES},
+    {"--vertices", OPT_VERTICES},     {"--color-lines", OPT_COLOR_LINES}, {"--online", OPT_ONLINE},
+    {"--work", OPT_WORK},             {"--frames", OPT_FRAMES},     {"--every", OPT_EVERY},
 };
 
 static const char usage_text[] =
@@ -61,6 +63,12 @@ static const char usage_text[] =
     "  --points, --grid, --vertices\n"
     "                          SVG layers: scan endpoints, grid cells, vertex dots\n"
     "  --color-lines           SVG: a colour per polyline (default: one for the map)\n"
+    "  --online                replay the log as a live stream: add each scan, update the\n"
+    "                          map within a work budget, finish, then write it as above\n"
+    "  --work N                --online: an update's budget in work units (default %u)\n"
+    "  --frames DIR            --online: the map as SVG every --every scans into DIR\n"
+    "                          (made if missing): DIR/frame-00050.svg, ...\n"
+    "  --every N               --frames: scans between frames (default 50)\n"
     "  --help, --version\n"
     "exit codes: 0 ok, 1 bad input or other failure, 2 usage, 3 memory budget too small\n";
 
@@ -118,6 +126,17 @@ static int set_value(options *o, const char *name, const char *val)
         if (parse_double(val, 0.05, 1e6, &d))
             return complain(EXIT_USAGE, "--max-range needs metres in [0.05, 1e6], not '%s'", val);
         o->max_range_m = d;
+    } else if (strcmp(name, "--work") == 0) {
+        if (parse_u64(val, UINT64_MAX, &u) || u == 0)
+            return complain(EXIT_USAGE, "--work needs a budget of 1 or more work units, not"
+                                        " '%s' (an update with no budget does nothing)", val);
+        o->work = u;
+    } else if (strcmp(name, "--every") == 0) {
+        if (parse_u64(val, UINT32_MAX, &u) || u == 0)
+            return complain(EXIT_USAGE, "--every needs 1..%u scans, not '%s'", UINT32_MAX, val);
+        o->every = (uint32_t)u;
+    } else if (strcmp(name, "--frames") == 0) {
+        o->frames = val;
     } else if (strcmp(name, "--memory-mb") == 0) {
         if (parse_double(val, 1e-6, 1e9, &d))
             return complain(EXIT_USAGE, "--memory-mb needs MiB from 0.000001 to 1000000000,"
@@ -169,6 +188,8 @@ static int set_flag(options *o, const char *name)
         o->vertices = 1;
     else if (strcmp(name, "--color-lines") == 0)
         o->color_lines = 1;
+    else if (strcmp(name, "--online") == 0)
+        o->online = 1;
     else
         return -1;
     return 0;
@@ -179,7 +200,8 @@ static int takes_value(const char *name)
     static const char *const names[] = {"--format", "-o",          "--output",    "--trace",
                                         "--seed",   "--iterations", "--max-range", "--memory-mb",
                                         "--cell",   "--threshold", "--alpha",     "--gamma",
-                                        "--occupied-thresh", "--free-thresh"};
+                                        "--occupied-thresh", "--free-thresh", "--work",
+                                        "--frames", "--every"};
     for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
         if (strcmp(name, names[i]) == 0)
             return 1;
@@ -240,6 +262,25 @@ static int check_outputs(options *o)
     return 0;
 }
 
+/* --work, --frames and --every with --online only, --every with --frames;
+ * --frames naming a folder (or a new name). Before any work. */
+static int check_online(const options *o)
+{
+    struct stat st;
+    if (!o->online)
+        return refuse_options(o, ~(unsigned)OPTS_ONLINE, "a batch run (give --online)");
+    if ((o->given & OPT_EVERY) && !o->frames)
+        return complain(EXIT_USAGE, "--every needs --frames DIR");
+    if (o->no_optimize)
+        return complain(EXIT_USAGE, "--no-optimize does not apply to --online (its map is"
+                                    " always optimised)");
+    if (o->frames && !*o->frames)
+        return complain(EXIT_USAGE, "--frames '' is empty: give a folder");
+    if (o->frames && stat(o->frames, &st) == 0 && !S_ISDIR(st.st_mode))
+        return complain(EXIT_USAGE, "--frames '%s' is not a folder", o->frames);
+    return 0;
+}
+
 /* polyc_config_check's message, in the options' names: "cell_m must be in
  * [0.001, 10]" is "--cell must be in [0.001, 10]". */
 static int config_fail(const char *why)
@@ -275,6 +316,8 @@ int parse_args(int argc, char **argv, options *o)
     int npos = 0, only_files = 0;
     memset(o, 0, sizeof *o);
     polyc_config_default(&o->config);
+    o->work = POLYC_ONLINE_WORK_DEFAULT;
+    o->every = 50;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         if (only_files || a[0] != '-' || strcmp(a, "-") == 0) {
@@ -286,7 +329,7 @@ int parse_args(int argc, char **argv, options *o)
         if (strcmp(a, "--") == 0) {
             only_files = 1;
         } else if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            fputs(usage_text, stdout);
+            printf(usage_text, (unsigned)POLYC_ONLINE_WORK_DEFAULT);
             return -1;
         } else if (strcmp(a, "--version") == 0) {
             printf("polyc %d.%d.%d\n", POLYC_VERSION_MAJOR, POLYC_VERSION_MINOR,
@@ -325,6 +368,8 @@ int parse_args(int argc, char **argv, options *o)
         return complain(EXIT_USAGE, "polyc grid needs -o PREFIX (it writes PREFIX.pgm and"
                                     " PREFIX.yaml)");
     int rc = check_outputs(o);
+    if (!rc)
+        rc = check_online(o);
     if (rc)
         return rc;
     const char *why = NULL;

@@ -9,7 +9,8 @@
  * Formats and rules: docs/formats.md.
  *
  * This file: main. The rest of the tool: options.c (the command line),
- * load.c (the input), run.c (the library's run and the outputs), cli.c
+ * load.c (the input), run.c (the library's run and the outputs), online.c
+ * (--online: the log replayed as a stream), cli.c
  * (messages, the progress line, writing the outputs); cli.h joins them. */
 #include <stdlib.h>
 #include <string.h>
@@ -26,7 +27,9 @@ static int struct_sizes_match(void)
            polyc_struct_size("polyc_polyline") == sizeof(polyc_polyline) &&
            polyc_struct_size("polyc_stats") == sizeof(polyc_stats) &&
            polyc_struct_size("polyc_iteration") == sizeof(polyc_iteration) &&
-           polyc_struct_size("polyc_occupancy_grid") == sizeof(polyc_occupancy_grid);
+           polyc_struct_size("polyc_occupancy_grid") == sizeof(polyc_occupancy_grid) &&
+           polyc_struct_size("polyc_online_limits") == sizeof(polyc_online_limits) &&
+           polyc_struct_size("polyc_online_report") == sizeof(polyc_online_report);
 }
 
 int main(int argc, char **argv)
@@ -77,6 +80,7 @@ int main(int argc, char **argv)
         if (!rc)
             rc = o.command == CMD_CONVERT ? convert(&o, &r)
                  : o.command == CMD_GRID  ? grid_files(&o, &r, t_start)
+                 : o.online               ? online_map(&o, &r, t_start, &t)
                                           : make_map(&o, &r, t_start, &t);
     }
     progress_clear();

@@ -11,8 +11,7 @@
 #include "cli.h"
 #include "ctxblock.h"
 
-/* Maps a library failure to a message and an exit code. */
-static int library_fail(const char *stage, polyc_status st, const polyc_ctx *ctx, size_t block)
+int library_fail(const char *stage, polyc_status st, const polyc_ctx *ctx, size_t block)
 {
     const char *msg = ctx ? polyc_last_error(ctx) : NULL;
     if (st == POLYC_ERR_NOMEM)
@@ -29,12 +28,6 @@ static int budget_fail(const options *o, size_t size)
     return complain(EXIT_MEMORY, "memory budget too small: need %zu bytes (%.1f MiB), --memory-mb"
                                  " %g allows %g MiB: give --memory-mb %.0f or more",
                     size, mib, o->memory_mb, o->memory_mb, ceil(mib));
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
 }
 
 /* The data are too wide for the grid. Names the scan that reaches farthest
@@ -98,26 +91,41 @@ static int map_fail(const options *o, const map_input *m, polyc_status st, const
     return library_fail("map", st, ctx, block);
 }
 
-/* The library's block for cfg and lim in r->block (ctxblock.h) and a
- * context on it; 0, or the exit code of the complaint. */
-static int make_block(const options *o, run *r, const polyc_config *cfg, const polyc_limits *lim,
-                      polyc_ctx **ctx, size_t *size)
+int block_fail(const options *o, int made, polyc_status st, const polyc_ctx *ctx, size_t size)
 {
-    polyc_status st = POLYC_OK;
-    switch (ctxblock_make(cfg, lim, o->memory_mb * 1048576.0, &r->block, size, ctx, &st)) {
+    switch (made) {
     case CTXBLOCK_OK:
         return 0;
     case CTXBLOCK_UNSIZED:
         return complain(EXIT_MEMORY, "memory budget too small: need more than %zu bytes",
                         (size_t)SIZE_MAX);
     case CTXBLOCK_OVER_CAP:
-        return budget_fail(o, *size);
+        return budget_fail(o, size);
     case CTXBLOCK_NOMEM:
         return complain(EXIT_MEMORY, "memory budget too small: need %zu bytes (malloc failed)",
-                        *size);
+                        size);
     default:
-        return library_fail("init", st, *ctx, *size);
+        return library_fail("init", st, ctx, size);
     }
+}
+
+/* The library's block for cfg and lim in r->block (ctxblock.h) and a
+ * context on it; 0, or the exit code of the complaint. */
+static int make_block(const options *o, run *r, const polyc_config *cfg, const polyc_limits *lim,
+                      polyc_ctx **ctx, size_t *size)
+{
+    polyc_status st = POLYC_OK;
+    int made = ctxblock_make(cfg, lim, o->memory_mb * 1048576.0, &r->block, size, ctx, &st);
+    return block_fail(o, made, st, *ctx, *size);
+}
+
+int add_fail(const options *o, const run *r, uint32_t i, polyc_status st, const polyc_ctx *ctx,
+             size_t size)
+{
+    if (st == POLYC_ERR_SCAN)
+        return complain(EXIT_INPUT, "%s:%llu: scan rejected by the library: %s", input_name(o),
+                        (unsigned long long)r->log.line_of_scan[i], polyc_last_error(ctx));
+    return library_fail("add scan", st, ctx, size);
 }
 
 /* The log's scans into the context; 0, or the exit code of the complaint
@@ -127,13 +135,8 @@ static int add_scans(const options *o, const run *r, polyc_ctx *ctx, size_t size
     progress_stage("adding scans");
     for (uint32_t i = 0; i < r->log.count; i++) {
         polyc_status st = polyc_add_scan(ctx, &r->log.scans[i]);
-        if (st == POLYC_OK)
-            continue;
-        if (st == POLYC_ERR_SCAN)
-            return complain(EXIT_INPUT, "%s:%llu: scan rejected by the library: %s",
-                            input_name(o), (unsigned long long)r->log.line_of_scan[i],
-                            polyc_last_error(ctx));
-        return library_fail("add scan", st, ctx, size);
+        if (st != POLYC_OK)
+            return add_fail(o, r, i, st, ctx, size);
     }
     return 0;
 }
@@ -197,9 +200,33 @@ int convert(const options *o, run *r)
     return write_outputs(paths, bufs, 1);
 }
 
+polyc_progress_fn iteration_fn(const options *o)
+{
+    return o->trace || progress_on() ? on_iteration : NULL;
+}
+
 /* ---- the map out ---- */
 
-#define RUN_AGAIN (-1)
+int optimiser_status(run *r, polyc_status st, int retry, const char *stage, const polyc_ctx *ctx,
+                     size_t size)
+{
+    if (st == POLYC_ERR_NOMEM && retry) {
+        if (r->trace.f)
+            rewind(r->trace.f);    /* (the rerun writes the same lines again) */
+        return RUN_AGAIN;
+    }
+    return st == POLYC_OK ? 0 : library_fail(stage, st, ctx, size);
+}
+
+int open_trace(const options *o, run *r)
+{
+    if (!o->trace || r->trace.f)
+        return 0;
+    if (membuf_open(&r->trace))
+        return EXIT_INPUT;
+    fputs("# iteration bic best_bic vertices polylines noise_m\n", r->trace.f);
+    return 0;
+}
 
 /* The stages on a fresh context, from the data in to the optimised map,
  * each timed into t; 0, an exit code, or RUN_AGAIN if the trace or the
@@ -247,30 +274,57 @@ static int run_stages(const options *o, run *r, const polyc_config *cfg, polyc_c
         return library_fail("trace", st, ctx, size);
     double t4 = now_ms();
     t->trace_ms = t4 - t3;
-    if (o->trace && !r->trace.f) {
-        if (membuf_open(&r->trace))
-            return EXIT_INPUT;
-        fputs("# iteration bic best_bic vertices polylines noise_m\n", r->trace.f);
-    }
+    if (open_trace(o, r))
+        return EXIT_INPUT;
     if (!o->no_optimize && cfg->max_iterations > 0) {
         progress_stage("optimize");
-        st = polyc_optimize(ctx, o->trace || progress_on() ? on_iteration : NULL, r->trace.f);
-        if (st == POLYC_ERR_NOMEM && retry) {
-            if (r->trace.f)
-                rewind(r->trace.f); /* (the rerun writes the same lines again) */
-            return RUN_AGAIN;
-        }
-        if (st != POLYC_OK)
-            return library_fail("optimize", st, ctx, size);
+        st = polyc_optimize(ctx, iteration_fn(o), r->trace.f);
+        int rc = optimiser_status(r, st, retry, "optimize", ctx, size);
+        if (rc)
+            return rc;
     }
     t->optimize_ms = now_ms() - t4;
     return 0;
 }
 
-/* The map rendered (SVG, JSON or TXT) and written with the trace, both or
- * neither; --stats after. 0 or an exit code. */
-static int write_map(const options *o, run *r, const polyc_config *cfg, polyc_ctx *ctx,
-                     size_t size, const mapout_times *t, double t_start)
+int map_to_draw(const options *o, run *r, const polyc_config *cfg, polyc_ctx *ctx, size_t size,
+                mapout_map *map)
+{
+    polyc_status st;
+    uint32_t n = polyc_polyline_count(ctx);
+    free(r->lines);
+    r->lines = calloc(n ? n : 1, sizeof *r->lines);
+    if (!r->lines)
+        return complain(EXIT_INPUT, "out of memory");
+    for (uint32_t i = 0; i < n; i++)
+        if ((st = polyc_get_polyline(ctx, i, &r->lines[i])) != POLYC_OK)
+            return library_fail("get polyline", st, ctx, size);
+    memset(map, 0, sizeof *map);
+    map->lines = r->lines;
+    map->line_count = n;
+    map->scans = o->points ? r->log.scans : NULL;
+    map->scan_count = r->log.count;
+    map->grid = o->grid ? ctx : NULL;
+    map->contour_threshold = cfg->contour_threshold;
+    map->vertices = o->vertices;
+    map->color_lines = o->color_lines;
+    map->title = input_name(o);
+    map->cell_m = r->map ? r->map->yaml.resolution_m : (double)cfg->cell_m;
+    return 0;
+}
+
+int render_map(membuf *out, enum format format, const mapout_map *map)
+{
+    if (membuf_open(out))
+        return EXIT_INPUT;
+    int bad = format == FORMAT_JSON  ? mapout_json(out->f, map)
+              : format == FORMAT_TXT ? mapout_txt(out->f, map)
+                                     : mapout_svg(out->f, map);
+    return membuf_close(out, bad) ? EXIT_INPUT : 0;
+}
+
+int write_map(const options *o, run *r, const polyc_config *cfg, polyc_ctx *ctx, size_t size,
+              const mapout_times *t, double t_start)
 {
     double t5 = now_ms();
     progress_stage("writing");
@@ -285,42 +339,21 @@ static int write_map(const options *o, run *r, const polyc_config *cfg, polyc_ct
         stats.bic = bic;
         stats.error_sq_m2 = error_sq_m2;
     }
-    uint32_t n = polyc_polyline_count(ctx);
-    r->lines = calloc(n ? n : 1, sizeof *r->lines);
-    if (!r->lines)
-        return complain(EXIT_INPUT, "out of memory");
-    for (uint32_t i = 0; i < n; i++)
-        if ((st = polyc_get_polyline(ctx, i, &r->lines[i])) != POLYC_OK)
-            return library_fail("get polyline", st, ctx, size);
-
     mapout_map map;
-    memset(&map, 0, sizeof map);
-    map.lines = r->lines;
-    map.line_count = n;
+    int rc = map_to_draw(o, r, cfg, ctx, size, &map);
+    if (rc)
+        return rc;
     map.stats = &stats;
     map.times = t;
-    map.scans = o->points ? r->log.scans : NULL;
-    map.scan_count = r->log.count;
-    map.grid = o->grid ? ctx : NULL;
-    map.contour_threshold = cfg->contour_threshold;
-    map.vertices = o->vertices;
-    map.color_lines = o->color_lines;
-    map.title = input_name(o);
-    map.cell_m = r->map ? r->map->yaml.resolution_m : (double)cfg->cell_m;
     map.total_ms = now_ms() - t_start;
-    if (membuf_open(&r->out))
-        return EXIT_INPUT;
-    int bad = o->format == FORMAT_JSON  ? mapout_json(r->out.f, &map)
-              : o->format == FORMAT_TXT ? mapout_txt(r->out.f, &map)
-                                        : mapout_svg(r->out.f, &map);
-    if (membuf_close(&r->out, bad))
-        return EXIT_INPUT;
+    if ((rc = render_map(&r->out, o->format, &map)) != 0)
+        return rc;
     if (o->trace && membuf_close(&r->trace, 0))
         return EXIT_INPUT;
     /* both outputs or neither */
     const char *paths[] = {o->output, o->trace};
     const membuf *bufs[] = {&r->out, &r->trace};
-    int rc = write_outputs(paths, bufs, o->trace ? 2 : 1);
+    rc = write_outputs(paths, bufs, o->trace ? 2 : 1);
     double t6 = now_ms();
     if (o->stats)
         print_stats(o, r, &stats, t, t6 - t5, t6 - t_start);

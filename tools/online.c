@@ -1,0 +1,256 @@
+/* online.c - polyc --online (cli.h): a log replayed as a live stream.
+ * Takes: the log read by load.c and the options. Gives: an online context
+ * sized for the log's area, each scan added and the map updated within
+ * --work, --frames' SVGs, the finished map written as run.c writes a batch
+ * map, and --stats' latencies of an add and of an add and its update. */
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "cli.h"
+#include "ctxblock.h"
+
+#define ONLINE_ATTEMPTS 3          /* the usual limits, then 4 and 16 times them */
+#define ONLINE_EDGE_M 1.0          /* the library refuses data this near the area's
+                                      edge (docs/api.md, "Online") */
+#define ONLINE_AIR_CELLS 32.0      /* and a tile of air inside that */
+
+/* What --stats shows of the replay. */
+typedef struct replay {
+    double *add_ms, *step_ms;      /* per scan: the add, the add and its update */
+    double area_m, finish_ms, frames_ms;
+    polyc_box box;                 /* every scan's endpoints and pose: the frames' view */
+    uint32_t max_backlog, frames, attempts;
+    char stage[48];                /* the progress line's */
+} replay;
+
+/* The side of the square round the first pose that holds every scan's
+ * endpoints and pose (*box), with a margin; *max_beams gets the largest scan. */
+static double log_area(const polyc_config *cfg, const scanlog *log, polyc_box *box,
+                       uint32_t *max_beams)
+{
+    double x0 = log->scans[0].pose_x_m, y0 = log->scans[0].pose_y_m;
+    *box = (polyc_box){x0, y0, x0, y0};
+    *max_beams = 0;
+    for (uint32_t i = 0; i < log->count; i++) {
+        polyc_scan_extent(cfg, &log->scans[i], box);
+        if (log->scans[i].beam_count > *max_beams)
+            *max_beams = log->scans[i].beam_count;
+    }
+    double reach = fmax(fmax(x0 - box->min_x_m, box->max_x_m - x0),
+                        fmax(y0 - box->min_y_m, box->max_y_m - y0));
+    return 2.0 * (reach + ONLINE_EDGE_M + ONLINE_AIR_CELLS * (double)cfg->cell_m);
+}
+
+/* a * 4, at most cap */
+static uint32_t times4(uint32_t a, double cap)
+{
+    return (uint32_t)fmin(4.0 * a, cap);
+}
+
+/* The block for lim in r->block and an online context on it; 0 or the exit
+ * code of the complaint. */
+static int make_block(const options *o, run *r, const polyc_config *cfg,
+                      const polyc_online_limits *lim, polyc_ctx **ctx, size_t *size)
+{
+    polyc_status st = POLYC_OK;
+    *ctx = NULL;
+    *size = polyc_online_memory_size(cfg, lim);
+    int made = ctxblock_alloc(*size, o->memory_mb * 1048576.0, &r->block);
+    if (made == CTXBLOCK_OK && (st = polyc_online_init(r->block, *size, cfg, lim, ctx)) != POLYC_OK)
+        made = CTXBLOCK_INIT;
+    return block_fail(o, made, st, *ctx, *size);
+}
+
+/* --frames: the folder, made if missing (its parent must exist). */
+static int make_frames_dir(const char *dir)
+{
+    struct stat st;
+    if (mkdir(dir, 0777) == 0 || (errno == EEXIST && stat(dir, &st) == 0 && S_ISDIR(st.st_mode)))
+        return 0;
+    return complain(EXIT_INPUT, "--frames %s: %s", dir, strerror(errno == EEXIST ? ENOTDIR : errno));
+}
+
+/* The map after `scans` scans as DIR/frame-NNNNN.svg (as wide as the last
+ * frame's number needs, at least 5 digits), written as -o is (outfile.h). */
+static int write_frame(const options *o, run *r, const polyc_config *cfg, polyc_ctx *ctx,
+                       size_t size, const polyc_box *view, uint32_t scans)
+{
+    mapout_map map;
+    int rc = map_to_draw(o, r, cfg, ctx, size, &map);
+    if (rc)
+        return rc;
+    char title[96];
+    const char *name = strrchr(input_name(o), '/');
+    snprintf(title, sizeof title, "%s, %u of %u scans", name ? name + 1 : input_name(o),
+             (unsigned)scans, (unsigned)r->log.count);
+    map.title = title;
+    map.scan_count = scans;        /* --points: the scans so far */
+    map.path = r->log.scans;
+    map.path_count = scans;
+    map.view_m = view;             /* one view for every frame */
+    int digits = snprintf(NULL, 0, "%u", (unsigned)r->log.count);
+    size_t n = strlen(o->frames) + 32;
+    char *path = malloc(n);
+    if (!path)
+        return complain(EXIT_INPUT, "out of memory");
+    snprintf(path, n, "%s/frame-%0*u.svg", o->frames, digits > 5 ? digits : 5, (unsigned)scans);
+    membuf m = {NULL, 0, NULL};
+    rc = render_map(&m, FORMAT_SVG, &map);
+    if (!rc) {
+        const char *paths[] = {path};
+        const membuf *bufs[] = {&m};
+        rc = write_outputs(paths, bufs, 1);
+    }
+    free(m.data);
+    free(path);
+    return rc;
+}
+
+/* Each scan added and the map updated, timed into rp; frames on the way.
+ * 0, an exit code, or RUN_AGAIN when the block ran out and `retry`
+ * allows a larger one. */
+static int add_and_update(const options *o, run *r, const polyc_config *cfg, polyc_ctx *ctx,
+                          size_t size, int retry, replay *rp)
+{
+    polyc_online_report rep;
+    rp->max_backlog = 0;
+    rp->frames = 0;
+    rp->frames_ms = 0;
+    for (uint32_t i = 0; i < r->log.count; i++) {
+        if (i % 64 == 0 && progress_on()) {
+            snprintf(rp->stage, sizeof rp->stage, "online: scan %u of %u", (unsigned)i + 1,
+                     (unsigned)r->log.count);
+            progress_stage(rp->stage);
+        }
+        double t0 = now_ms();
+        polyc_status st = polyc_online_add_scan(ctx, &r->log.scans[i], 0, NULL);
+        double t1 = now_ms();
+        if (st == POLYC_ERR_NOMEM && retry)
+            return RUN_AGAIN;
+        if (st != POLYC_OK)
+            return add_fail(o, r, i, st, ctx, size);
+        st = polyc_online_update(ctx, o->work, &rep);
+        double t2 = now_ms();
+        if (st == POLYC_ERR_NOMEM && retry)
+            return RUN_AGAIN;
+        if (st != POLYC_OK)
+            return library_fail("update", st, ctx, size);
+        rp->add_ms[i] = t1 - t0;
+        rp->step_ms[i] = t2 - t0;
+        if (rep.backlog_tiles > rp->max_backlog)
+            rp->max_backlog = rep.backlog_tiles;
+        if (o->frames && (i + 1) % o->every == 0) {
+            int rc = write_frame(o, r, cfg, ctx, size, &rp->box, i + 1);
+            if (rc)
+                return rc;
+            rp->frames++;
+            rp->frames_ms += now_ms() - t2;
+        }
+    }
+    return 0;
+}
+
+/* The replay on a fresh context, then polyc_online_finish; t gets the adds
+ * and the updates with the finish as the optimiser's time. 0, an exit code
+ * or RUN_AGAIN. */
+static int run_online(const options *o, run *r, const polyc_config *cfg, polyc_ctx *ctx,
+                      size_t size, int retry, replay *rp, mapout_times *t)
+{
+    int rc = add_and_update(o, r, cfg, ctx, size, retry, rp);
+    if (rc)
+        return rc;
+    if (open_trace(o, r))
+        return EXIT_INPUT;
+    progress_stage("online: finish");
+    double t0 = now_ms();
+    polyc_status st = polyc_online_finish(ctx, iteration_fn(o), r->trace.f, NULL);
+    rp->finish_ms = now_ms() - t0;
+    if ((rc = optimiser_status(r, st, retry, "finish", ctx, size)) != 0)
+        return rc;
+    t->add_ms = t->optimize_ms = 0;
+    for (uint32_t i = 0; i < r->log.count; i++) {
+        t->add_ms += rp->add_ms[i];
+        t->optimize_ms += rp->step_ms[i] - rp->add_ms[i];
+    }
+    t->optimize_ms += rp->finish_ms;
+    t->grid_ms = t->contour_ms = t->trace_ms = 0;   /* within the adds and updates */
+    return 0;
+}
+
+/* "median M, p99 P, max X" of n times (sorted in place), nearest rank. */
+static void print_latency(const char *label, double *ms, uint32_t n)
+{
+    qsort(ms, n, sizeof *ms, cmp_double);
+    size_t med = (n - 1) / 2, p99 = (size_t)ceil(0.99 * n) - 1;
+    fprintf(stderr, "%-14s median %.3f, p99 %.3f, max %.3f\n", label, ms[med], ms[p99], ms[n - 1]);
+}
+
+static void print_online_stats(const options *o, const run *r, replay *rp, size_t size)
+{
+    uint32_t n = r->log.count;
+    double total = 0;
+    for (uint32_t i = 0; i < n; i++)
+        total += rp->step_ms[i];
+    fprintf(stderr, "online         %u scans, --work %llu, a square of %.1f m, block %zu bytes%s\n",
+            (unsigned)n, (unsigned long long)o->work, rp->area_m, size,
+            rp->attempts > 1 ? " (after a larger block)" : "");
+    print_latency("add ms", rp->add_ms, n);
+    print_latency("add+update ms", rp->step_ms, n);
+    fprintf(stderr, "online ms      adds and updates %.1f in all, finish %.1f\n", total,
+            rp->finish_ms);
+    fprintf(stderr, "backlog        at most %u tiles\n", (unsigned)rp->max_backlog);
+    if (o->frames)
+        fprintf(stderr, "frames         %u in %s, %.1f ms\n", (unsigned)rp->frames, o->frames,
+                rp->frames_ms);
+}
+
+int online_map(const options *o, run *r, double t_start, mapout_times *t)
+{
+    polyc_config cfg = o->config;
+    polyc_online_limits lim;
+    polyc_ctx *ctx = NULL;
+    replay rp;
+    memset(&rp, 0, sizeof rp);
+    uint32_t max_beams;
+    rp.area_m = log_area(&cfg, &r->log, &rp.box, &max_beams);
+    polyc_status st = polyc_online_limits_for_area(&cfg, rp.area_m, max_beams, &lim);
+    if (st == POLYC_ERR_EXTENT)
+        return complain(EXIT_INPUT, "%s: the log reaches %.0f m from its first pose: an online"
+                                    " map of %.0f m square is more than the grid's limit of %g m",
+                        input_name(o), rp.area_m / 2, rp.area_m, (double)cfg.max_extent_m);
+    if (st != POLYC_OK)
+        return library_fail("sizing", st, NULL, 0);
+    if (o->frames && make_frames_dir(o->frames))
+        return EXIT_INPUT;
+    rp.add_ms = malloc(2 * (size_t)r->log.count * sizeof *rp.add_ms);
+    if (!rp.add_ms)
+        return complain(EXIT_INPUT, "out of memory");
+    rp.step_ms = rp.add_ms + r->log.count;
+    size_t size = 0;
+    int rc;
+    for (;;) {
+        rp.attempts++;
+        int retry = rp.attempts < ONLINE_ATTEMPTS;
+        rc = make_block(o, r, &cfg, &lim, &ctx, &size);
+        if (rc == 0)
+            rc = run_online(o, r, &cfg, ctx, size, retry, &rp, t);
+        if (rc != RUN_AGAIN)
+            break;
+        /* grid cells, data cells and vertices are sized for a usual building:
+         * four times as many, up to the whole square and the library's caps */
+        double tiles = ceil(lim.area_m / (double)cfg.cell_m / 32.0);
+        lim.max_grid_cells = times4(lim.max_grid_cells, fmin(tiles * tiles * 1024.0, 0x40000000));
+        lim.max_points = times4(lim.max_points, 0x10000000);
+        lim.max_vertices = times4(lim.max_vertices, 0x10000000);
+    }
+    if (rc == 0)
+        rc = write_map(o, r, &cfg, ctx, size, t, t_start);
+    if (rc == 0 && o->stats)
+        print_online_stats(o, r, &rp, size);
+    free(rp.add_ms);
+    return rc;
+}
