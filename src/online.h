@@ -101,6 +101,8 @@ polyc_status polyc__online_refresh_tiles(polyc_ctx *ctx, uint32_t n);
 /* online_data.c: the polylines with ids above after_id (traced by this
  * update) into the hash and the books */
 polyc_status polyc__online_add_lines(polyc_ctx *ctx, uint32_t after_id);
+/* and out again (a trace or an insertion that ran out of room) */
+void polyc__online_drop_lines(polyc_ctx *ctx, uint32_t after_id);
 /* online_round.c */
 polyc_status polyc__online_round(polyc_ctx *ctx, uint64_t work, int all, uint64_t *spent);
 /* online_changes.c: publishes the store as the context's result, a new

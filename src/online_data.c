@@ -128,6 +128,26 @@ polyc_status polyc__online_refresh_tiles(polyc_ctx *ctx, uint32_t n_taken)
     return POLYC_OK;
 }
 
+void polyc__online_drop_lines(polyc_ctx *ctx, uint32_t after_id)
+{
+    polyc__opt *o = &ctx->online->opt;
+    polyc__store *s = o->s;
+    for (int32_t l = 0; l < s->l_high; l++) {
+        if (s->l[l].closed == POLYC__NONE || s->l[l].id <= after_id)
+            continue;
+        polyc__chg_begin(o);
+        int32_t v = s->l[l].head;
+        for (int32_t k = 0; k < s->l[l].count; k++, v = s->v[v].next)
+            if (o->chg.v_dirty[v] != o->chg.epoch && !o->seg_in[v])
+                o->acost[v] = 0.0; /* never counted: nothing to take out */
+        while (s->l[l].closed != POLYC__NONE && s->l[l].count > 1)
+            polyc__op_remove(o, s->l[l].head);
+        if (s->l[l].closed != POLYC__NONE) /* one vertex left (a trace cut short) */
+            polyc__line_free(s, l);
+        polyc__chg_commit(o);
+    }
+}
+
 polyc_status polyc__online_add_lines(polyc_ctx *ctx, uint32_t after_id)
 {
     polyc__opt *o = &ctx->online->opt;

@@ -236,8 +236,10 @@ polyc_status polyc__online_round(polyc_ctx *ctx, uint64_t work, int all, uint64_
         ctx->contour_count = 0;
         if (st == POLYC_OK)
             st = polyc__online_add_lines(ctx, last_id);
-        if (st != POLYC_OK)
+        if (st != POLYC_OK) { /* the map stays the one before */
+            polyc__online_drop_lines(ctx, last_id);
             return st;
+        }
     }
     stamp_region(ctx, taken, since);
     o->region_since = since;
