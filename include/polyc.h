@@ -326,7 +326,8 @@ POLYC_API polyc_status polyc_grid_cell(const polyc_ctx *ctx, uint32_t ix, uint32
  * the map as the last update or finish left it. docs/api.md, "Online". */
 typedef struct polyc_online_limits {
     double area_m;             /* side of the square the map may span, centred
-                                  on the first scan's pose */
+                                  on the first scan's pose; at most twice
+                                  config.max_extent_m */
     uint32_t max_grid_cells;   /* grid cells stored (tiles of 32 x 32 cells where
                                   some beam ended in a hit) */
     uint32_t max_vertices;     /* polyline vertices of the map */
@@ -369,8 +370,9 @@ typedef struct polyc_change {
 #define POLYC_ONLINE_WORK_DEFAULT 4000u
 
 /* Limits for an area of side area_m (metres) and scans of up to
- * max_scan_beams beams, keeping no scans: the grid cells of the whole
- * square, and vertices and data cells for a usual building in it. Pure. */
+ * max_scan_beams beams, keeping no scans: grid cells, data cells and
+ * vertices for a usual building in that square (docs/api.md, "Online").
+ * Pure. POLYC_ERR_EXTENT for a side over twice config.max_extent_m. */
 POLYC_API polyc_status polyc_online_limits_for_area(const polyc_config *config, double area_m,
                                                     uint32_t max_scan_beams,
                                                     polyc_online_limits *out);

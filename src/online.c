@@ -48,9 +48,12 @@ void polyc__online_stage_limits(const polyc_online_limits *ol, polyc_limits *lim
     lim->max_points = ol->max_points / 2 > 16 ? ol->max_points / 2 : 16;
 }
 
-static int limits_ok(const polyc_online_limits *ol)
+/* The limits' ranges; the square's side at most twice config.max_extent_m
+ * (the data may lie on one side of the first pose), as a batch context
+ * refuses data spanning more than it. */
+static int limits_ok(const polyc_config *cfg, const polyc_online_limits *ol)
 {
-    return ol->area_m > 1.0 && ol->area_m <= 1e5 && ol->max_grid_cells >= POLYC__TILE_CELLS &&
+    return ol->area_m > 1.0 && ol->area_m <= 1e5 && ol->area_m <= 2.0 * (double)cfg->max_extent_m && ol->max_grid_cells >= POLYC__TILE_CELLS &&
            ol->max_grid_cells <= 0x40000000u && ol->max_vertices >= 16 &&
            ol->max_vertices <= 0x10000000u && ol->max_points >= 16 && ol->max_points <= 0x10000000u &&
            ol->max_scan_beams > 0 && ol->max_scan_beams <= 0x1000000u &&
@@ -67,6 +70,8 @@ polyc_status polyc_online_limits_for_area(const polyc_config *config, double are
     memset(out, 0, sizeof *out);
     if (!(area_m > 1.0 && area_m <= 1e5) || max_scan_beams == 0)
         return POLYC_ERR_CONFIG;
+    if (area_m > 2.0 * (double)config->max_extent_m)
+        return POLYC_ERR_EXTENT;
     double side = ceil(area_m / (double)config->cell_m / POLYC__TILE_SIDE);
     double tiles = side * side;
     /* the tiles a building's walls reach: intel 851 of its 50 m square's
@@ -175,7 +180,7 @@ static size_t header_bytes(void)
 
 size_t polyc_online_memory_size(const polyc_config *config, const polyc_online_limits *limits)
 {
-    if (!config || !limits || polyc_config_check(config, NULL) != POLYC_OK || !limits_ok(limits))
+    if (!config || !limits || polyc_config_check(config, NULL) != POLYC_OK || !limits_ok(config, limits))
         return 0;
     polyc_ctx ctx;
     polyc__online on;
@@ -202,7 +207,7 @@ polyc_status polyc_online_init(void *block, size_t size, const polyc_config *con
     *out = NULL;
     if (!block || !config || !limits)
         return POLYC_ERR_NULL;
-    if (polyc_config_check(config, NULL) != POLYC_OK || !limits_ok(limits))
+    if (polyc_config_check(config, NULL) != POLYC_OK || !limits_ok(config, limits))
         return POLYC_ERR_CONFIG;
     size_t need = polyc_online_memory_size(config, limits);
     if (need == 0)
