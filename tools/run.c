@@ -172,9 +172,11 @@ static void print_stats(const options *o, const run *r, const polyc_stats *s,
             (unsigned)s->grid_width, (unsigned)s->grid_height,
             r->map ? (double)r->map->grid.resolution_m : (double)o->config.cell_m,
             (unsigned)s->grid_tiles, (unsigned long long)s->grid_bytes);
-    fprintf(e, "contour cells  %u\n", (unsigned)s->contour_cells);
-    fprintf(e, "initial        %u polylines, %u vertices\n", (unsigned)s->initial_polylines,
-            (unsigned)s->initial_vertices);
+    if (!o->online) { /* an online map has no contour stage nor one initial trace */
+        fprintf(e, "contour cells  %u\n", (unsigned)s->contour_cells);
+        fprintf(e, "initial        %u polylines, %u vertices\n", (unsigned)s->initial_polylines,
+                (unsigned)s->initial_vertices);
+    }
     fprintf(e, "final          %u polylines, %u vertices, %u iterations\n",
             (unsigned)s->polylines, (unsigned)s->vertices, (unsigned)s->iterations);
     fprintf(e, "BIC            %.3f (error %.6f m^2)\n", s->bic, s->error_sq_m2);
