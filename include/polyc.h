@@ -385,6 +385,8 @@ POLYC_API polyc_status polyc_online_init(void *block, size_t size, const polyc_c
                                          const polyc_online_limits *limits, polyc_ctx **out);
 /* Adds one scan to the grid, the data and the prior (a few hundred
  * microseconds for 180 beams); the map changes only at the next update.
+ * The scan's pose and endpoints must lie more than 1 m inside the area's
+ * square (vertices may wander past the data).
  * keep != 0 keeps the scan for polyc_online_correct (POLYC_ERR_LIMIT when
  * keep_scans or keep_beams are used up; the scan is then not added).
  * *scan_id (may be NULL) gets its number: 0 for the first scan added.

@@ -217,7 +217,20 @@ static void drop_dataless(polyc__opt *o)
     }
 }
 
+static polyc_status round_in(polyc_ctx *ctx, uint64_t work, int all, uint64_t *spent);
+
+/* An update's scratch (the trace's walk) sits above the grid's tiles, which
+ * must stay contiguous for the next scan's: it is given back whatever the
+ * round's outcome. */
 polyc_status polyc__online_round(polyc_ctx *ctx, uint64_t work, int all, uint64_t *spent)
+{
+    size_t mark = ctx->arena.used;
+    polyc_status st = round_in(ctx, work, all, spent);
+    ctx->arena.used = mark;
+    return st;
+}
+
+static polyc_status round_in(polyc_ctx *ctx, uint64_t work, int all, uint64_t *spent)
 {
     polyc__online *on = ctx->online;
     polyc__opt *o = &on->opt;
@@ -375,6 +388,7 @@ polyc_status polyc_online_finish(polyc_ctx *ctx, polyc_progress_fn progress, voi
     polyc__online *on = ctx->online;
     polyc__opt *o = &on->opt;
     uint64_t spent = 0;
+    size_t mark = ctx->arena.used; /* the traces' scratch, given back below */
     /* every tile: what no polyline explains anywhere is traced */
     polyc__online_backlog_all(ctx);
     st = polyc__online_round(ctx, UINT64_MAX, 1, &spent);
@@ -407,6 +421,7 @@ polyc_status polyc_online_finish(polyc_ctx *ctx, polyc_progress_fn progress, voi
             }
         }
     }
+    ctx->arena.used = mark;
     uint32_t changed = 0;
     polyc_status pst = polyc__online_publish(ctx, &changed);
     if (st == POLYC_OK)

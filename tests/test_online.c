@@ -1456,6 +1456,56 @@ static void test_bad_use(void **state)
     scansim_scene_free(&sc);
 }
 
+/* An update that runs out of room (vertices) leaves the context as valid as
+ * before: later scans still get grid tiles (the update's scratch sat above
+ * the tiles and was not given back). An 8 m x 5 m room, scans all round. */
+static float room_cast(double x, double y, double a)
+{
+    double dx = cos(a), dy = sin(a), best = 30.0, t;
+    if (dx > 1e-12 && (t = (8.0 - x) / dx) < best) best = t;
+    if (dx < -1e-12 && (t = -x / dx) < best) best = t;
+    if (dy > 1e-12 && (t = (5.0 - y) / dy) < best) best = t;
+    if (dy < -1e-12 && (t = -y / dy) < best) best = t;
+    return (float)best;
+}
+
+static void test_nomem_update_then_scans(void **state)
+{
+    (void)state;
+    polyc_config cfg;
+    polyc_config_default(&cfg);
+    cfg.cell_m = 0.05f;
+    polyc_online_limits lim;
+    check_status(polyc_online_limits_for_area(&cfg, 16.0, 361, &lim), NULL, "limits");
+    lim.max_vertices = 64;
+    size_t n = polyc_online_memory_size(&cfg, &lim);
+    assert_true(n > 0);
+    void *block = malloc(n);
+    assert_non_null(block);
+    polyc_ctx *ctx;
+    check_status(polyc_online_init(block, n, &cfg, &lim, &ctx), NULL, "init");
+    float r[361];
+    int nomem = 0;
+    uint32_t seed = 12345; /* +-1 cm of noise: more vertices than 64 */
+    for (int k = 0; k < 5; k++) {
+        double x = 1.5 + 0.4348 * k, y = 1.8, th = 0.1 * k;
+        polyc_scan s = {x, y, th, (float)-3.14159265, (float)(2 * 3.14159265 / 360), 0.02f, 30.0f, 361, 0, r};
+        for (int i = 0; i < 361; i++) {
+            seed = seed * 1664525u + 1013904223u;
+            r[i] = room_cast(x, y, th + (double)s.start_angle_rad + (double)i * (double)s.angle_step_rad) +
+                   0.02f * ((float)(seed >> 8) / 16777216.0f - 0.5f);
+        }
+        check_status(polyc_online_add_scan(ctx, &s, 0, NULL), ctx, "add");
+        if (k == 1) {
+            polyc_status st = polyc_online_update(ctx, POLYC_ONLINE_WORK_DEFAULT, NULL);
+            nomem = st == POLYC_ERR_NOMEM;
+            assert_true(st == POLYC_OK || st == POLYC_ERR_NOMEM);
+        }
+    }
+    assert_true(nomem); /* the case this test is for */
+    free(block);
+}
+
 /* ---- 8. exhaustion ---------------------------------------------------------- */
 
 #define GUARD 64
@@ -1645,6 +1695,7 @@ int main(void)
         cmocka_unit_test(test_ten_passes),
         cmocka_unit_test(test_pose_correction),
         cmocka_unit_test(test_bad_use),
+        cmocka_unit_test(test_nomem_update_then_scans),
         cmocka_unit_test(test_exhaustion),
         cmocka_unit_test(test_exhaustion_limits),
     };
