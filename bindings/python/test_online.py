@@ -284,6 +284,11 @@ class Online(unittest.TestCase):
         with self.assertRaises(polyc.PolycError) as e:
             polyc.OnlineMap(-5.0, BEAMS)
         self.assertEqual(e.exception.status, polyc.ERR_CONFIG)
+        self.assertIn("area_m must be", str(e.exception))
+        with self.assertRaises(polyc.PolycError) as e:       # wider than max_extent_m allows
+            polyc.OnlineMap(200.0, BEAMS, config={"max_extent_m": 50.0})
+        self.assertEqual(e.exception.status, polyc.ERR_EXTENT)
+        self.assertIn("max_extent_m", str(e.exception))
 
     def test_a_kept_scan_corrected(self):
         scans = room_scans(12)

@@ -813,8 +813,10 @@ class OnlineMap(_Block):
         status = _lib.polyc_online_limits_for_area(ctypes.byref(self._cfg), area_m,
                                                    max_scan_beams, ctypes.byref(lim))
         if status != OK:
-            raise PolycError(status, "online limits for area",
-                             "area_m %r, max_scan_beams %d" % (area_m, max_scan_beams))
+            why = {ERR_EXTENT: "a square over twice config.max_extent_m",
+                   ERR_CONFIG: "area_m must be over 1 and at most 1e5, max_scan_beams over 0"}
+            raise PolycError(status, "online limits for area", "%s (area_m %r, max_scan_beams %d)"
+                             % (why.get(status, "refused"), area_m, max_scan_beams))
         _set_fields(lim, dict(limits, keep_scans=keep_scans, keep_beams=keep_beams),
                     "polyc_online_limits")
         self._lim = lim
