@@ -21,13 +21,14 @@
  * added since it changed: nearest first, but none waits for ever. */
 #define AGE_M_PER_SCAN 0.25f
 /* An update starts a round when the backlog holds this many tiles, when a
- * tile in it has waited this many scans, or when no scan came since the
- * last update. A round's fixed costs (the passes over the map's ends, the
- * region's books) and the climbs of the vertices near the robot are then
- * paid once for several scans, not for each. On intel, 4 tiles or 8 scans
- * made 666 rounds and 1.06 s of updates; 8 or 16 made 371 rounds, 0.70 s
- * and a lower final BIC (67,393 against 69,307); 16 or 32, 180 rounds but
- * 1.05 s (the rounds grew) and a p99 of 8 ms. */
+ * tile in it has waited this many scans, when no scan came since the last
+ * update, or when there is no map yet. A round's fixed costs (the passes
+ * over the map's ends, the region's books) and the climbs of the vertices
+ * near the robot are then paid once for several scans, not for each. On
+ * intel, 4 tiles or 8 scans made 666 rounds and 1.06 s of updates; 8 or 16
+ * made 371 rounds and 0.70 s, but the sweep's worst row (online against
+ * batch core precision) went from 2.73 to 3.13 times; 16 or 32, 180 rounds
+ * and 1.05 s (the rounds grew), a p99 of 8 ms. */
 #define ROUND_TILES 4u
 #define ROUND_WAIT_SCANS 8u
 /* The tile taken in a round is marked so in dirty_since until it is done. */
