@@ -53,6 +53,28 @@ polyc_status polyc__check_ctx(const polyc_ctx *ctx)
     return ctx->magic == POLYC__MAGIC ? POLYC_OK : POLYC_ERR_NULL;
 }
 
+polyc_status polyc__place_ctx(void *block, size_t size, size_t need, size_t head,
+                              const polyc_config *config, polyc_ctx **out)
+{
+    if (need == 0)
+        return POLYC_ERR_CONFIG;
+    if (size < need)
+        return POLYC_ERR_NOMEM;
+    uintptr_t p = ((uintptr_t)block + 15u) & ~(uintptr_t)15u;
+    size_t skew = (size_t)(p - (uintptr_t)block);
+    polyc_ctx *ctx = (polyc_ctx *)p;
+    memset(ctx, 0, head);
+    ctx->magic = POLYC__MAGIC;
+    ctx->cfg = *config;
+    ctx->arena.base = (unsigned char *)p + head;
+    ctx->arena.size = size - skew - head;
+    ctx->frame_dir.cos = 1.0;
+    ctx->stats.memory_size_bytes = size;
+    ctx->err.scan = -1;
+    *out = ctx;
+    return POLYC_OK;
+}
+
 polyc_status polyc_init(void *block, size_t size, const polyc_config *config,
                         const polyc_limits *limits, polyc_ctx **out)
 {
@@ -63,27 +85,15 @@ polyc_status polyc_init(void *block, size_t size, const polyc_config *config,
         return POLYC_ERR_NULL;
     if (polyc_config_check(config, NULL) != POLYC_OK)
         return POLYC_ERR_CONFIG;
-    size_t need = polyc_memory_size(config, limits);
-    if (need == 0)
-        return POLYC_ERR_CONFIG;
-    if (size < need)
-        return POLYC_ERR_NOMEM;
-    uintptr_t p = ((uintptr_t)block + 15u) & ~(uintptr_t)15u;
-    size_t skew = (size_t)(p - (uintptr_t)block);
-    polyc_ctx *ctx = (polyc_ctx *)p;
-    memset(ctx, 0, sizeof *ctx);
-    ctx->magic = POLYC__MAGIC;
-    ctx->cfg = *config;
+    polyc_ctx *ctx;
+    polyc_status st = polyc__place_ctx(block, size, polyc_memory_size(config, limits),
+                                       polyc__bytes(1, sizeof(polyc_ctx)), config, &ctx);
+    if (st != POLYC_OK)
+        return st;
     ctx->lim = *limits;
-    size_t head = polyc__bytes(1, sizeof(polyc_ctx));
-    ctx->arena.base = (unsigned char *)p + head;
-    ctx->arena.size = size - skew - head;
     if (!scans_carve(&ctx->arena, limits, &ctx->scans, &ctx->ranges))
         return POLYC_ERR_NOMEM;
     ctx->scans_mark = ctx->base_mark = ctx->arena.used;
-    ctx->frame_dir.cos = 1.0;
-    ctx->stats.memory_size_bytes = size;
-    ctx->err.scan = -1;
     *out = ctx;
     return POLYC_OK;
 }

@@ -80,6 +80,12 @@ struct polyc_ctx {
  * its magic reads POLYC__MAGIC_BUSY and every entry point refuses it with
  * POLYC_ERR_BUSY (api.c, guarded_progress). */
 #define POLYC__MAGIC_BUSY 0x62757379u /* "busy" */
+/* Places a context at block's first 16-byte boundary: the first `head`
+ * bytes zeroed (the context's header and what follows it), the arena after
+ * them; POLYC_ERR_CONFIG when `need` (the size query's) is 0, NOMEM when
+ * size is under it (api.c) */
+polyc_status polyc__place_ctx(void *block, size_t size, size_t need, size_t head,
+                              const polyc_config *config, polyc_ctx **out);
 /* the caller's progress callback, called with the context lent (api.c) */
 typedef struct polyc__guarded {
     polyc_ctx *ctx;

@@ -216,8 +216,6 @@ typedef struct count_pass {
     polyc__arena *a;
     const uint32_t *wanted;
     polyc__tile *spill;
-    void (*count)(polyc__count *a, polyc__count *b); /* count_inc, or count_dec */
-    uint32_t *on_hits;             /* online: per tile, misses counted in cells with hits */
 } count_pass;
 
 /* The tile of cell (ix, iy) inside the grid: stored (allocated on first use
@@ -248,7 +246,18 @@ static polyc__tile *tile_get(const count_pass *p, int32_t ix, int32_t iy)
  * miss_end, a hit in the end cell of a reflection; the walk stops at the
  * grid's edge. The tile is looked up only when the walk crosses into
  * another one. */
-static void count_beam(const count_pass *p, const polyc__beam *b)
+/* One count: in, or out again (take_back, the constant 0 in a batch
+ * build's calls, which the compiler folds away). */
+static inline void count_one(int take_back, polyc__count *a, polyc__count *b)
+{
+    if (take_back)
+        count_dec(a, b);
+    else
+        count_inc(a, b);
+}
+
+static inline void count_beam(const count_pass *p, const polyc__beam *b, int take_back,
+                              uint32_t *on_hits)
 {
     polyc__grid *g = p->g;
     polyc__walk w;
@@ -275,9 +284,9 @@ static void count_beam(const count_pass *p, const polyc__beam *b)
         int left;
         do {
             if (polyc__walk_t(&w) < miss_end) {
-                p->count(&t->misses[w.idx], &t->hits[w.idx]);
-                if (p->on_hits && t->hits[w.idx])
-                    p->on_hits[t - g->tiles]++;
+                count_one(take_back, &t->misses[w.idx], &t->hits[w.idx]);
+                if (on_hits && t->hits[w.idx])
+                    on_hits[t - g->tiles]++;
             }
             left = polyc__walk_step(&w);
         } while (!left && w.n > 0);
@@ -291,9 +300,9 @@ static void count_beam(const count_pass *p, const polyc__beam *b)
         return;
     int idx = polyc__cell_index(w.ex, w.ey);
     if (b->hit)
-        p->count(&t->hits[idx], &t->misses[idx]);
+        count_one(take_back, &t->hits[idx], &t->misses[idx]);
     else if (polyc__walk_t(&w) < miss_end)
-        p->count(&t->misses[idx], &t->hits[idx]);
+        count_one(take_back, &t->misses[idx], &t->hits[idx]);
 }
 
 /* The grid's cells over w_m x h_m metres from the frame-relative corner
@@ -358,18 +367,21 @@ static polyc_status count_scan(polyc_ctx *ctx, const polyc__scan *s, int take_ba
 {
     polyc__grid *g = &ctx->grid;
     count_pass p;
-    p.on_hits = on_hits;
     p.g = g;
     p.a = &ctx->arena;
     p.wanted = g->wanted;
     p.spill = g->spill;
-    p.count = take_back ? count_dec : count_inc;
     step_rot rot = {cosf(s->step_rad), sinf(s->step_rad)};
     for (uint32_t i = 0; i < s->count; i++) {
         polyc__beam b;
         if (!beam_fill(ctx, s, i, &b, 1, &rot))
             continue;
-        count_beam(&p, &b);
+        /* the batch's (and an added scan's) count without the online
+         * tests in its inner loop: constants the compiler folds */
+        if (!take_back && !on_hits)
+            count_beam(&p, &b, 0, NULL);
+        else
+            count_beam(&p, &b, take_back, on_hits);
         if (g->out_of_tiles)
             return polyc__fail(ctx, POLYC_ERR_NOMEM, "grid needs more cells than limits.max_grid_cells");
     }

@@ -209,35 +209,23 @@ polyc_status polyc_online_init(void *block, size_t size, const polyc_config *con
         return POLYC_ERR_NULL;
     if (polyc_config_check(config, NULL) != POLYC_OK || !limits_ok(config, limits))
         return POLYC_ERR_CONFIG;
-    size_t need = polyc_online_memory_size(config, limits);
-    if (need == 0)
-        return POLYC_ERR_CONFIG;
-    if (size < need)
-        return POLYC_ERR_NOMEM;
-    uintptr_t p = ((uintptr_t)block + 15u) & ~(uintptr_t)15u;
-    size_t skew = (size_t)(p - (uintptr_t)block);
-    polyc_ctx *ctx = (polyc_ctx *)p;
-    memset(ctx, 0, sizeof *ctx);
-    polyc__online *on = (polyc__online *)((unsigned char *)p + polyc__bytes(1, sizeof(polyc_ctx)));
-    memset(on, 0, sizeof *on);
-    ctx->magic = POLYC__MAGIC;
-    ctx->cfg = *config;
+    /* the context's header, then the online state's, then the arena */
+    polyc_ctx *ctx;
+    polyc_status st = polyc__place_ctx(block, size, polyc_online_memory_size(config, limits),
+                                       header_bytes(), config, &ctx);
+    if (st != POLYC_OK)
+        return st;
+    polyc__online *on = (polyc__online *)((unsigned char *)ctx + polyc__bytes(1, sizeof(polyc_ctx)));
     ctx->online = on;
     on->lim = *limits;
     polyc__online_stage_limits(limits, &ctx->lim);
-    size_t head = header_bytes();
-    ctx->arena.base = (unsigned char *)p + head;
-    ctx->arena.size = size - skew - head;
     polyc__arena a = ctx->arena;
     if (!lay_out(ctx, on, &a))
         return POLYC_ERR_NOMEM;
     ctx->arena = a;
     ctx->arena.peak = ctx->arena.used;
     ctx->flat.count = 0;
-    ctx->frame_dir.cos = 1.0;
-    ctx->stats.memory_size_bytes = size;
     ctx->stage = POLYC__STAGE_SCANS;
-    ctx->err.scan = -1;
     *out = ctx;
     return POLYC_OK;
 }

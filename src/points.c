@@ -168,18 +168,30 @@ static void finish_moments(polyc_ctx *ctx, polyc__point *tmp)
             finish_tile(ctx, d, tmp);
 }
 
+/* Every tile's blocks marked and numbered, and that many points (and
+ * views, if any) zeroed; POLYC_ERR_NOMEM past cap. */
+static polyc_status begin_blocks(polyc_ctx *ctx, polyc__point *tmp, float *view, int32_t cap,
+                                 uint32_t *n)
+{
+    *n = mark_blocks(ctx);
+    if (*n > (uint32_t)cap)
+        return polyc__fail(ctx, POLYC_ERR_NOMEM, "more weighted data points than limits.max_points");
+    memset(tmp, 0, (size_t)*n * sizeof *tmp);
+    if (view)
+        memset(view, 0, (size_t)*n * 2 * sizeof *view);
+    return POLYC_OK;
+}
+
 /* One weighted point per marked block, from the endpoints. */
 static polyc_status collect_cells(polyc__opt *o, polyc__point *tmp, float *view, int32_t cap,
                                   int32_t *n_out)
 {
     polyc_ctx *ctx = o->ctx;
     polyc__grid *g = &ctx->grid;
-    uint32_t n = mark_blocks(ctx);
-    if (n > (uint32_t)cap)
-        return polyc__fail(ctx, POLYC_ERR_NOMEM, "more weighted data points than limits.max_points");
-    memset(tmp, 0, (size_t)n * sizeof *tmp);
-    if (view)
-        memset(view, 0, (size_t)n * 2 * sizeof *view);
+    uint32_t n;
+    polyc_status st = begin_blocks(ctx, tmp, view, cap, &n);
+    if (st != POLYC_OK)
+        return st;
     endpoint e;
     for (uint32_t si = 0; si < ctx->scan_count; si++)
         for (uint32_t i = 0; i < ctx->scans[si].count; i++) {
@@ -264,11 +276,10 @@ static polyc_status collect_sums(polyc__opt *o, polyc__point *tmp, float *view, 
 {
     polyc_ctx *ctx = o->ctx;
     polyc__grid *g = &ctx->grid;
-    uint32_t n = mark_blocks(ctx);
-    if (n > (uint32_t)cap)
-        return polyc__fail(ctx, POLYC_ERR_NOMEM, "more weighted data points than limits.max_points");
-    memset(tmp, 0, (size_t)n * sizeof *tmp);
-    memset(view, 0, (size_t)n * 2 * sizeof *view);
+    uint32_t n;
+    polyc_status st = begin_blocks(ctx, tmp, view, cap, &n);
+    if (st != POLYC_OK)
+        return st;
     int32_t dir_n = g->tiles_x * g->tiles_y;
     polyc__online *on = ctx->online;
     for (int32_t d = 0; d < dir_n; d++)

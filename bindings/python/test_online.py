@@ -30,6 +30,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(os.path.dirname(HERE))
 os.environ.setdefault("POLYC_LIB", os.path.join(REPO, "build", "py", "libpolyc.so"))
 import polyc  # noqa: E402
+from test_polyc import cast as room_cast, f32  # noqa: E402
 
 try:
     import numpy
@@ -44,24 +45,9 @@ BEAMS = 361                                # all round, one degree apart
 CELL_M = 0.05
 
 
-def f32(v):
-    return struct.unpack("f", struct.pack("f", v))[0]
-
-
 def cast(x, y, a, max_range):
-    """Range from (x, y) along angle a to the nearest wall."""
-    dx, dy = math.cos(a), math.sin(a)
-    best = max_range
-    for ax, ay, bx, by in WALLS:
-        ex, ey = bx - ax, by - ay
-        den = dx * ey - dy * ex
-        if abs(den) < 1e-12:
-            continue
-        t = ((ax - x) * ey - (ay - y) * ex) / den
-        u = ((ax - x) * dy - (ay - y) * dx) / den
-        if 0 < t < best and 0 <= u <= 1:
-            best = t
-    return best
+    """Range from (x, y) along angle a to the nearest wall of this room."""
+    return room_cast(x, y, a, max_range, WALLS)
 
 
 def poses(n=24):
@@ -110,6 +96,18 @@ def segments(polylines):
 def new_map(area_m=16.0, **kw):
     kw.setdefault("config", {"cell_m": CELL_M})
     return polyc.OnlineMap(area_m, BEAMS, **kw)
+
+
+def replay_with(scans):
+    """A function of a ranges type: the scans replayed with their ranges of
+    that type, an update after each; the map, its ids and its version."""
+    def run(kind):
+        m = new_map()
+        for s in scans:
+            m.add_scan(*s._replace(ranges_m=kind(s.ranges_m)))
+            m.update()
+        return m.polylines, m.polyline_ids, m.version
+    return run
 
 
 class Online(unittest.TestCase):
@@ -188,15 +186,7 @@ class Online(unittest.TestCase):
         self.assertTrue(all(after[i].kind == "removed" for i in set(ids) - set(m.polyline_ids)))
 
     def test_the_same_scans_give_the_same_map(self):
-        scans = room_scans(8)
-
-        def run(kind):
-            m = new_map()
-            for s in scans:
-                m.add_scan(*s._replace(ranges_m=kind(s.ranges_m)))
-                m.update()
-            return m.polylines, m.polyline_ids, m.version
-
+        run = replay_with(room_scans(8))
         want = run(list)
         self.assertGreater(len(want[0]), 0)
         self.assertEqual(run(lambda r: array("f", r)), want)
@@ -206,14 +196,7 @@ class Online(unittest.TestCase):
     @unittest.skipIf(numpy is None, "numpy is not installed")
     def test_numpy_ranges(self):
         scans = room_scans(8)
-
-        def run(kind):
-            m = new_map()
-            for s in scans:
-                m.add_scan(*s._replace(ranges_m=kind(s.ranges_m)))
-                m.update()
-            return m.polylines, m.polyline_ids, m.version
-
+        run = replay_with(scans)
         want = run(list)
         self.assertEqual(run(lambda r: numpy.array(r, dtype=numpy.float32)), want)
         self.assertEqual(run(lambda r: numpy.array(r, dtype=numpy.float64)), want)

@@ -57,10 +57,11 @@ def f32(v):
     return struct.unpack("f", struct.pack("f", v))[0]
 
 
-def cast(x, y, a, max_range):
+def cast(x, y, a, max_range, walls=None):
+    """Range from (x, y) along angle a to the nearest of walls (the room's)."""
     dx, dy = math.cos(a), math.sin(a)
     best = max_range
-    for ax, ay, bx, by in WALLS:
+    for ax, ay, bx, by in WALLS if walls is None else walls:
         ex, ey = bx - ax, by - ay
         den = dx * ey - dy * ex
         if abs(den) < 1e-12:
