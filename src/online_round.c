@@ -265,13 +265,15 @@ static void drop_dataless(polyc__opt *o)
     }
 }
 
-/* The pieces of map within overlap_m of an end this round edited, stamped
- * as edited; returns how many. The zip looks at edited segments only, and
- * a round's climb can bring an end along a piece outside the region: where
- * two ends reach into one segment from both sides (a junction seen in
- * clutter), that segment is doubly covered over 20 cm and more, and no
- * later round need come near it (acapulco, scans 250 to 800, with sparse
- * tiles in the backlog). */
+/* The pieces of map that an end this round edited lies along, stamped as
+ * edited; returns how many. The zip looks at edited segments only, and a
+ * round's climb can bring an end along a piece outside the region that the
+ * round did not edit: where two ends reach into one segment from both
+ * sides, that segment is doubly covered over 20 cm and more, and no later
+ * round need come near it (acapulco, scans 250 to 800, with sparse tiles in
+ * the backlog). "Along": the end within overlap_m of the piece, its segment
+ * within ALONG_COS of parallel to it (an end at a T junction is not). */
+#define ALONG_COS 0.866f /* cos 30 degrees */
 static uint32_t stamp_near_ends(polyc__opt *o, uint32_t since)
 {
     const polyc__store *s = o->s;
@@ -281,8 +283,11 @@ static uint32_t stamp_near_ends(polyc__opt *o, uint32_t since)
     for (int32_t v = 0; v < s->v_high; v++) {
         const polyc__vertex *e = &s->v[v];
         if (e->line == POLYC__NONE || o->v_touch[v] < since ||
-            (e->prev != POLYC__NONE && e->next != POLYC__NONE))
+            (e->prev != POLYC__NONE && e->next != POLYC__NONE) ||
+            (e->prev == POLYC__NONE && e->next == POLYC__NONE))
             continue;
+        const polyc__vertex *f = &s->v[e->prev != POLYC__NONE ? e->prev : e->next];
+        float ex = f->x - e->x, ey = f->y - e->y, el = sqrtf(ex * ex + ey * ey);
         int32_t bx, by, around[9];
         polyc__bucket_xy(h, e->x, e->y, &bx, &by);
         int nb = polyc__buckets_around(h, bx, by, around);
@@ -290,14 +295,27 @@ static uint32_t stamp_near_ends(polyc__opt *o, uint32_t since)
             for (int32_t en = h->seg_head[around[i]]; en != POLYC__NONE; en = h->entries[en].next) {
                 int32_t sg = h->entries[en].seg;
                 const polyc__vertex *c = &s->v[sg], *d = &s->v[c->next];
-                if (c->line == e->line || o->v_touch[sg] >= stamp ||
+                if (c->line == e->line || polyc__edited_since(o, sg, since) ||
                     polyc__seg_dist2(e->x, e->y, c->x, c->y, d->x, d->y) > lim2)
+                    continue;
+                float dx = d->x - c->x, dy = d->y - c->y, dl = sqrtf(dx * dx + dy * dy);
+                if (fabsf(ex * dx + ey * dy) < ALONG_COS * el * dl)
                     continue;
                 o->v_touch[sg] = stamp;
                 n++;
             }
     }
     return n;
+}
+
+/* Whether a vertex was edited since the zip's last pass began. */
+static int edited_after_zip(const polyc__opt *o)
+{
+    const polyc__store *s = o->s;
+    for (int32_t v = 0; v < s->v_high; v++)
+        if (s->v[v].line != POLYC__NONE && o->v_touch[v] >= o->zip_mark)
+            return 1;
+    return 0;
 }
 
 static polyc_status round_in(polyc_ctx *ctx, uint64_t work, int all, uint64_t *spent);
@@ -344,7 +362,10 @@ static polyc_status round_in(polyc_ctx *ctx, uint64_t work, int all, uint64_t *s
     o->pol.add_vertices = 0;
     polyc__operators(o, since, since);
     drop_dataless(o);
-    if (o->pol.restructure && stamp_near_ends(o, since) > 0)
+    /* the operators' zip came before their crossing repair and the drop of
+     * dataless polylines: what those edited, and the pieces of map the ends
+     * lie along, are zipped now */
+    if (o->pol.restructure && (stamp_near_ends(o, since) > 0 || edited_after_zip(o)))
         polyc__op_zip(o);
     o->pol.add_vertices = add;
     o->region_since = 0;

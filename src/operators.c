@@ -46,6 +46,20 @@ static float other_dist2(const polyc__opt *o, float x, float y, int32_t v)
     return best;
 }
 
+/* Whether an end is looked at: always, but in an online round only when
+ * it or its neighbour was edited since the region's stamp. An end outside
+ * the region lies where nothing changed: what could overlap it or merge
+ * with it there is itself in the region, and is looked at from that side
+ * (merge) or by the zip (an edited segment along it). */
+static int in_region(const polyc__opt *o, int32_t e)
+{
+    if (o->region_since == 0)
+        return 1;
+    const polyc__vertex *v = &o->s->v[e];
+    int32_t n = v->next != POLYC__NONE ? v->next : v->prev;
+    return o->v_touch[e] >= o->region_since || (n != POLYC__NONE && o->v_touch[n] >= o->region_since);
+}
+
 /* ---- A: overlaps ---- */
 
 /* Whether the segment from vertex e to its neighbour e2 runs along other
@@ -92,7 +106,7 @@ int polyc__op_overlaps(polyc__opt *o)
                     break;
                 int32_t e = side ? ln->tail : ln->head;
                 int32_t e2 = side ? s->v[e].prev : s->v[e].next;
-                if (!runs_along(o, e, e2, o->cfg->overlap_m))
+                if (!in_region(o, e) || !runs_along(o, e, e2, o->cfg->overlap_m))
                     break;
                 polyc__apply_remove(o, e);
                 changed++;
@@ -155,6 +169,8 @@ int polyc__op_merge(polyc__opt *o)
             if (ln->closed != 0 || ln->count < 2)
                 continue;
             int32_t e = side ? ln->tail : ln->head;
+            if (!in_region(o, e))
+                continue;
             int32_t f = nearest_end(o, e, lim2);
             if (f == POLYC__NONE || polyc__link_crosses(o, e, f))
                 continue; /* (a link through a wall would be cut again) */
