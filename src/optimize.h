@@ -255,7 +255,8 @@ void polyc__points_reserve(polyc__arena *a, const polyc_config *cfg, const polyc
 
 /* spatial_hash.c */
 int32_t polyc__hash_bucket_cap(const polyc_limits *lim);
-int32_t polyc__hash_entry_cap(const polyc_limits *lim);
+/* the entries for a hash of nb buckets (the reserve: the bucket cap) */
+int32_t polyc__hash_entry_cap(const polyc_limits *lim, size_t nb);
 polyc_status polyc__hash_init(polyc__opt *o);
 /* the buckets over the grid, carved from a (no clearing); 0: no room */
 int polyc__hash_lay_out(polyc__opt *o, polyc__arena *a);
