@@ -144,15 +144,9 @@ static int lay_out(polyc_ctx *ctx, polyc__online *on, polyc__arena *a)
     else
         polyc__flat_reserve(a, V);
     size_t P = (size_t)polyc__points_bound(&ctx->cfg, &ctx->lim), nb = (size_t)on->opt.h.bx * (size_t)on->opt.h.by;
-    POLYC__CARVE(ok, a, on->alt_pts, P);
-    POLYC__CARVE(ok, a, on->alt_view, 2 * P);
-    POLYC__CARVE(ok, a, on->alt_seg, P);
-    POLYC__CARVE(ok, a, on->alt_cost, P);
-    POLYC__CARVE(ok, a, on->alt_tile, P);
     POLYC__CARVE(ok, a, on->pt_tile, P);
     POLYC__CARVE(ok, a, on->fresh_tile, P);
     POLYC__CARVE(ok, a, on->fresh_bucket, P);
-    POLYC__CARVE(ok, a, on->alt_start, nb + 1);
     POLYC__CARVE(ok, a, on->bucket_fill, nb);
     POLYC__CARVE_ZERO(ok, a, on->tile_raw, tile_cap);
     POLYC__CARVE_ZERO(ok, a, on->tile_new, tile_cap);

@@ -63,14 +63,10 @@ typedef struct polyc__online {
     float *view_tmp;
     uint32_t *fresh_tile;          /* per new point: its tile's directory entry */
     int32_t *fresh_bucket;         /* per new point: its bucket */
-    /* the points' spare arrays (online_data.c swaps them in) and, per
-     * point, its tile's directory entry; per bucket a fill position; per
-     * stored tile the endpoints its points hold */
-    polyc__point *alt_pts;
-    float *alt_view;
-    int32_t *alt_seg;
-    double *alt_cost;
-    uint32_t *alt_tile, *pt_tile, *alt_start, *bucket_fill;
+    /* per point, its tile's directory entry; per bucket a count or fill
+     * position (online_data.c); per stored tile the endpoints its points
+     * hold */
+    uint32_t *pt_tile, *bucket_fill;
     double *tile_raw;
     uint32_t *tile_new;            /* per stored tile: endpoints in or out since its refresh */
     uint32_t *tile_miss;           /* and misses counted in its cells with hits */
