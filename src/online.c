@@ -127,8 +127,7 @@ static int lay_out(polyc_ctx *ctx, polyc__online *on, polyc__arena *a)
     size_t dir_n = (size_t)ctx->grid.tiles_x * (size_t)ctx->grid.tiles_y;
     uint32_t tile_cap = ctx->grid.tile_cap;
     ok &= polyc__prior_online(ctx, &on->prior, &on->acc, a);
-    POLYC__CARVE_ZERO(ok, a, on->slot, (size_t)tile_cap * POLYC__TILE_CELLS);
-    POLYC__CARVE(ok, a, on->sums, ol->max_points);
+    ok = ok && polyc__cells_carve(a, on, tile_cap);
     POLYC__CARVE_ZERO(ok, a, on->pose_bits, dir_n / 32 + 1);
     POLYC__CARVE(ok, a, on->spacing_dist, dir_n);
     POLYC__CARVE_ZERO(ok, a, on->dirty_since, dir_n);
@@ -292,24 +291,14 @@ static int sum_endpoints(polyc_ctx *ctx, const polyc__scan *s, float sign)
         uint32_t k = g->dir[d] - 1;
         if (++on->tile_new[k] >= CHANGE_MIN && (double)on->tile_new[k] >= CHANGE_SHARE * on->tile_raw[k])
             mark_dirty(on, (size_t)d);
-        uint32_t *slot = &on->slot[(size_t)(g->dir[d] - 1) * POLYC__TILE_CELLS + (size_t)polyc__cell_index(ix, iy)];
-        if (*slot == 0) {
-            if (sign < 0.0f)
-                continue;
-            uint32_t e;
-            if (on->sums_free) {
-                e = on->sums_free - 1;
-                on->sums_free = on->sums[e].n;
-            } else if (on->sums_n < on->lim.max_points) {
-                e = on->sums_n++;
-            } else {
+        uint32_t key = polyc__cell_key(k, polyc__cell_index(ix, iy));
+        uint32_t e = sign < 0.0f ? polyc__cell_find(on, key) : polyc__cell_add(on, key);
+        if (e == 0) { /* the entries are used up (or a cell without sums taken back) */
+            if (sign > 0.0f)
                 ok = 0;
-                continue;
-            }
-            memset(&on->sums[e], 0, sizeof on->sums[0]);
-            *slot = e + 1;
+            continue;
         }
-        polyc__cell_sums *c = &on->sums[*slot - 1];
+        polyc__cell_sums *c = &on->sums[e - 1];
         float ox = (b.ex - fx - 0.5f) * g->cell_m, oy = (b.ey - fy - 0.5f) * g->cell_m;
         c->fx += sign * ox;
         c->fy += sign * oy;
@@ -319,11 +308,8 @@ static int sum_endpoints(polyc_ctx *ctx, const polyc__scan *s, float sign)
         c->vx += sign * (b.sx - b.ex) * g->cell_m;
         c->vy += sign * (b.sy - b.ey) * g->cell_m;
         c->n = sign > 0.0f ? c->n + 1 : (c->n > 0 ? c->n - 1 : 0);
-        if (c->n == 0) { /* its last endpoint went (a correction): the entry is free */
-            c->n = on->sums_free;
-            on->sums_free = *slot;
-            *slot = 0;
-        }
+        if (c->n == 0) /* its last endpoint went (a correction): the entry is free */
+            polyc__cell_drop(on, e);
     }
     return ok;
 }

@@ -9,11 +9,12 @@
 
 /* One grid cell's endpoints: their count, the sums of their offsets from
  * the cell's centre and of those offsets' products (metres), and of the
- * vectors from them to their sensors. A scan taken back subtracts what it
- * added. */
+ * vectors from them to their sensors; and the cell (polyc__cell_key). A
+ * scan taken back subtracts what it added. */
 typedef struct polyc__cell_sums {
     float fx, fy, fxx, fxy, fyy, vx, vy;
-    uint32_t n;
+    uint32_t n;                    /* a free entry: 1 + the next free one, 0: none */
+    uint32_t cell;
 } polyc__cell_sums;
 
 /* What the last publication held of a polyline: its id, a hash of its
@@ -25,12 +26,15 @@ typedef struct polyc__pub {
 
 typedef struct polyc__online {
     polyc_online_limits lim;
-    /* per cell of the stored tiles (tile index * 1024 + cell): 1 + its
-     * entry in sums, 0 for a cell without endpoints */
-    uint32_t *slot;
+    /* the cells with endpoints (online_cells.c): their sums, and a table
+     * of 1 + their entries (0: an empty slot) by the hash of their key;
+     * per stored tile, how many of its cells have sums */
     polyc__cell_sums *sums;
     uint32_t sums_n;
     uint32_t sums_free;            /* 1 + a free entry (a list through their n), 0: none */
+    uint32_t *cell_at;
+    uint32_t cell_mask, cell_shift;
+    uint32_t *tile_cells;
     uint32_t *pose_bits;           /* bit per directory entry: a pose lay in the tile */
     float min_step_rad;            /* smallest |angle step| seen */
     float *spacing_dist;           /* the spacing table (spacing.c), per directory entry */
@@ -105,6 +109,22 @@ polyc_status polyc__online_round(polyc_ctx *ctx, uint64_t work, int all, uint64_
  * version if anything changed; *changed gets the polylines that did */
 polyc_status polyc__online_publish(polyc_ctx *ctx, uint32_t *changed);
 void polyc__online_pub_carve(polyc__arena *a, polyc__online *on, int32_t lines);
+
+/* online_cells.c: a cell's key, from its tile's storage index and its
+ * index in the tile */
+static inline uint32_t polyc__cell_key(uint32_t tile, int idx)
+{
+    return tile * POLYC__TILE_CELLS + (uint32_t)idx;
+}
+/* the sums, the table and the tiles' counts, carved (a zeroed table) */
+int polyc__cells_carve(polyc__arena *a, polyc__online *on, uint32_t tile_cap);
+/* 1 + the entry of the cell's sums, 0 for a cell without endpoints */
+uint32_t polyc__cell_find(const polyc__online *on, uint32_t key);
+/* the same, the cell added with zero sums if it has none; 0 when the
+ * entries (limits.max_points) are used up */
+uint32_t polyc__cell_add(polyc__online *on, uint32_t key);
+/* entry (1 + its index) out: its cell has no endpoints left */
+void polyc__cell_drop(polyc__online *on, uint32_t entry);
 
 /* points.c: the weighted points from the cells' sums (online) */
 /* opt_setup.c: the optimiser of an online context, carved once; and its

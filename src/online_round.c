@@ -52,11 +52,7 @@ static uint32_t tile_work(const polyc_ctx *ctx, uint32_t d)
     const polyc__grid *g = &ctx->grid;
     if (!g->dir[d])
         return TILE_WORK;
-    const uint32_t *slot = ctx->online->slot + (size_t)(g->dir[d] - 1) * POLYC__TILE_CELLS;
-    uint32_t n = TILE_WORK;
-    for (int i = 0; i < POLYC__TILE_CELLS; i++)
-        n += slot[i] != 0;
-    return n;
+    return TILE_WORK + ctx->online->tile_cells[g->dir[d] - 1];
 }
 
 /* Moves the tiles to take to the front of the backlog (all of them, or

@@ -230,12 +230,14 @@ static double sum_tile(const polyc_ctx *ctx, int32_t d, polyc__point *tmp, float
     const float half = 0.5f * (float)(BLOCK_SIDE - 1);
     uint32_t k = g->dir[d] - 1;
     const polyc__tile *t = &g->tiles[k];
-    const uint32_t *slot = on->slot + (size_t)k * POLYC__TILE_CELLS;
     double raw = 0.0;
     for (int idx = 0; idx < POLYC__TILE_CELLS; idx++) {
-        if (!slot[idx] || !t->hits[idx] || !cell_holds_data(ctx, t, idx))
+        if (!t->hits[idx] || !cell_holds_data(ctx, t, idx))
             continue;
-        const polyc__cell_sums *c = &on->sums[slot[idx] - 1];
+        uint32_t e = polyc__cell_find(on, polyc__cell_key(k, idx));
+        if (!e)
+            continue;
+        const polyc__cell_sums *c = &on->sums[e - 1];
         int32_t ix = idx & (POLYC__TILE_SIDE - 1), iy = idx >> POLYC__TILE_SHIFT;
         int32_t bx = ix & ~(int32_t)(BLOCK_SIDE - 1), by = iy & ~(int32_t)(BLOCK_SIDE - 1);
         float dx = ((float)(ix - bx) - half) * g->cell_m, dy = ((float)(iy - by) - half) * g->cell_m;
