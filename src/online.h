@@ -59,14 +59,17 @@ typedef struct polyc__online {
     polyc__prior prior;
     polyc__acc_learn acc;
 
-    /* an update's scratch: the contour cells to trace, the points */
+    /* scratch, carved above the tiles by the step that needs it and given
+     * back after it (polyc__online_scratch): a trace's contour cells; the
+     * points made again and their tiles and buckets; the prior's endpoint
+     * cache for one scan. NULL while not carved. */
     int32_t *cells;
     uint32_t cells_cap;
-    float *learn_cache;            /* the prior's endpoint cache, one scan */
     polyc__point *pts_tmp;
     float *view_tmp;
     uint32_t *fresh_tile;          /* per new point: its tile's directory entry */
     int32_t *fresh_bucket;         /* per new point: its bucket */
+    float *learn_cache;
     /* per point, its tile's directory entry; per bucket a count or fill
      * position (online_data.c); per stored tile the endpoints its points
      * hold */
@@ -89,6 +92,14 @@ typedef struct polyc__online {
     uint64_t forgot_through;       /* removals of versions up to this are forgotten */
 } polyc__online;
 
+/* online.c: the scratch of one step, carved from a (the context's arena
+ * above the tiles; the caller gives it back); 0: no room */
+typedef enum polyc__online_step {
+    POLYC__STEP_TRACE,             /* cells (and the trace's own walk) */
+    POLYC__STEP_POINTS,            /* pts_tmp, view_tmp, fresh_tile, fresh_bucket */
+    POLYC__STEP_LEARN              /* learn_cache */
+} polyc__online_step;
+int polyc__online_scratch(polyc__arena *a, polyc__online *on, int32_t points, polyc__online_step step);
 /* online.c: the context's limits for the stages, from the online limits */
 void polyc__online_stage_limits(const polyc_online_limits *ol, polyc_limits *lim);
 /* online.c: the tiles whose cells with hits beams have crossed often into

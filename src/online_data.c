@@ -28,7 +28,27 @@ static int taken(const polyc__online *on, uint32_t d)
     return on->dirty_since[d] == UINT32_MAX;
 }
 
+static polyc_status refresh(polyc_ctx *ctx, uint32_t n_taken);
+
+/* The new points' scratch, above the tiles, given back whatever the outcome. */
 polyc_status polyc__online_refresh_tiles(polyc_ctx *ctx, uint32_t n_taken)
+{
+    polyc__online *on = ctx->online;
+    size_t mark = ctx->arena.used;
+    polyc_status st;
+    if (!polyc__online_scratch(&ctx->arena, on, polyc__points_bound(&ctx->cfg, &ctx->lim), POLYC__STEP_POINTS))
+        st = polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the data points");
+    else
+        st = refresh(ctx, n_taken);
+    ctx->arena.used = mark;
+    on->pts_tmp = NULL;
+    on->view_tmp = NULL;
+    on->fresh_tile = NULL;
+    on->fresh_bucket = NULL;
+    return st;
+}
+
+static polyc_status refresh(polyc_ctx *ctx, uint32_t n_taken)
 {
     polyc__online *on = ctx->online;
     polyc__opt *o = &on->opt;

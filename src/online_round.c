@@ -216,14 +216,16 @@ static void drop_dataless(polyc__opt *o)
 
 static polyc_status round_in(polyc_ctx *ctx, uint64_t work, int all, uint64_t *spent);
 
-/* An update's scratch (the trace's walk) sits above the grid's tiles, which
- * must stay contiguous for the next scan's: it is given back whatever the
- * round's outcome. */
+/* An update's scratch (the points made again, the contour cells, the
+ * trace's walk: online.h) sits above the grid's tiles, which must stay
+ * contiguous for the next scan's: it is given back whatever the round's
+ * outcome. */
 polyc_status polyc__online_round(polyc_ctx *ctx, uint64_t work, int all, uint64_t *spent)
 {
     size_t mark = ctx->arena.used;
     polyc_status st = round_in(ctx, work, all, spent);
     ctx->arena.used = mark;
+    ctx->online->cells = NULL;
     return st;
 }
 
@@ -237,6 +239,8 @@ static polyc_status round_in(polyc_ctx *ctx, uint64_t work, int all, uint64_t *s
         return st;
     on->opt_ready = 1;
     uint32_t since = ++o->touch_stamp;
+    if (!polyc__online_scratch(&ctx->arena, on, 0, POLYC__STEP_TRACE))
+        return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the contour cells");
     uint32_t n = unexplained_cells(ctx, taken);
     if (n > 0) {
         uint32_t last_id = o->s->last_id;
@@ -339,6 +343,8 @@ static int trace_afresh(polyc_ctx *ctx, polyc_status *st)
     float thr = ctx->cfg.contour_threshold;
     uint32_t n = 0;
     size_t dir_n = (size_t)g->tiles_x * (size_t)g->tiles_y;
+    if (!polyc__online_scratch(&ctx->arena, on, 0, POLYC__STEP_TRACE))
+        return 0; /* (the block is sized for it) */
     for (size_t d = 0; d < dir_n; d++) {
         if (!g->dir[d])
             continue;
@@ -419,6 +425,7 @@ polyc_status polyc_online_finish(polyc_ctx *ctx, polyc_progress_fn progress, voi
         }
     }
     ctx->arena.used = mark;
+    on->cells = NULL;
     uint32_t changed = 0;
     polyc_status pst = polyc__online_publish(ctx, &changed);
     if (st == POLYC_OK)

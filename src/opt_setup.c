@@ -125,11 +125,10 @@ static void opt_begin(polyc_ctx *ctx, polyc__opt *o)
  * map. The prior and the spacing are the context's (online.h). */
 int polyc__opt_carve_online(polyc_ctx *ctx, polyc__arena *a, polyc__opt *o)
 {
-    polyc__online *on = ctx->online;
     opt_begin(ctx, o);
     int32_t V = polyc__max_vertices(&ctx->lim), P = polyc__points_bound(o->cfg, &ctx->lim);
     polyc__rays_init(&o->rays, ctx);
-    int ok = polyc__hash_lay_out(o, a) && polyc__points_carve_online(a, o, &on->pts_tmp, &on->view_tmp) &&
+    int ok = polyc__hash_lay_out(o, a) && polyc__points_carve_online(a, o) &&
              opt_carve(a, o, P > 0 ? P : 1, V, 1, loc_soa_cap(o->cfg, &ctx->lim), 1);
     if (!a->base) { /* a counting arena: nothing is written */
         polyc__flat_reserve(a, V);
@@ -160,7 +159,13 @@ polyc_status polyc__opt_refresh(polyc__opt *o)
     if (st != POLYC_OK)
         return st;
     polyc__hash_clear(o);
-    if ((st = polyc__points_collect(o)) != POLYC_OK)
+    size_t mark = ctx->arena.used; /* the points' scratch, given back below */
+    if (!polyc__online_scratch(&ctx->arena, on, polyc__points_bound(o->cfg, &ctx->lim), POLYC__STEP_POINTS))
+        st = polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the data points");
+    else
+        st = polyc__points_collect(o);
+    ctx->arena.used = mark;
+    if (st != POLYC_OK)
         return st;
     o->d.log_n = log(o->d.n > 1.0 ? o->d.n : 1.0);
     return polyc__rebuild(o);

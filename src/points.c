@@ -460,11 +460,11 @@ void polyc__points_spans(polyc__opt *o, int exact)
     o->d.support_m = polyc__maxf(POLYC__SUPPORT_M, o->d.point_span_m);
 }
 
-/* online: the points and their unsorted copy, carved once */
-int polyc__points_carve_online(polyc__arena *a, polyc__opt *o, polyc__point **tmp, float **tmp_view)
+/* online: the points, carved once */
+int polyc__points_carve_online(polyc__arena *a, polyc__opt *o)
 {
     int32_t cap = polyc__points_bound(o->cfg, &o->ctx->lim);
-    return points_carve(a, cap, 1, &o->d.pts, &o->d.pt_view) && points_carve(a, cap, 1, tmp, tmp_view);
+    return points_carve(a, cap, 1, &o->d.pts, &o->d.pt_view);
 }
 
 void polyc__points_reserve(polyc__arena *a, const polyc_config *cfg, const polyc_limits *lim)
@@ -488,7 +488,7 @@ polyc_status polyc__points_collect(polyc__opt *o)
     size_t mark = ctx->arena.used;
     polyc__point *tmp;
     float *tmp_view;
-    if (ctx->online) { /* carved once, with the optimiser (polyc__opt_carve_online) */
+    if (ctx->online) { /* the points carved once, the copy by the caller (online.h) */
         tmp = ctx->online->pts_tmp;
         tmp_view = ctx->online->view_tmp;
     } else {
