@@ -79,7 +79,6 @@ typedef struct polyc__online {
     uint32_t *tile_miss;           /* and misses counted in its cells with hits */
 
     polyc__opt opt;                /* the optimiser (its arrays in the block) */
-    polyc__flat first;             /* the finishing call: the first search's map */
     int opt_ready;                 /* it holds the map (0 before the first update) */
 
     /* publication */
@@ -106,6 +105,8 @@ void polyc__online_stage_limits(const polyc_online_limits *ol, polyc_limits *lim
  * the backlog (every few scans); every stored tile (the finishing call) */
 void polyc__online_backlog_misses(polyc_ctx *ctx);
 void polyc__online_backlog_all(polyc_ctx *ctx);
+/* the sum of the view vectors of a cell's endpoints (0, 0: none) */
+void polyc__online_cell_view(const polyc_ctx *ctx, int32_t ix, int32_t iy, float *vx, float *vy);
 /* online_data.c: the points of the n taken tiles (the first n of the
  * backlog, marked) made again from the sums */
 polyc_status polyc__online_refresh_tiles(polyc_ctx *ctx, uint32_t n);

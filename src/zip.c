@@ -64,7 +64,7 @@ static int covered(const polyc__opt *o, float x, float y, int32_t a, int32_t b, 
  * squared distance). Along the segment's left normal it gives its side
  * (> 0: seen from the left; as docs/evaluation.md's band15 gives a segment
  * its side). Valid for the segments not edited since zip_mark. */
-static void find_sides(polyc__opt *o)
+void polyc__find_sides(polyc__opt *o)
 {
     const polyc__store *s = o->s;
     float *side = o->seg_side;
@@ -307,7 +307,7 @@ static int zip_pass(polyc__opt *o, uint32_t since)
     polyc__store *s = o->s;
     int zipped = 0;
     if (o->seg_side)
-        find_sides(o);
+        polyc__find_sides(o);
     for (int32_t v = 0; v < s->v_high; v++) {
         for (int k = 0; k < POLYC__FIXES_PER_SEGMENT; k++) {
             if (s->v[v].line == POLYC__NONE || s->v[v].next == POLYC__NONE ||

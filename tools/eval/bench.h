@@ -55,6 +55,8 @@ typedef struct bench_figures {
     uint64_t block_bytes;      /* the context's block */
     uint32_t lines, vertices;
     double bic;                /* polyc_stats.bic */
+    double bic_on_batch;       /* online maps: the BIC on the batch build's
+                                  data (tools/eval/fairbic.h); 0: none */
     gttopo_score topo;         /* against the log's scan endpoints */
     gtband_score band;
     double core_m;             /* sim scenes: core precision (CORE_M); < 0: none */

@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "bench.h"
+#include "fairbic.h"
 #include "gtscore.h"
 
 #define CHECK_EVERY 100u  /* a checkpoint every 100 scans... */
@@ -146,10 +147,19 @@ static void score_map(const scene_data *d, const polyc_ctx *ctx, bench_figures *
     free(lines);
 }
 
+/* Another map (an online one) to score on a batch build's data. */
+typedef struct other_map {
+    const polyc_polyline *lines;
+    uint32_t count;
+    double bic;                /* out: its BIC on the batch's data */
+} other_map;
+
 /* The batch build of scans[0..n) (one run, tools/eval/pipeline.h): its
- * BIC, and with d its figures into *f; -1 with a message if it failed. */
+ * BIC, with d its figures into *f, and with other that map's BIC on the
+ * same data; -1 with a message if it failed. */
 static int batch_build(const options *o, const scene_data *d, const polyc_scan *scans,
-                       uint32_t n, double *bic, bench_figures *f, const char *label)
+                       uint32_t n, double *bic, bench_figures *f, other_map *other,
+                       const char *label)
 {
     pipeline p;
     double times[PIPELINE_STAGES] = {0};
@@ -164,6 +174,14 @@ static int batch_build(const options *o, const scene_data *d, const polyc_scan *
             score_map(d, p.ctx, f);
         }
         rc = 0;
+        /* last: it replaces the context's map */
+        polyc_status st = other ? fairbic_score(p.ctx, other->lines, other->count, &other->bic)
+                                : POLYC_OK;
+        if (st != POLYC_OK) {
+            printf("%-24s batch of %u scans: the other map not scored: %s\n", label, n,
+                   polyc_status_str(st));
+            rc = -1;
+        }
     } else
         printf("%-24s batch of %u scans: error in %s: %s (%s)\n", label, n,
                p.failed_at ? p.failed_at : "polyc_get_stats", polyc_status_str(p.status),
@@ -278,40 +296,40 @@ static int is_checkpoint(uint32_t k, uint32_t n)
 
 /* The checkpoint at k scans: the online map's crossings and double cover
  * (against no data: those two need none), and its BIC against a batch
- * build of the same k scans (the full batch's when k is all of them). */
+ * build of the same k scans, both on that build's data (fairbic.h). */
 static void checkpoint(const options *o, const polyc_ctx *ctx, const polyc_scan *scans,
-                       uint32_t k, uint32_t n, double online_bic, const bench_figures *full,
-                       replay *r, const char *label)
+                       uint32_t k, replay *r, const char *label)
 {
     uint32_t count;
     polyc_polyline *lines = map_lines(ctx, &count);
     gttopo_score t;
     double bic;
-    if (lines && gttopo_score_map(lines, count, NULL, 0, &t) == 0) {
+    other_map now = {lines, count, 0.0};
+    if (!lines)
+        return;
+    if (gttopo_score_map(lines, count, NULL, 0, &t) == 0) {
         if (t.crossings > r->cross_max)
             r->cross_max = t.crossings;
         r->dcov_max_m = fmax(r->dcov_max_m, t.double_cover_m);
     }
-    free(lines);
-    if (k == n && full && full->ok)
-        bic = full->bic;
-    else if (batch_build(o, NULL, scans, k, &bic, NULL, label) != 0)
-        return;
-    r->checks++;
-    if (bic > 0.0 && online_bic / bic > r->worst_ratio) {
-        r->worst_ratio = online_bic / bic;
-        r->worst_at = k;
+    if (batch_build(o, NULL, scans, k, &bic, NULL, &now, label) == 0 && bic > 0.0) {
+        r->checks++;
+        if (now.bic / bic > r->worst_ratio) {
+            r->worst_ratio = now.bic / bic;
+            r->worst_at = k;
+        }
     }
+    free(lines);
 }
 
 /* scans[0..n) `passes` times over into on's context (opened here on
  * on->limits), an update after each add, then polyc_online_finish (with
  * finish). keep: keep the scans, their ids into ids[]. With checks, the
- * checkpoints of the first pass (full: the batch figures of all n). 0, or
+ * checkpoints of the first pass. 0, or
  * -1 with on->failed_at; the context stays open either way (online_close). */
 static int replay_run(const options *o, online *on, const polyc_scan *scans, uint32_t n,
-                      unsigned passes, int keep, uint32_t *ids, int checks,
-                      const bench_figures *full, int finish, replay *r, const char *label)
+                      unsigned passes, int keep, uint32_t *ids, int checks, int finish,
+                      replay *r, const char *label)
 {
     polyc_config config;
     polyc_online_report rep;
@@ -343,7 +361,7 @@ static int replay_run(const options *o, online *on, const polyc_scan *scans, uin
                 r->backlog_max = rep.backlog_tiles;
             r->scans++;
             if (checks && pass == 0 && is_checkpoint(i + 1u, n))
-                checkpoint(o, on->ctx, scans, i + 1u, n, rep.bic, full, r, label);
+                checkpoint(o, on->ctx, scans, i + 1u, r, label);
         }
     if (finish) {
         double t0 = pipeline_now_ms();
@@ -367,7 +385,7 @@ static uint32_t twice(uint32_t a, double cap)
  * pipeline_run_online does, LIMIT_TRIES times in all; r->tries says how
  * many runs it took. */
 static int replay_grow(const options *o, online *on, const polyc_scan *scans, uint32_t n,
-                       int checks, const bench_figures *full, replay *r, const char *label)
+                       int checks, replay *r, const char *label)
 {
     double *add_ms = r->add_ms, *step_ms = r->step_ms;
     polyc_config config;
@@ -379,7 +397,7 @@ static int replay_grow(const options *o, online *on, const polyc_scan *scans, ui
         r->add_ms = add_ms;
         r->step_ms = step_ms;
         r->tries = ++tries;
-        rc = replay_run(o, on, scans, n, 1, 0, NULL, checks, full, 1, r, label);
+        rc = replay_run(o, on, scans, n, 1, 0, NULL, checks, 1, r, label);
         if (rc == 0 || on->status != POLYC_ERR_NOMEM || tries >= LIMIT_TRIES)
             return rc;
         online_close(on);
@@ -461,16 +479,19 @@ static void print_replay_header(const options *o, int batch_from_table)
 
 static void print_figures_header(void)
 {
-    printf("%-24s %-9s | %6s %7s %10s | %8s %6s %6s %8s %6s %6s | %6s %6s\n", "scene", "map",
-           "lines", "verts", "BIC", "band15", "band%", "cross", "dcov", "uns20", "end20", "core",
+    printf("%-24s %-9s | %6s %7s %10s %10s %6s | %8s %6s %6s %8s %6s %6s | %6s %6s\n", "scene",
+           "map", "lines", "verts", "BIC", "BIC@batch", "/batch", "band15", "band%", "cross", "dcov", "uns20", "end20", "core",
            "compl");
-    printf("%-24s %-9s | %6s %7s %10s | %8s %6s %6s %8s %6s %6s | %6s %6s\n", "", "", "", "",
-           "", "m", "", "", "m", "", "", "mm", "");
+    printf("%-24s %-9s | %6s %7s %10s %10s %6s | %8s %6s %6s %8s %6s %6s | %6s %6s\n", "", "",
+           "", "", "", "", "", "m", "", "", "m", "", "", "mm", "");
 }
 
-static void print_figures(const char *label, const char *map, const bench_figures *f)
+/* batch: the batch map's figures, for the online map's BIC ratio (NULL for
+ * the batch row itself) */
+static void print_figures(const char *label, const char *map, const bench_figures *f,
+                          const bench_figures *batch)
 {
-    char core[16] = "-", compl[16] = "-";
+    char core[16] = "-", compl[16] = "-", fair[16] = "-", ratio[16] = "-";
     if (!f->ok) {
         printf("%-24s %-9s | %6s\n", label, map, "-");
         return;
@@ -479,8 +500,13 @@ static void print_figures(const char *label, const char *map, const bench_figure
         snprintf(core, sizeof core, "%.1f", 1e3 * f->core_m);
     if (f->completeness >= 0.0)
         snprintf(compl, sizeof compl, "%.4f", f->completeness);
-    printf("%-24s %-9s | %6u %7u %10.1f | %8.2f %6.2f %6u %8.2f %6u %6.4f | %6s %6s\n", label,
-           map, f->lines, f->vertices, f->bic, f->band.band_m,
+    if (batch && f->bic_on_batch > 0.0) {
+        snprintf(fair, sizeof fair, "%.1f", f->bic_on_batch);
+        if (batch->ok && batch->bic > 0.0)
+            snprintf(ratio, sizeof ratio, "%.4f", f->bic_on_batch / batch->bic);
+    }
+    printf("%-24s %-9s | %6u %7u %10.1f %10s %6s | %8.2f %6.2f %6u %8.2f %6u %6.4f | %6s %6s\n", label,
+           map, f->lines, f->vertices, f->bic, fair, ratio, f->band.band_m,
            f->band.map_length_m > 0.0 ? 100.0 * f->band.band_m / f->band.map_length_m : 0.0,
            f->topo.crossings, f->topo.double_cover_m, f->topo.unsupported_20,
            gtband_share(f->band.within_20, f->band.points), core, compl);
@@ -499,6 +525,20 @@ typedef struct scene_result {
     int ok;
     bench_figures online, batch;
 } scene_result;
+
+/* The online map's BIC on the data of a batch build of the same scans
+ * (one more batch build: the table's keeps no context). */
+static void fair_score(const options *o, const scene_data *d, const polyc_ctx *ctx,
+                       bench_figures *f, const char *label)
+{
+    uint32_t count;
+    double bic;
+    polyc_polyline *lines = map_lines(ctx, &count);
+    other_map now = {lines, count, 0.0};
+    if (lines && batch_build(o, NULL, d->log.scans, d->log.count, &bic, NULL, &now, label) == 0)
+        f->bic_on_batch = now.bic;
+    free(lines);
+}
 
 static int online_scene(const options *o, const scene *s, const bench_figures *table_batch,
                         scene_result *res)
@@ -527,7 +567,7 @@ static int online_scene(const options *o, const scene *s, const bench_figures *t
     /* the batch map: the main table's, or built here (one run) */
     if (table_batch && table_batch->ok)
         res->batch = *table_batch;
-    else if (batch_build(o, &d, d.log.scans, n, &bic, &res->batch, res->label) != 0)
+    else if (batch_build(o, &d, d.log.scans, n, &bic, &res->batch, NULL, res->label) != 0)
         memset(&res->batch, 0, sizeof res->batch);
     bench_config(o, &config);
     if ((st = limits_for(&config, &d, NULL, 0, &on.limits)) != POLYC_OK) {
@@ -540,8 +580,7 @@ static int online_scene(const options *o, const scene *s, const bench_figures *t
     r.step_ms = malloc(n * sizeof *r.step_ms);
     if (!r.add_ms || !r.step_ms) {
         printf("%-24s error: out of memory\n", res->label);
-    } else if (replay_grow(o, &on, d.log.scans, n, 1, res->batch.ok ? &res->batch : NULL, &r,
-                           res->label) != 0) {
+    } else if (replay_grow(o, &on, d.log.scans, n, 1, &r, res->label) != 0) {
         print_failure(res->label, &on);
     } else {
         double add_med = median(r.add_ms, n), step_med = median(r.step_ms, n);
@@ -562,6 +601,7 @@ static int online_scene(const options *o, const scene *s, const bench_figures *t
                worst, at, r.cross_max, r.dcov_max_m, tries);
         res->online.lib_ms = r.total_ms;
         score_map(&d, on.ctx, &res->online);
+        fair_score(o, &d, on.ctx, &res->online, res->label);
         res->ok = 1;
         rc = 0;
     }
@@ -606,7 +646,7 @@ static int memory_row(const options *o, const scene *s, const scene_result *one)
            "batchMiB", "passes", "scans", "status", "usedMiB", "total", "finish");
     printf("%-24s %6s %9s %9s | %6s %6s %-14s %8s %8s %9s\n", "", "m", "", "", "", "", "", "",
            "ms", "ms");
-    rc = replay_run(o, &on, d.log.scans, d.log.count, PASSES, 0, NULL, 0, NULL, 0, &r,
+    rc = replay_run(o, &on, d.log.scans, d.log.count, PASSES, 0, NULL, 0, 0, &r,
                     one->label);
     if (on.ctx) {
         /* finish what was added, whether all of it fitted or not */
@@ -615,9 +655,10 @@ static int memory_row(const options *o, const scene *s, const scene_result *one)
         polyc_status st = polyc_online_finish(on.ctx, NULL, NULL, &rep);
         r.finish_ms = pipeline_now_ms() - t0;
         r.total_ms += r.finish_ms;
-        if (online_fail(&on, st, "polyc_online_finish", r.scans) == 0)
+        if (online_fail(&on, st, "polyc_online_finish", r.scans) == 0) {
             score_map(&d, on.ctx, &f);
-        else
+            fair_score(o, &d, on.ctx, &f, one->label);
+        } else
             rc = -1;
     }
     if (on.failed_at)
@@ -638,9 +679,9 @@ static int memory_row(const options *o, const scene *s, const scene_result *one)
         print_failure(one->label, &on);
     print_figures_header();
     if (one->ok)
-        print_figures(one->label, "1 pass", &one->online);
-    print_figures(one->label, "10 passes", &f);
-    print_figures(one->label, "batch", &one->batch);
+        print_figures(one->label, "1 pass", &one->online, &one->batch);
+    print_figures(one->label, "10 passes", &f, &one->batch);
+    print_figures(one->label, "batch", &one->batch, NULL);
     fflush(stdout);
     online_close(&on);
     scene_data_free(&d);
@@ -711,9 +752,10 @@ static int correction_row(const options *o, const scene *s, const scene_result *
         printf("%-24s error: out of memory or no limits\n", one->label);
         goto done;
     }
-    if (replay_run(o, &on, bad, n, 1, 1, ids, 0, NULL, 0, &r, one->label) != 0)
+    if (replay_run(o, &on, bad, n, 1, 1, ids, 0, 0, &r, one->label) != 0)
         goto failed;
     score_map(&d, on.ctx, &before);
+    fair_score(o, &d, on.ctx, &before, one->label);
     {
         double t0 = pipeline_now_ms();
         for (i = 0; i < n; i++)
@@ -738,6 +780,8 @@ static int correction_row(const options *o, const scene *s, const scene_result *
         finish_ms = pipeline_now_ms() - t0;
     }
     score_map(&d, on.ctx, &after);
+    /* on the data of the batch map of the true poses: the log's */
+    fair_score(o, &d, on.ctx, &after, one->label);
     {
         char upd[16];
         snprintf(upd, sizeof upd, "%u%s", updates,
@@ -747,9 +791,9 @@ static int correction_row(const options *o, const scene *s, const scene_result *
                "ok");
     }
     print_figures_header();
-    print_figures(one->label, "drifted", &before);
-    print_figures(one->label, "corrected", &after);
-    print_figures(one->label, "batch", &one->batch);
+    print_figures(one->label, "drifted", &before, &one->batch);
+    print_figures(one->label, "corrected", &after, &one->batch);
+    print_figures(one->label, "batch", &one->batch, NULL);
     rc = 0;
     goto done;
 failed:
@@ -794,8 +838,8 @@ int bench_online_section(const options *o, const scene *list, size_t count,
     print_figures_header();
     for (i = 0; i < count; i++) {
         if (res[i].ok)
-            print_figures(res[i].label, "online", &res[i].online);
-        print_figures(res[i].label, "batch", &res[i].batch);
+            print_figures(res[i].label, "online", &res[i].online, &res[i].batch);
+        print_figures(res[i].label, "batch", &res[i].batch, NULL);
     }
     if (intel < count) {
         if (memory_row(o, &list[intel], &res[intel]) != 0)
