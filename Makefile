@@ -170,15 +170,17 @@ test-python: all $(BUILD)/py/libpolyc.so $(PYVENV)/ready
 	POLYC_LIB=$(abspath $(BUILD)/py/libpolyc.so) POLYC_TOOL=$(abspath $(BUILD)/polyc) \
 	    POLYC_WHEELS=$(abspath $(BUILD)/pywheels) \
 	    $(PYVENV)/bin/python -m unittest discover -v -s bindings/python -p 'test_*.py'
-# the library as for the target (8-bit grid counters), tests/embedded_test.sh checks the map
+# the library as for the target (8-bit grid counters), and the embedded examples on it (one
+# scan; an online map scan by scan): tests/embedded_test.sh checks their maps
 EMB_OBJ = $(LIB_SRC:src/%.c=$(BUILD)/emb/%.o)
 $(BUILD)/emb/%.o: src/%.c include/polyc.h $(wildcard src/*.h)
 	@mkdir -p $(dir $@)
 	$(CC) $(WARN) $(OPT) $(CFLAGS) -DPOLYC_COUNTER_BITS=8 -Iinclude -c $< -o $@
-$(BUILD)/embedded_scan: examples/embedded_scan.c $(EMB_OBJ)
-	$(CC) $(WARN) $(OPT) $(CFLAGS) -Iinclude $^ -o $@ $(LDLIBS)
-test-embedded: $(BUILD)/embedded_scan footprint
-	tests/embedded_test.sh $(BUILD)/embedded_scan
+EMB_EXAMPLES = embedded_scan embedded_online
+$(EMB_EXAMPLES:%=$(BUILD)/%): $(BUILD)/%: examples/%.c examples/embedded_room.h $(EMB_OBJ)
+	$(CC) $(WARN) $(OPT) $(CFLAGS) -Iinclude $(filter %.c %.o,$^) -o $@ $(LDLIBS)
+test-embedded: $(EMB_EXAMPLES:%=$(BUILD)/%) footprint
+	tests/embedded_test.sh $(EMB_EXAMPLES:%=$(BUILD)/%)
 # bytes per scan, beam, vertex and grid tile (README "Footprint"): 16-, then 8-bit counters
 .PHONY: footprint
 footprint: $(BUILD)/footprint $(BUILD)/footprint8
@@ -262,7 +264,7 @@ fuzz-merge: $(FUZZ_BIN)
 
 # Cortex-M4 (`make cross`; needs gcc-arm-none-eabi, libnewlib-arm-none-eabi): the
 # library at -Os -Werror and its sizes; FAILS if it references an allocator or
-# stdio (nm -u), or if the linked example (nosys.specs) contains one; then the
+# stdio (nm -u), or if a linked example (nosys.specs) contains one; then each
 # example's stack from -fstack-usage. A failed POLYC_ASSERT traps (udf): newlib's
 # assert() calls __assert_func, which pulls in fiprintf and all of stdio.
 CROSS  ?= arm-none-eabi-
@@ -277,25 +279,32 @@ X_STDIO = $(subst $(sp),|,.*printf.* .*scanf.* f?open fdopen freopen fclose frea
           fputc putc puts putchar fgets gets fgetc getc getchar ungetc fflush fseek ftell rewind \
           perror setvbuf setbuf tmpfile stdin stdout stderr __assert_func setlocale localeconv \
           strto(d|f|ld) atof)
-cross: $(XBUILD)/libpolyc.a $(XBUILD)/embedded_scan.elf
+XELF    = $(EMB_EXAMPLES:%=$(XBUILD)/%.elf)
+cross: $(XBUILD)/libpolyc.a $(XELF)
 	$(CROSS)size -t $(XOBJ)
-	$(CROSS)size $(XBUILD)/embedded_scan.elf
+	$(CROSS)size $(XELF)
 	@bad=$$($(CROSS)nm -u $(XOBJ) | awk '{print $$2}' | grep -Ex '$(X_ALLOC)|$(X_STDIO)|_impure_ptr' | sort -u); \
 	if [ -n "$$bad" ]; then echo "cross: FAIL: the library references" $$bad; exit 1; fi
-	@bad=$$($(CROSS)nm $(XBUILD)/embedded_scan.elf | awk '{print $$3}' | grep -Ex '$(X_ALLOC)|$(X_STDIO)' | sort -u); \
-	if [ -n "$$bad" ]; then echo "cross: FAIL: the linked example contains" $$bad; exit 1; fi
-	@echo "cross: no allocator and no stdio in the library or the linked example"
-	python3 tools/eval/stack_usage.py --cross $(CROSS) --elf $(XBUILD)/embedded_scan.elf \
-	    $(XOBJ:.o=.ci) $(XBUILD)/embedded_scan.ci
+	@for e in $(XELF); do \
+	  bad=$$($(CROSS)nm $$e | awk '{print $$3}' | grep -Ex '$(X_ALLOC)|$(X_STDIO)' | sort -u); \
+	  if [ -n "$$bad" ]; then echo "cross: FAIL: the linked $$e contains" $$bad; exit 1; fi; \
+	done
+	@echo "cross: no allocator and no stdio in the library or the linked examples"
+	@set -e; for x in $(EMB_EXAMPLES); do \
+	  python3 tools/eval/stack_usage.py --cross $(CROSS) --elf $(XBUILD)/$$x.elf \
+	    $(XOBJ:.o=.ci) $(XBUILD)/$$x.ci; done
 $(XBUILD)/%.o: src/%.c include/polyc.h $(wildcard src/*.h)
 	@mkdir -p $(dir $@)
 	$(CROSS)gcc $(XFLAGS) -c $< -o $@
 $(XBUILD)/libpolyc.a: $(XOBJ)
 	rm -f $@ && $(CROSS)ar rcs $@ $^
-$(XBUILD)/embedded_scan.o: examples/embedded_scan.c include/polyc.h
+# (each example with its target macro: no stdio)
+$(XBUILD)/embedded_scan.o: XTARGET = EMBEDDED_SCAN_TARGET
+$(XBUILD)/embedded_online.o: XTARGET = EMBEDDED_ONLINE_TARGET
+$(EMB_EXAMPLES:%=$(XBUILD)/%.o): $(XBUILD)/%.o: examples/%.c examples/embedded_room.h include/polyc.h
 	@mkdir -p $(dir $@)
-	$(CROSS)gcc $(XFLAGS) -DEMBEDDED_SCAN_TARGET -c $< -o $@
-$(XBUILD)/embedded_scan.elf: $(XBUILD)/embedded_scan.o $(XBUILD)/libpolyc.a
+	$(CROSS)gcc $(XFLAGS) -D$(XTARGET) -c $< -o $@
+$(XELF): %.elf: %.o $(XBUILD)/libpolyc.a
 	$(CROSS)gcc $(XFLAGS) -specs=nosys.specs -Wl,--gc-sections $^ -lm -o $@
 
 # Benchmark on the shared data (not in the repo): an optimised build in

@@ -1,97 +1,41 @@
 /* embedded_scan.c - the whole pipeline (grid, contour, trace, optimiser) on
  * one 180-beam scan inside a static 128 KiB block, as on a Cortex-M4.
  *
- * The scan is computed here (no I/O on the target): a 5 m x 4 m room with a
- * 0.6 m x 0.5 m cabinet, seen by a laser at (1.2, 2.0) looking along +x,
- * beams from -90 to +89 degrees in 1 degree steps, +-1 cm of noise.
+ * The scan is computed here (no I/O on the target): the room of
+ * embedded_room.h, a 5 m x 4 m room with a 0.6 m x 0.5 m cabinet, seen by a
+ * laser at (1.2, 2.0) looking along +x, beams from -90 to +89 degrees in 1
+ * degree steps, +-1 cm of noise.
  *
  * Choices that make it fit (also in README.md, "Footprint"):
  *   grid cell      0.10 m   (limits.max_grid_cells: 4 tiles = 64 x 64 cells)
  *   range cap      4.5 m    (scan max_range_m and config free_range_m)
  *   counters       8 bit    (library built with -DPOLYC_COUNTER_BITS=8)
  *   vertices       96       (limits.max_vertices; the trace gives ~40, the map ~10)
- * polyc_memory_size() is then about 118 KB <= sizeof block, 64 KiB of it the
- * optimiser's spatial hash, which has a fixed floor. With 16-bit counters it
- * is 8 KiB more, 128 KB: still within the block.
+ * polyc_memory_size() is then about 82 KB <= sizeof block (the host build;
+ * the spatial hash's buckets and entries follow the grid and the vertices).
+ * With 16-bit counters it is 10 KB more, 92 KB: still within the block.
  *
  * Host:   prints the polylines in polyc's TXT format (tests/embedded_test.sh).
  * Target: built with -DEMBEDDED_SCAN_TARGET, main() only runs the pipeline
  *         and returns the status; no stdio is linked.
  */
-#include <math.h>
 #include <stdint.h>
 
+#include "embedded_room.h"
 #include "polyc.h"
 
 #ifndef EMBEDDED_SCAN_TARGET
 #include <stdio.h>
 #endif
 
-#define BEAMS 180
-#define CELL_M 0.10f
-#define RANGE_CAP_M 4.5f
 #define MAX_VERTICES 96u
 #define BLOCK_BYTES (128u * 1024u)
 
 static uint8_t block[BLOCK_BYTES]; /* the library's only memory */
 static float ranges[BEAMS];
 
-/* The room: wall segments (x0, y0, x1, y1) in metres. */
-static const float walls[][4] = {
-    {0.0f, 0.0f, 5.0f, 0.0f}, {5.0f, 0.0f, 5.0f, 4.0f},
-    {5.0f, 4.0f, 0.0f, 4.0f}, {0.0f, 4.0f, 0.0f, 0.0f},
-    /* cabinet */
-    {3.6f, 2.6f, 4.2f, 2.6f}, {4.2f, 2.6f, 4.2f, 3.1f},
-    {4.2f, 3.1f, 3.6f, 3.1f}, {3.6f, 3.1f, 3.6f, 2.6f},
-};
-
 #define POSE_X 1.2f
 #define POSE_Y 2.0f
-
-/* Distance along (dx, dy) from (px, py) to the nearest wall; RANGE_CAP_M if none. */
-static float cast(float px, float py, float dx, float dy)
-{
-    float best = RANGE_CAP_M;
-    for (unsigned i = 0; i < sizeof walls / sizeof walls[0]; i++) {
-        float ax = walls[i][0], ay = walls[i][1];
-        float ex = walls[i][2] - ax, ey = walls[i][3] - ay;
-        float den = dx * ey - dy * ex;
-        if (fabsf(den) < 1e-9f)
-            continue;
-        float t = ((ax - px) * ey - (ay - py) * ex) / den; /* along the beam */
-        float u = ((ax - px) * dy - (ay - py) * dx) / den; /* along the wall */
-        if (t > 0.0f && t < best && u >= 0.0f && u <= 1.0f)
-            best = t;
-    }
-    return best;
-}
-
-/* Uniform noise in [-1, 1) from a fixed LCG: the same scan every run. */
-static float noise(uint32_t *state)
-{
-    *state = *state * 1664525u + 1013904223u;
-    return (float)(*state >> 8) / 8388608.0f - 1.0f;
-}
-
-static void make_scan(polyc_scan *scan)
-{
-    const float start = -1.5707963f, step = 0.017453292f; /* -90 deg, 1 deg */
-    uint32_t seed = 12345u;
-    for (uint32_t i = 0; i < BEAMS; i++) {
-        float a = start + (float)i * step;
-        ranges[i] = cast(POSE_X, POSE_Y, cosf(a), sinf(a)) + 0.01f * noise(&seed);
-    }
-    scan->pose_x_m = (double)POSE_X;
-    scan->pose_y_m = (double)POSE_Y;
-    scan->pose_theta_rad = 0.0;
-    scan->start_angle_rad = start;
-    scan->angle_step_rad = step;
-    scan->min_range_m = 0.02f;
-    scan->max_range_m = RANGE_CAP_M; /* a range >= the cap is free space only */
-    scan->beam_count = BEAMS;
-    scan->reserved = 0;
-    scan->range_m = ranges;
-}
 
 /* Runs the pipeline; *out gets the context (valid while `block` lives). */
 static polyc_status run(polyc_ctx **out, size_t *need)
@@ -101,7 +45,8 @@ static polyc_status run(polyc_ctx **out, size_t *need)
     polyc_scan scan;
     polyc_status st;
 
-    make_scan(&scan);
+    uint32_t seed = 12345u;
+    make_scan(&scan, ranges, POSE_X, POSE_Y, 0.0f, &seed);
     polyc_config_default(&cfg);
     cfg.cell_m = CELL_M;
     cfg.free_range_m = RANGE_CAP_M;

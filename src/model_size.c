@@ -14,7 +14,11 @@ int polyc__size_carve(polyc__arena *a, polyc__size_scratch *sz, int32_t V)
     POLYC__CARVE(ok, a, sz->seg_w, V);
     POLYC__CARVE(ok, a, sz->seg_far_d, V);
     POLYC__CARVE(ok, a, sz->seg_far, V);
-    sz->heap_cap = V + POLYC__HEAP_SPARE; /* a candidate that finds it full is not retried */
+    /* A pass pushes each live vertex once, and each removal pops one
+     * candidate and pushes at most its two neighbours: the heap never holds
+     * more than twice the vertices, so a small store's spare is V. A
+     * candidate that finds it full is not retried. */
+    sz->heap_cap = V + (V < POLYC__HEAP_SPARE ? V : POLYC__HEAP_SPARE);
     POLYC__CARVE(ok, a, sz->heap, sz->heap_cap);
     return ok;
 }

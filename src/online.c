@@ -135,28 +135,17 @@ static int lay_out(polyc_ctx *ctx, polyc__online *on, polyc__arena *a)
     size_t dir_n = (size_t)ctx->grid.tiles_x * (size_t)ctx->grid.tiles_y;
     uint32_t tile_cap = ctx->grid.tile_cap;
     ok &= polyc__prior_online(ctx, &on->prior, &on->acc, a);
-    POLYC__CARVE_ZERO(ok, a, on->slot, (size_t)tile_cap * POLYC__TILE_CELLS);
-    POLYC__CARVE(ok, a, on->sums, ol->max_points);
+    ok = ok && polyc__cells_carve(a, on, tile_cap);
     POLYC__CARVE_ZERO(ok, a, on->pose_bits, dir_n / 32 + 1);
     POLYC__CARVE(ok, a, on->spacing_dist, dir_n);
     POLYC__CARVE_ZERO(ok, a, on->dirty_since, dir_n);
     POLYC__CARVE(ok, a, on->dirty, dir_n);
     on->cells_cap = ol->max_points + 1;
-    POLYC__CARVE(ok, a, on->cells, 2 * (size_t)on->cells_cap);
-    POLYC__CARVE(ok, a, on->learn_cache, 3 * (size_t)ol->max_scan_beams);
     ok = ok && polyc__opt_carve_online(ctx, a, &on->opt);
     if (!ok)
         return 0;
     size_t P = (size_t)polyc__points_bound(&ctx->cfg, &ctx->lim), nb = (size_t)on->opt.h.bx * (size_t)on->opt.h.by;
-    POLYC__CARVE(ok, a, on->alt_pts, P);
-    POLYC__CARVE(ok, a, on->alt_view, 2 * P);
-    POLYC__CARVE(ok, a, on->alt_seg, P);
-    POLYC__CARVE(ok, a, on->alt_cost, P);
-    POLYC__CARVE(ok, a, on->alt_tile, P);
     POLYC__CARVE(ok, a, on->pt_tile, P);
-    POLYC__CARVE(ok, a, on->fresh_tile, P);
-    POLYC__CARVE(ok, a, on->fresh_bucket, P);
-    POLYC__CARVE(ok, a, on->alt_start, nb + 1);
     POLYC__CARVE(ok, a, on->bucket_fill, nb);
     POLYC__CARVE_ZERO(ok, a, on->tile_raw, tile_cap);
     POLYC__CARVE_ZERO(ok, a, on->tile_new, tile_cap);
@@ -170,11 +159,47 @@ static int lay_out(polyc_ctx *ctx, polyc__online *on, polyc__arena *a)
     ctx->arena = saved;
     if (st != POLYC_OK)
         return 0;
-    /* the tiles, and above them an update's scratch: the trace's walk */
-    a->peak = polyc__add(a->used, polyc__add(polyc__bytes(tile_cap, sizeof(polyc__tile)),
-                                             polyc__bytes(2 * (size_t)on->cells_cap + 2,
-                                                          sizeof(int32_t))));
+    /* the tiles, and above them the largest step's scratch */
+    size_t scratch = 0;
+    for (int step = POLYC__STEP_TRACE; step <= POLYC__STEP_LEARN; step++) {
+        polyc__arena c;
+        polyc__arena_counting(&c);
+        polyc__online_scratch(&c, on, (int32_t)P, (polyc__online_step)step);
+        if (step == POLYC__STEP_TRACE) /* and the trace's walk, which trace.c carves */
+            c.peak = polyc__add(c.peak, polyc__bytes(2 * (size_t)on->cells_cap + 2, sizeof(int32_t)));
+        scratch = c.peak > scratch ? c.peak : scratch;
+    }
+    on->cells = NULL;
+    on->pts_tmp = NULL;
+    on->view_tmp = NULL;
+    on->fresh_tile = NULL;
+    on->fresh_bucket = NULL;
+    on->learn_cache = NULL;
+    a->peak = polyc__add(a->used, polyc__add(polyc__bytes(tile_cap, sizeof(polyc__tile)), scratch));
     return 1;
+}
+
+/* A step's scratch lives only while the step runs, so the steps share one
+ * region above the tiles: the block holds the largest, not their sum. */
+int polyc__online_scratch(polyc__arena *a, polyc__online *on, int32_t points, polyc__online_step step)
+{
+    int ok = 1;
+    size_t P = (size_t)points;
+    switch (step) {
+    case POLYC__STEP_TRACE:
+        POLYC__CARVE(ok, a, on->cells, 2 * (size_t)on->cells_cap);
+        break;
+    case POLYC__STEP_POINTS:
+        POLYC__CARVE(ok, a, on->pts_tmp, P);
+        POLYC__CARVE(ok, a, on->view_tmp, 2 * P);
+        POLYC__CARVE(ok, a, on->fresh_tile, P);
+        POLYC__CARVE(ok, a, on->fresh_bucket, P);
+        break;
+    case POLYC__STEP_LEARN:
+        POLYC__CARVE(ok, a, on->learn_cache, 3 * (size_t)on->lim.max_scan_beams);
+        break;
+    }
+    return ok;
 }
 
 static size_t header_bytes(void)
@@ -296,7 +321,7 @@ void polyc__online_cell_view(const polyc_ctx *ctx, int32_t ix, int32_t iy, float
     *vx = *vy = 0.0f;
     if (d < 0 || g->dir[d] == 0)
         return;
-    uint32_t e = on->slot[(size_t)(g->dir[d] - 1) * POLYC__TILE_CELLS + (size_t)polyc__cell_index(ix, iy)];
+    uint32_t e = polyc__cell_find(on, polyc__cell_key(g->dir[d] - 1, polyc__cell_index(ix, iy)));
     if (e == 0)
         return;
     *vx = on->sums[e - 1].vx;
@@ -322,24 +347,14 @@ static int sum_endpoints(polyc_ctx *ctx, const polyc__scan *s, float sign)
         uint32_t k = g->dir[d] - 1;
         if (++on->tile_new[k] >= CHANGE_MIN && (double)on->tile_new[k] >= CHANGE_SHARE * on->tile_raw[k])
             mark_dirty(on, (size_t)d);
-        uint32_t *slot = &on->slot[(size_t)(g->dir[d] - 1) * POLYC__TILE_CELLS + (size_t)polyc__cell_index(ix, iy)];
-        if (*slot == 0) {
-            if (sign < 0.0f)
-                continue;
-            uint32_t e;
-            if (on->sums_free) {
-                e = on->sums_free - 1;
-                on->sums_free = on->sums[e].n;
-            } else if (on->sums_n < on->lim.max_points) {
-                e = on->sums_n++;
-            } else {
+        uint32_t key = polyc__cell_key(k, polyc__cell_index(ix, iy));
+        uint32_t e = sign < 0.0f ? polyc__cell_find(on, key) : polyc__cell_add(on, key);
+        if (e == 0) { /* the entries are used up (or a cell without sums taken back) */
+            if (sign > 0.0f)
                 ok = 0;
-                continue;
-            }
-            memset(&on->sums[e], 0, sizeof on->sums[0]);
-            *slot = e + 1;
+            continue;
         }
-        polyc__cell_sums *c = &on->sums[*slot - 1];
+        polyc__cell_sums *c = &on->sums[e - 1];
         float ox = (b.ex - fx - 0.5f) * g->cell_m, oy = (b.ey - fy - 0.5f) * g->cell_m;
         c->fx += sign * ox;
         c->fy += sign * oy;
@@ -349,11 +364,8 @@ static int sum_endpoints(polyc_ctx *ctx, const polyc__scan *s, float sign)
         c->vx += sign * (b.sx - b.ex) * g->cell_m;
         c->vy += sign * (b.sy - b.ey) * g->cell_m;
         c->n = sign > 0.0f ? c->n + 1 : (c->n > 0 ? c->n - 1 : 0);
-        if (c->n == 0) { /* its last endpoint went (a correction): the entry is free */
-            c->n = on->sums_free;
-            on->sums_free = *slot;
-            *slot = 0;
-        }
+        if (c->n == 0) /* its last endpoint went (a correction): the entry is free */
+            polyc__cell_drop(on, e);
     }
     return ok;
 }
@@ -420,9 +432,16 @@ static polyc_status accumulate(polyc_ctx *ctx, const polyc__scan *s, uint32_t nu
     if (take_back)
         return st;
     label_contour(ctx, s);
-    if (learn)
+    if (learn) {
+        /* (the block is sized for it; without it, NULL: the same lines,
+         * the endpoints computed twice) */
+        size_t mark = ctx->arena.used;
+        polyc__online_scratch(&ctx->arena, on, 0, POLYC__STEP_LEARN);
         polyc__prior_learn_scan(ctx, &on->prior, s, number, on->learn_cache, on->lim.max_scan_beams,
                                 &on->acc);
+        ctx->arena.used = mark;
+        on->learn_cache = NULL;
+    }
     int64_t d = tile_of(g, (int32_t)floorf((float)((double)s->x_m - (g->origin_x_m - ctx->frame_x)) * g->inv_cell),
                         (int32_t)floorf((float)((double)s->y_m - (g->origin_y_m - ctx->frame_y)) * g->inv_cell));
     if (d >= 0 && !((on->pose_bits[d >> 5] >> (d & 31)) & 1u)) {

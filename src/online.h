@@ -9,11 +9,12 @@
 
 /* One grid cell's endpoints: their count, the sums of their offsets from
  * the cell's centre and of those offsets' products (metres), and of the
- * vectors from them to their sensors. A scan taken back subtracts what it
- * added. */
+ * vectors from them to their sensors; and the cell (polyc__cell_key). A
+ * scan taken back subtracts what it added. */
 typedef struct polyc__cell_sums {
     float fx, fy, fxx, fxy, fyy, vx, vy;
-    uint32_t n;
+    uint32_t n;                    /* a free entry: 1 + the next free one, 0: none */
+    uint32_t cell;
 } polyc__cell_sums;
 
 /* What the last publication held of a polyline: its id, a hash of its
@@ -25,12 +26,15 @@ typedef struct polyc__pub {
 
 typedef struct polyc__online {
     polyc_online_limits lim;
-    /* per cell of the stored tiles (tile index * 1024 + cell): 1 + its
-     * entry in sums, 0 for a cell without endpoints */
-    uint32_t *slot;
+    /* the cells with endpoints (online_cells.c): their sums, and a table
+     * of 1 + their entries (0: an empty slot) by the hash of their key;
+     * per stored tile, how many of its cells have sums */
     polyc__cell_sums *sums;
     uint32_t sums_n;
     uint32_t sums_free;            /* 1 + a free entry (a list through their n), 0: none */
+    uint32_t *cell_at;
+    uint32_t cell_mask, cell_shift;
+    uint32_t *tile_cells;
     uint32_t *pose_bits;           /* bit per directory entry: a pose lay in the tile */
     float min_step_rad;            /* smallest |angle step| seen */
     float *spacing_dist;           /* the spacing table (spacing.c), per directory entry */
@@ -55,22 +59,21 @@ typedef struct polyc__online {
     polyc__prior prior;
     polyc__acc_learn acc;
 
-    /* an update's scratch: the contour cells to trace, the points */
+    /* scratch, carved above the tiles by the step that needs it and given
+     * back after it (polyc__online_scratch): a trace's contour cells; the
+     * points made again and their tiles and buckets; the prior's endpoint
+     * cache for one scan. NULL while not carved. */
     int32_t *cells;
     uint32_t cells_cap;
-    float *learn_cache;            /* the prior's endpoint cache, one scan */
     polyc__point *pts_tmp;
     float *view_tmp;
     uint32_t *fresh_tile;          /* per new point: its tile's directory entry */
     int32_t *fresh_bucket;         /* per new point: its bucket */
-    /* the points' spare arrays (online_data.c swaps them in) and, per
-     * point, its tile's directory entry; per bucket a fill position; per
-     * stored tile the endpoints its points hold */
-    polyc__point *alt_pts;
-    float *alt_view;
-    int32_t *alt_seg;
-    double *alt_cost;
-    uint32_t *alt_tile, *pt_tile, *alt_start, *bucket_fill;
+    float *learn_cache;
+    /* per point, its tile's directory entry; per bucket a count or fill
+     * position (online_data.c); per stored tile the endpoints its points
+     * hold */
+    uint32_t *pt_tile, *bucket_fill;
     double *tile_raw;
     uint32_t *tile_new;            /* per stored tile: endpoints in or out since its refresh */
     uint32_t *tile_miss;           /* and misses counted in its cells with hits */
@@ -88,6 +91,14 @@ typedef struct polyc__online {
     uint64_t forgot_through;       /* removals of versions up to this are forgotten */
 } polyc__online;
 
+/* online.c: the scratch of one step, carved from a (the context's arena
+ * above the tiles; the caller gives it back); 0: no room */
+typedef enum polyc__online_step {
+    POLYC__STEP_TRACE,             /* cells (and the trace's own walk) */
+    POLYC__STEP_POINTS,            /* pts_tmp, view_tmp, fresh_tile, fresh_bucket */
+    POLYC__STEP_LEARN              /* learn_cache */
+} polyc__online_step;
+int polyc__online_scratch(polyc__arena *a, polyc__online *on, int32_t points, polyc__online_step step);
 /* online.c: the context's limits for the stages, from the online limits */
 void polyc__online_stage_limits(const polyc_online_limits *ol, polyc_limits *lim);
 /* online.c: the tiles whose cells with hits beams have crossed often into
@@ -110,6 +121,22 @@ polyc_status polyc__online_round(polyc_ctx *ctx, uint64_t work, int all, uint64_
  * version if anything changed; *changed gets the polylines that did */
 polyc_status polyc__online_publish(polyc_ctx *ctx, uint32_t *changed);
 void polyc__online_pub_carve(polyc__arena *a, polyc__online *on, int32_t lines);
+
+/* online_cells.c: a cell's key, from its tile's storage index and its
+ * index in the tile */
+static inline uint32_t polyc__cell_key(uint32_t tile, int idx)
+{
+    return tile * POLYC__TILE_CELLS + (uint32_t)idx;
+}
+/* the sums, the table and the tiles' counts, carved (a zeroed table) */
+int polyc__cells_carve(polyc__arena *a, polyc__online *on, uint32_t tile_cap);
+/* 1 + the entry of the cell's sums, 0 for a cell without endpoints */
+uint32_t polyc__cell_find(const polyc__online *on, uint32_t key);
+/* the same, the cell added with zero sums if it has none; 0 when the
+ * entries (limits.max_points) are used up */
+uint32_t polyc__cell_add(polyc__online *on, uint32_t key);
+/* entry (1 + its index) out: its cell has no endpoints left */
+void polyc__cell_drop(polyc__online *on, uint32_t entry);
 
 /* points.c: the weighted points from the cells' sums (online) */
 /* opt_setup.c: the optimiser of an online context, carved once; and its

@@ -1,8 +1,8 @@
 /* online_data.c - an online update's data: the weighted points of the
  * tiles it takes are made again from their cells' sums and take the place
- * of their old ones (the other tiles' points, and their segments, stay);
- * the polylines the update traced join the spatial hash, the points near
- * them re-assigned as after any edit. Takes: the optimiser of an online
+ * of their old ones in the same arrays (the other tiles' points, and their
+ * segments, stay); the polylines the update traced join the spatial hash,
+ * the points near them re-assigned as after any edit. Takes: the optimiser of an online
  * context, the taken tiles. Gives: the optimiser's data and books, exact
  * for what it holds. */
 #include "online.h"
@@ -10,28 +10,16 @@
 #include <math.h>
 #include <string.h>
 
-/* The arrays of the points, swapped with their spares when the points are
- * made again. */
-static void swap_points(polyc__opt *o, polyc__online *on)
+/* Point i moved to position k (k <= i, or k >= i walking down): its
+ * arrays, in place. */
+static void move_point(polyc__opt *o, polyc__online *on, uint32_t i, uint32_t k)
 {
-    polyc__point *p = o->d.pts;
-    o->d.pts = on->alt_pts;
-    on->alt_pts = p;
-    float *v = o->d.pt_view;
-    o->d.pt_view = on->alt_view;
-    on->alt_view = v;
-    int32_t *sg = o->d.pt_seg;
-    o->d.pt_seg = on->alt_seg;
-    on->alt_seg = sg;
-    double *c = o->d.pt_cost;
-    o->d.pt_cost = on->alt_cost;
-    on->alt_cost = c;
-    uint32_t *t = on->pt_tile;
-    on->pt_tile = on->alt_tile;
-    on->alt_tile = t;
-    uint32_t *st = o->h.pt_start;
-    o->h.pt_start = on->alt_start;
-    on->alt_start = st;
+    o->d.pts[k] = o->d.pts[i];
+    o->d.pt_view[2 * k] = o->d.pt_view[2 * i];
+    o->d.pt_view[2 * k + 1] = o->d.pt_view[2 * i + 1];
+    o->d.pt_seg[k] = o->d.pt_seg[i];
+    o->d.pt_cost[k] = o->d.pt_cost[i];
+    on->pt_tile[k] = on->pt_tile[i];
 }
 
 /* The taken tiles are marked TAKEN in dirty_since (online_round.c). */
@@ -40,7 +28,27 @@ static int taken(const polyc__online *on, uint32_t d)
     return on->dirty_since[d] == UINT32_MAX;
 }
 
+static polyc_status refresh(polyc_ctx *ctx, uint32_t n_taken);
+
+/* The new points' scratch, above the tiles, given back whatever the outcome. */
 polyc_status polyc__online_refresh_tiles(polyc_ctx *ctx, uint32_t n_taken)
+{
+    polyc__online *on = ctx->online;
+    size_t mark = ctx->arena.used;
+    polyc_status st;
+    if (!polyc__online_scratch(&ctx->arena, on, polyc__points_bound(&ctx->cfg, &ctx->lim), POLYC__STEP_POINTS))
+        st = polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the data points");
+    else
+        st = refresh(ctx, n_taken);
+    ctx->arena.used = mark;
+    on->pts_tmp = NULL;
+    on->view_tmp = NULL;
+    on->fresh_tile = NULL;
+    on->fresh_bucket = NULL;
+    return st;
+}
+
+static polyc_status refresh(polyc_ctx *ctx, uint32_t n_taken)
 {
     polyc__online *on = ctx->online;
     polyc__opt *o = &on->opt;
@@ -66,15 +74,16 @@ polyc_status polyc__online_refresh_tiles(polyc_ctx *ctx, uint32_t n_taken)
     for (uint32_t j = 0; j < n_taken; j++)
         if (g->dir[on->dirty[j]])
             o->d.n += on->tile_raw[g->dir[on->dirty[j]] - 1];
-    /* old points of the taken tiles out of the error and the count */
+    /* old points of the taken tiles out of the error; the kept ones counted
+     * per bucket (nothing moves before the room is known) */
     int32_t nb = h->bx * h->by;
-    uint32_t *count = on->alt_start;
-    memset(count, 0, ((size_t)nb + 1) * sizeof(uint32_t));
+    uint32_t *kept_in = on->bucket_fill;
     int32_t kept = 0;
-    for (int32_t b = 0; b < nb; b++)
+    for (int32_t b = 0; b < nb; b++) {
+        kept_in[b] = 0;
         for (uint32_t i = h->pt_start[b]; i < h->pt_start[b + 1]; i++) {
             if (!taken(on, on->pt_tile[i])) {
-                count[b + 1]++;
+                kept_in[b]++;
                 kept++;
                 continue;
             }
@@ -82,38 +91,40 @@ polyc_status polyc__online_refresh_tiles(polyc_ctx *ctx, uint32_t n_taken)
             if (o->d.pt_seg[i] != POLYC__NONE)
                 o->split_due[o->d.pt_seg[i]] = 1;
         }
+    }
     if (kept + nf > cap)
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "more weighted data points than limits.max_points");
+    /* in place, bucket by bucket: the kept points, then the new. First the
+     * kept ones down to the front, in order; then the buckets' new starts;
+     * then, last bucket first, each bucket's kept points up to its start
+     * (never past a lower bucket's, which start no later than they end
+     * up), the new points after them */
+    uint32_t w = 0;
+    for (uint32_t i = 0; i < h->pt_start[nb]; i++)
+        if (!taken(on, on->pt_tile[i]))
+            move_point(o, on, i, w++);
+    memset(h->pt_start, 0, ((size_t)nb + 1) * sizeof(uint32_t));
     for (int32_t j = 0; j < nf; j++) {
         on->fresh_bucket[j] = polyc__bucket_of(h, on->pts_tmp[j].x, on->pts_tmp[j].y);
-        count[on->fresh_bucket[j] + 1]++;
+        h->pt_start[on->fresh_bucket[j] + 1]++;
     }
     for (int32_t b = 0; b < nb; b++)
-        count[b + 1] += count[b];
-    /* into the spare arrays, bucket by bucket: the kept points, then the new */
-    uint32_t *at = on->bucket_fill;
-    memcpy(at, count, (size_t)nb * sizeof(uint32_t));
-    for (int32_t b = 0; b < nb; b++)
-        for (uint32_t i = h->pt_start[b]; i < h->pt_start[b + 1]; i++) {
-            if (taken(on, on->pt_tile[i]))
-                continue;
-            uint32_t k = at[b]++;
-            on->alt_pts[k] = o->d.pts[i];
-            on->alt_view[2 * k] = o->d.pt_view[2 * i];
-            on->alt_view[2 * k + 1] = o->d.pt_view[2 * i + 1];
-            on->alt_seg[k] = o->d.pt_seg[i];
-            on->alt_cost[k] = o->d.pt_cost[i];
-            on->alt_tile[k] = on->pt_tile[i];
-        }
+        h->pt_start[b + 1] += h->pt_start[b] + kept_in[b];
+    for (int32_t b = nb - 1; b >= 0; b--) {
+        uint32_t n_b = kept_in[b];
+        w -= n_b;
+        for (uint32_t k = n_b; k-- > 0;)
+            move_point(o, on, w + k, h->pt_start[b] + k);
+        kept_in[b] = h->pt_start[b] + n_b; /* where its new points go */
+    }
     for (int32_t j = 0; j < nf; j++) {
-        uint32_t k = at[on->fresh_bucket[j]]++;
-        on->alt_pts[k] = on->pts_tmp[j];
-        on->alt_view[2 * k] = on->view_tmp[2 * j];
-        on->alt_view[2 * k + 1] = on->view_tmp[2 * j + 1];
-        on->alt_seg[k] = POLYC__NONE - 1; /* new: assigned below */
-        on->alt_tile[k] = on->fresh_tile[j];
+        uint32_t k = kept_in[on->fresh_bucket[j]]++;
+        o->d.pts[k] = on->pts_tmp[j];
+        o->d.pt_view[2 * k] = on->view_tmp[2 * j];
+        o->d.pt_view[2 * k + 1] = on->view_tmp[2 * j + 1];
+        o->d.pt_seg[k] = POLYC__NONE - 1; /* new: assigned below */
+        on->pt_tile[k] = on->fresh_tile[j];
     }
-    swap_points(o, on);
     o->d.np = kept + nf;
     for (int32_t i = 0; i < o->d.np; i++)
         if (o->d.pt_seg[i] == POLYC__NONE - 1) {

@@ -58,11 +58,7 @@ static uint32_t tile_work(const polyc_ctx *ctx, uint32_t d)
     const polyc__grid *g = &ctx->grid;
     if (!g->dir[d])
         return TILE_WORK;
-    const uint32_t *slot = ctx->online->slot + (size_t)(g->dir[d] - 1) * POLYC__TILE_CELLS;
-    uint32_t n = TILE_WORK;
-    for (int i = 0; i < POLYC__TILE_CELLS; i++)
-        n += slot[i] != 0;
-    return n;
+    return TILE_WORK + ctx->online->tile_cells[g->dir[d] - 1];
 }
 
 /* Moves the tiles to take to the front of the backlog (all of them, or
@@ -320,14 +316,16 @@ static int edited_after_zip(const polyc__opt *o)
 
 static polyc_status round_in(polyc_ctx *ctx, uint64_t work, int all, uint64_t *spent);
 
-/* An update's scratch (the trace's walk) sits above the grid's tiles, which
- * must stay contiguous for the next scan's: it is given back whatever the
- * round's outcome. */
+/* An update's scratch (the points made again, the contour cells, the
+ * trace's walk: online.h) sits above the grid's tiles, which must stay
+ * contiguous for the next scan's: it is given back whatever the round's
+ * outcome. */
 polyc_status polyc__online_round(polyc_ctx *ctx, uint64_t work, int all, uint64_t *spent)
 {
     size_t mark = ctx->arena.used;
     polyc_status st = round_in(ctx, work, all, spent);
     ctx->arena.used = mark;
+    ctx->online->cells = NULL;
     return st;
 }
 
@@ -341,6 +339,8 @@ static polyc_status round_in(polyc_ctx *ctx, uint64_t work, int all, uint64_t *s
         return st;
     on->opt_ready = 1;
     uint32_t since = ++o->touch_stamp;
+    if (!polyc__online_scratch(&ctx->arena, on, 0, POLYC__STEP_TRACE))
+        return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the contour cells");
     float near = all ? FINISH_EXPLAINED_CELLS * ctx->grid.cell_m : EXPLAINED_M;
     uint32_t n = unexplained_cells(ctx, taken, near);
     if (n > 0) {
@@ -471,6 +471,7 @@ polyc_status polyc_online_finish(polyc_ctx *ctx, polyc_progress_fn progress, voi
         st = polyc__search(o, progress ? polyc__guarded_progress : NULL, &g);
     }
     ctx->arena.used = mark;
+    on->cells = NULL;
     uint32_t changed = 0;
     polyc_status pst = polyc__online_publish(ctx, &changed);
     if (st == POLYC_OK)

@@ -10,11 +10,15 @@
 #include <string.h>
 
 /* No copy for a context of one scan: its trials list fewer than 8 points
- * nine times in ten (and its block is the embedded one). An occupancy
- * grid's limits have no scans (polyc_limits_for_grid) and get the copy. */
-static int32_t loc_soa_cap(const polyc_limits *lim)
+ * nine times in ten (and its block is the embedded one). Nor for limits of
+ * at most POLYC__LOC_SOA points, a room's map: its block is an embedded
+ * one too, where the copy's 56 bytes a point count for more than the
+ * trials' speed (the costs are the same values either way, trial_costs.c).
+ * An occupancy grid's limits have no scans (polyc_limits_for_grid) and get
+ * the copy. */
+static int32_t loc_soa_cap(const polyc_config *cfg, const polyc_limits *lim)
 {
-    return lim->max_scans != 1 ? POLYC__LOC_SOA : 0;
+    return lim->max_scans != 1 && polyc__points_bound(cfg, lim) > POLYC__LOC_SOA ? POLYC__LOC_SOA : 0;
 }
 
 /* The optimiser's own arrays for P points and V vertices, then each
@@ -52,7 +56,7 @@ void polyc__optimizer_reserve(polyc__arena *a, const polyc_config *cfg, const po
     polyc__spacing_reserve(a, lim);
     polyc__hash_reserve(a, &o, lim);
     polyc__points_reserve(a, cfg, lim);
-    opt_carve(a, &o, P > 0 ? P : 1, V, lim->max_scans > 1, loc_soa_cap(lim), 0);
+    opt_carve(a, &o, P > 0 ? P : 1, V, lim->max_scans > 1, loc_soa_cap(cfg, lim), 0);
     polyc__flat_reserve(a, V);
 }
 
@@ -121,12 +125,11 @@ static void opt_begin(polyc_ctx *ctx, polyc__opt *o)
  * map. The prior and the spacing are the context's (online.h). */
 int polyc__opt_carve_online(polyc_ctx *ctx, polyc__arena *a, polyc__opt *o)
 {
-    polyc__online *on = ctx->online;
     opt_begin(ctx, o);
     int32_t V = polyc__max_vertices(&ctx->lim), P = polyc__points_bound(o->cfg, &ctx->lim);
     polyc__rays_init(&o->rays, ctx);
-    int ok = polyc__hash_lay_out(o, a) && polyc__points_carve_online(a, o, &on->pts_tmp, &on->view_tmp) &&
-             opt_carve(a, o, P > 0 ? P : 1, V, 1, loc_soa_cap(&ctx->lim), 1);
+    int ok = polyc__hash_lay_out(o, a) && polyc__points_carve_online(a, o) &&
+             opt_carve(a, o, P > 0 ? P : 1, V, 1, loc_soa_cap(o->cfg, &ctx->lim), 1);
     if (!a->base) { /* a counting arena: nothing is written */
         polyc__flat_reserve(a, V);
         return ok;
@@ -156,7 +159,13 @@ polyc_status polyc__opt_refresh(polyc__opt *o)
     if (st != POLYC_OK)
         return st;
     polyc__hash_clear(o);
-    if ((st = polyc__points_collect(o)) != POLYC_OK)
+    size_t mark = ctx->arena.used; /* the points' scratch, given back below */
+    if (!polyc__online_scratch(&ctx->arena, on, polyc__points_bound(o->cfg, &ctx->lim), POLYC__STEP_POINTS))
+        st = polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the data points");
+    else
+        st = polyc__points_collect(o);
+    ctx->arena.used = mark;
+    if (st != POLYC_OK)
         return st;
     o->d.log_n = log(o->d.n > 1.0 ? o->d.n : 1.0);
     return polyc__rebuild(o);
@@ -184,7 +193,7 @@ polyc_status polyc__opt_setup(polyc_ctx *ctx, polyc__opt *o)
         return st;
     o->d.log_n = log(o->d.n > 1.0 ? o->d.n : 1.0);
     int32_t P = o->d.np > 0 ? o->d.np : 1;
-    if (!opt_carve(&ctx->arena, o, P, V, o->d.pt_view != NULL, loc_soa_cap(&ctx->lim), 0))
+    if (!opt_carve(&ctx->arena, o, P, V, o->d.pt_view != NULL, loc_soa_cap(o->cfg, &ctx->lim), 0))
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the optimiser");
     memset(o->v_work, 0, (size_t)V * sizeof(uint32_t));
     memset(o->v_touch, 0, (size_t)V * sizeof(uint32_t));

@@ -248,14 +248,16 @@ void polyc__point_weigh(const polyc__prior *prior, polyc__point *p);
  * storage index) gets each tile's endpoints */
 int32_t polyc__points_of_tiles(polyc__opt *o, const uint32_t *dirs, uint32_t nd, polyc__point *out,
                                float *view, uint32_t *tile, int32_t cap, double *tile_raw);
-/* online: the points (in o->d) and their unsorted copy, carved once */
-int polyc__points_carve_online(polyc__arena *a, polyc__opt *o, polyc__point **tmp, float **tmp_view);
+/* online: the points (in o->d), carved once (their unsorted copy is the
+ * update's scratch, online.h) */
+int polyc__points_carve_online(polyc__arena *a, polyc__opt *o);
 /* the points' allocations under the limits, on a counting arena */
 void polyc__points_reserve(polyc__arena *a, const polyc_config *cfg, const polyc_limits *lim);
 
 /* spatial_hash.c */
 int32_t polyc__hash_bucket_cap(const polyc_limits *lim);
-int32_t polyc__hash_entry_cap(const polyc_limits *lim);
+/* the entries for a hash of nb buckets (the reserve: the bucket cap) */
+int32_t polyc__hash_entry_cap(const polyc_limits *lim, size_t nb);
 polyc_status polyc__hash_init(polyc__opt *o);
 /* the buckets over the grid, carved from a (no clearing); 0: no room */
 int polyc__hash_lay_out(polyc__opt *o, polyc__arena *a);

@@ -230,12 +230,14 @@ static double sum_tile(const polyc_ctx *ctx, int32_t d, polyc__point *tmp, float
     const float half = 0.5f * (float)(BLOCK_SIDE - 1);
     uint32_t k = g->dir[d] - 1;
     const polyc__tile *t = &g->tiles[k];
-    const uint32_t *slot = on->slot + (size_t)k * POLYC__TILE_CELLS;
     double raw = 0.0;
     for (int idx = 0; idx < POLYC__TILE_CELLS; idx++) {
-        if (!slot[idx] || !t->hits[idx] || !cell_holds_data(ctx, t, idx))
+        if (!t->hits[idx] || !cell_holds_data(ctx, t, idx))
             continue;
-        const polyc__cell_sums *c = &on->sums[slot[idx] - 1];
+        uint32_t e = polyc__cell_find(on, polyc__cell_key(k, idx));
+        if (!e)
+            continue;
+        const polyc__cell_sums *c = &on->sums[e - 1];
         int32_t ix = idx & (POLYC__TILE_SIDE - 1), iy = idx >> POLYC__TILE_SHIFT;
         int32_t bx = ix & ~(int32_t)(BLOCK_SIDE - 1), by = iy & ~(int32_t)(BLOCK_SIDE - 1);
         float dx = ((float)(ix - bx) - half) * g->cell_m, dy = ((float)(iy - by) - half) * g->cell_m;
@@ -458,11 +460,11 @@ void polyc__points_spans(polyc__opt *o, int exact)
     o->d.support_m = polyc__maxf(POLYC__SUPPORT_M, o->d.point_span_m);
 }
 
-/* online: the points and their unsorted copy, carved once */
-int polyc__points_carve_online(polyc__arena *a, polyc__opt *o, polyc__point **tmp, float **tmp_view)
+/* online: the points, carved once */
+int polyc__points_carve_online(polyc__arena *a, polyc__opt *o)
 {
     int32_t cap = polyc__points_bound(o->cfg, &o->ctx->lim);
-    return points_carve(a, cap, 1, &o->d.pts, &o->d.pt_view) && points_carve(a, cap, 1, tmp, tmp_view);
+    return points_carve(a, cap, 1, &o->d.pts, &o->d.pt_view);
 }
 
 void polyc__points_reserve(polyc__arena *a, const polyc_config *cfg, const polyc_limits *lim)
@@ -486,7 +488,7 @@ polyc_status polyc__points_collect(polyc__opt *o)
     size_t mark = ctx->arena.used;
     polyc__point *tmp;
     float *tmp_view;
-    if (ctx->online) { /* carved once, with the optimiser (polyc__opt_carve_online) */
+    if (ctx->online) { /* the points carved once, the copy by the caller (online.h) */
         tmp = ctx->online->pts_tmp;
         tmp_view = ctx->online->view_tmp;
     } else {

@@ -33,10 +33,17 @@ int32_t polyc__hash_bucket_cap(const polyc_limits *lim)
     return cap > 0x3fffffff ? 0x3fffffff : (int32_t)cap;
 }
 
-int32_t polyc__hash_entry_cap(const polyc_limits *lim)
+/* A segment takes an entry in each bucket its path crosses: three for a
+ * short one, and the long ones more, one per bucket they pass. Beyond three
+ * a vertex, the entries are room for the long segments to pass every bucket
+ * once (a wall through each bucket), at most HASH_LONG_ENTRIES: a small
+ * area's hash needs no more than its buckets. */
+#define HASH_LONG_ENTRIES 4096
+
+int32_t polyc__hash_entry_cap(const polyc_limits *lim, size_t nb)
 {
     int64_t v = polyc__max_vertices(lim);
-    int64_t cap = 3 * v + 4096;
+    int64_t cap = 3 * v + (nb < HASH_LONG_ENTRIES ? (int64_t)nb : HASH_LONG_ENTRIES);
     return cap > 0x3fffffff ? 0x3fffffff : (int32_t)cap;
 }
 
@@ -55,7 +62,8 @@ static int hash_carve(polyc__arena *a, polyc__opt *o, size_t nb, int32_t entry_c
 
 void polyc__hash_reserve(polyc__arena *a, polyc__opt *o, const polyc_limits *lim)
 {
-    hash_carve(a, o, (size_t)polyc__hash_bucket_cap(lim), polyc__hash_entry_cap(lim));
+    size_t nb = (size_t)polyc__hash_bucket_cap(lim);
+    hash_carve(a, o, nb, polyc__hash_entry_cap(lim, nb));
 }
 
 polyc_status polyc__hash_init(polyc__opt *o)
@@ -86,7 +94,7 @@ int polyc__hash_lay_out(polyc__opt *o, polyc__arena *a)
     h->origin_x = (float)(g->origin_x_m - ctx->frame_x) - HASH_MARGIN_M;
     h->origin_y = (float)(g->origin_y_m - ctx->frame_y) - HASH_MARGIN_M;
     size_t nb = (size_t)h->bx * (size_t)h->by;
-    return hash_carve(a, o, nb, polyc__hash_entry_cap(&ctx->lim));
+    return hash_carve(a, o, nb, polyc__hash_entry_cap(&ctx->lim, nb));
 }
 
 void polyc__hash_clear(polyc__opt *o)

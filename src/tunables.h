@@ -30,7 +30,8 @@
  * + 64); more wait for the next pass. */
 #define POLYC__CUT_SHARE 4
 #define POLYC__CUT_SPARE 64
-/* Candidates the vertex-removal heap holds beyond one per vertex; a
+/* Candidates the vertex-removal heap holds beyond one per vertex, at most
+ * (a store of fewer vertices: as many as it has, all a pass can push); a
  * candidate that finds it full is not retried. */
 #define POLYC__HEAP_SPARE 1024
 

@@ -1,0 +1,73 @@
+/* embedded_room.h - the room of the embedded examples (embedded_scan.c,
+ * embedded_online.c), computed, not read (no I/O on the target): a 5 m x
+ * 4 m room with a 0.6 m x 0.5 m cabinet, seen by a laser with 180 beams
+ * from -90 to +89 degrees in 1 degree steps, ranges capped at 4.5 m, +-1 cm
+ * of noise. */
+#ifndef EMBEDDED_ROOM_H
+#define EMBEDDED_ROOM_H
+
+#include <math.h>
+#include <stdint.h>
+
+#include "polyc.h"
+
+#define BEAMS 180
+#define CELL_M 0.10f
+#define RANGE_CAP_M 4.5f
+
+/* The room: wall segments (x0, y0, x1, y1) in metres. */
+static const float walls[][4] = {
+    {0.0f, 0.0f, 5.0f, 0.0f}, {5.0f, 0.0f, 5.0f, 4.0f},
+    {5.0f, 4.0f, 0.0f, 4.0f}, {0.0f, 4.0f, 0.0f, 0.0f},
+    /* cabinet */
+    {3.6f, 2.6f, 4.2f, 2.6f}, {4.2f, 2.6f, 4.2f, 3.1f},
+    {4.2f, 3.1f, 3.6f, 3.1f}, {3.6f, 3.1f, 3.6f, 2.6f},
+};
+
+/* Distance along (dx, dy) from (px, py) to the nearest wall; RANGE_CAP_M if none. */
+static float cast(float px, float py, float dx, float dy)
+{
+    float best = RANGE_CAP_M;
+    for (unsigned i = 0; i < sizeof walls / sizeof walls[0]; i++) {
+        float ax = walls[i][0], ay = walls[i][1];
+        float ex = walls[i][2] - ax, ey = walls[i][3] - ay;
+        float den = dx * ey - dy * ex;
+        if (fabsf(den) < 1e-9f)
+            continue;
+        float t = ((ax - px) * ey - (ay - py) * ex) / den; /* along the beam */
+        float u = ((ax - px) * dy - (ay - py) * dx) / den; /* along the wall */
+        if (t > 0.0f && t < best && u >= 0.0f && u <= 1.0f)
+            best = t;
+    }
+    return best;
+}
+
+/* Uniform noise in [-1, 1) from a fixed LCG: the same scan every run. */
+static float noise(uint32_t *state)
+{
+    *state = *state * 1664525u + 1013904223u;
+    return (float)(*state >> 8) / 8388608.0f - 1.0f;
+}
+
+/* The scan from pose (x, y, theta) into ranges[BEAMS], noise from *seed. */
+static void make_scan(polyc_scan *scan, float *ranges, float x, float y, float theta,
+                      uint32_t *seed)
+{
+    const float start = -1.5707963f, step = 0.017453292f; /* -90 deg, 1 deg */
+    for (uint32_t i = 0; i < BEAMS; i++) {
+        float a = theta + start + (float)i * step;
+        ranges[i] = cast(x, y, cosf(a), sinf(a)) + 0.01f * noise(seed);
+    }
+    scan->pose_x_m = (double)x;
+    scan->pose_y_m = (double)y;
+    scan->pose_theta_rad = (double)theta;
+    scan->start_angle_rad = start;
+    scan->angle_step_rad = step;
+    scan->min_range_m = 0.02f;
+    scan->max_range_m = RANGE_CAP_M; /* a range >= the cap is free space only */
+    scan->beam_count = BEAMS;
+    scan->reserved = 0;
+    scan->range_m = ranges;
+}
+
+#endif
