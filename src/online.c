@@ -95,8 +95,9 @@ polyc_status polyc_online_limits_for_area(const polyc_config *config, double are
     out->area_m = area_m;
     out->max_grid_cells = (uint32_t)cells;
     out->max_points = (uint32_t)points;
-    /* vertices: the contour traced afresh by the finishing call, a vertex
-     * per 16 data cells (intel's trace: 15,000 of them) */
+    /* vertices: the map and what the rounds and the finishing call trace
+     * into it, a vertex per 16 data cells (room for a whole contour traced
+     * at once: intel's batch trace is 15,000 of them) */
     out->max_vertices = (uint32_t)(points / 16.0) + 4096;
     out->max_scan_beams = max_scan_beams;
     return POLYC_OK;
