@@ -107,6 +107,18 @@ int polyc__accuracy_online(polyc__acc_learn *L, polyc__arena *a, float alpha)
     return L->cells && L->samples && L->ring_n;
 }
 
+void polyc__accuracy_forget(polyc__acc_learn *L)
+{
+    const polyc__prior *p = L->p;
+    if (!p || !L->cells || !L->ring_n)
+        return;
+    size_t cells = (size_t)p->w * (size_t)p->h;
+    memset(L->cells, 0, cells * sizeof(acc_cell));
+    memset(L->ring_n, 0, cells * sizeof(uint32_t));
+    for (size_t c = 0; p->weight && c < cells; c++)
+        p->weight[c] = 1.0f;
+}
+
 /* The prior cell holding (x, y) (frame metres); 0 outside the prior. */
 static int cell_at(const polyc__prior *p, float x, float y, uint32_t *cell)
 {

@@ -284,6 +284,15 @@ int polyc__prior_online(const polyc_ctx *ctx, polyc__prior *p, polyc__acc_learn 
            polyc__accuracy_online(acc, a, ctx->cfg.alpha);
 }
 
+void polyc__prior_forget(polyc__prior *p)
+{
+    if (p->hist)
+        memset(p->hist, 0, (size_t)p->rows * BINS * sizeof(uint16_t));
+    if (p->total)
+        memset(p->total, 0, (size_t)p->rows * sizeof(uint32_t));
+    p->corners = p->straights = 0;
+}
+
 /* ---- query (the optimiser's hot loop: no trigonometry, 9 cells x 3 bins) ---- */
 
 /* The cell of (x, y), or 0 if there is no evidence within a cell of it

@@ -200,6 +200,8 @@ void polyc__accuracy_finish(polyc__acc_learn *L, polyc__arena *a, float alpha);
 int polyc__accuracy_online(polyc__acc_learn *L, polyc__arena *a, float alpha);
 /* the weights from the pairs so far */
 void polyc__accuracy_weigh(polyc__acc_learn *L, float alpha);
+/* online: every cell's sums, ring and weight as before any sample */
+void polyc__accuracy_forget(polyc__acc_learn *L);
 /* what polyc__accuracy_finish allocates at most (L->cap samples), on a
  * counting arena */
 void polyc__accuracy_reserve_finish(polyc__acc_learn *L, polyc__arena *a);
@@ -217,6 +219,8 @@ polyc_status polyc__prior_build(polyc_ctx *ctx, polyc__prior *p, size_t spare);
  * (the rows' totals and the weights kept as scans come); 0: no room */
 int polyc__prior_online(const polyc_ctx *ctx, polyc__prior *p, polyc__acc_learn *acc,
                         polyc__arena *a);
+/* online: every count as before any scan (the rows stay handed out) */
+void polyc__prior_forget(polyc__prior *p);
 /* prior_learn.c: the counts from every scan, into p (laid out, rows handed
  * out as cells get evidence); cache: cache_cap beams' endpoints (NULL: none);
  * acc: the accuracy's samples (NULL: none) */

@@ -54,6 +54,7 @@ typedef struct polyc__online {
      * scan's; kept_id[k], ascending, is scan k's number */
     uint32_t *kept_id;
     uint32_t kept_n, kept_beams;
+    int relearn;                   /* corrections came while every scan was kept */
 
     /* the angle prior and the accuracy, learned scan by scan */
     polyc__prior prior;
@@ -105,6 +106,8 @@ void polyc__online_stage_limits(const polyc_online_limits *ol, polyc_limits *lim
  * the backlog (every few scans); every stored tile (the finishing call) */
 void polyc__online_backlog_misses(polyc_ctx *ctx);
 void polyc__online_backlog_all(polyc_ctx *ctx);
+/* after corrections (relearn): the prior and the accuracy learned again */
+void polyc__online_relearn(polyc_ctx *ctx);
 /* the sum of the view vectors of a cell's endpoints (0, 0: none) */
 void polyc__online_cell_view(const polyc_ctx *ctx, int32_t ix, int32_t iy, float *vx, float *vy);
 /* online_data.c: the points of the n taken tiles (the first n of the
