@@ -24,6 +24,9 @@
  */
 #include <stdint.h>
 
+#ifndef EMBEDDED_ONLINE_TARGET
+#define EMBEDDED_ROOM_HOST /* embedded_room.h's printing */
+#endif
 #include "embedded_room.h"
 #include "polyc.h"
 
@@ -107,16 +110,7 @@ int main(void)
     printf("scans %u, version %lu\n", (unsigned)s.scans, (unsigned long)polyc_online_version(ctx));
     printf("polylines %u vertices %u iterations %u\n", (unsigned)s.polylines, (unsigned)s.vertices,
            (unsigned)s.iterations);
-    for (uint32_t i = 0; i < polyc_polyline_count(ctx); i++) {
-        polyc_polyline pl;
-        if (polyc_get_polyline(ctx, i, &pl) != POLYC_OK)
-            return 1;
-        printf("%s %u", pl.closed ? "closed" : "open", (unsigned)pl.point_count);
-        for (uint32_t k = 0; k < 2 * pl.point_count; k++)
-            printf(" %.4f", (double)pl.xy_m[k]);
-        printf("\n");
-    }
-    return 0;
+    return print_polylines(ctx);
 }
 
 #endif

@@ -70,4 +70,24 @@ static void make_scan(polyc_scan *scan, float *ranges, float x, float y, float t
     scan->range_m = ranges;
 }
 
+#ifdef EMBEDDED_ROOM_HOST
+#include <stdio.h>
+
+/* The map in polyc's TXT form, a polyline a line (host builds: the tests
+ * read it); 1 if a polyline could not be read, else 0. */
+static int print_polylines(const polyc_ctx *ctx)
+{
+    for (uint32_t i = 0; i < polyc_polyline_count(ctx); i++) {
+        polyc_polyline pl;
+        if (polyc_get_polyline(ctx, i, &pl) != POLYC_OK)
+            return 1;
+        printf("%s %u", pl.closed ? "closed" : "open", (unsigned)pl.point_count);
+        for (uint32_t k = 0; k < 2 * pl.point_count; k++)
+            printf(" %.4f", (double)pl.xy_m[k]);
+        printf("\n");
+    }
+    return 0;
+}
+#endif
+
 #endif

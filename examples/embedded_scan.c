@@ -21,6 +21,9 @@
  */
 #include <stdint.h>
 
+#ifndef EMBEDDED_SCAN_TARGET
+#define EMBEDDED_ROOM_HOST /* embedded_room.h's printing */
+#endif
 #include "embedded_room.h"
 #include "polyc.h"
 
@@ -93,16 +96,7 @@ int main(void)
     printf("polylines %u vertices %u iterations %u (initial %u, %u)\n", (unsigned)s.polylines,
            (unsigned)s.vertices, (unsigned)s.iterations, (unsigned)s.initial_polylines,
            (unsigned)s.initial_vertices);
-    for (uint32_t i = 0; i < polyc_polyline_count(ctx); i++) {
-        polyc_polyline pl;
-        if (polyc_get_polyline(ctx, i, &pl) != POLYC_OK)
-            return 1;
-        printf("%s %u", pl.closed ? "closed" : "open", (unsigned)pl.point_count);
-        for (uint32_t k = 0; k < 2 * pl.point_count; k++)
-            printf(" %.4f", (double)pl.xy_m[k]);
-        printf("\n");
-    }
-    return 0;
+    return print_polylines(ctx);
 }
 
 #endif
