@@ -364,10 +364,11 @@ typedef struct polyc_change {
 #define POLYC_CHANGE_MODIFIED 2u
 #define POLYC_CHANGE_REMOVED 3u
 
-/* The default work budget of an update: about 5 ms of one core of the
- * bench machine (docs/performance.md). A unit is one weighted data point
- * taken into a re-optimised region (docs/api.md). */
-#define POLYC_ONLINE_WORK_DEFAULT 4000u
+/* The default work budget of an update: about 20 ms of one core of the
+ * bench machine when the backlog is long (docs/performance.md); most
+ * updates need far less. A unit is one weighted data point taken into a
+ * re-optimised region (docs/api.md). */
+#define POLYC_ONLINE_WORK_DEFAULT 8000u
 
 /* Limits for an area of side area_m (metres) and scans of up to
  * max_scan_beams beams, keeping no scans: grid cells, data cells and

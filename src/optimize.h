@@ -355,9 +355,9 @@ int polyc__op_untangle(polyc__opt *o);
 /* whether a segment from vertex a to vertex b would cross the map */
 int polyc__link_crosses(const polyc__opt *o, int32_t a, int32_t b);
 /* topology.c: stretches of map along another piece of map cut out */
-/* zip.c: what each segment is seen from, into seg_side (needs it); valid
- * until the next edit */
-void polyc__find_sides(polyc__opt *o);
+/* zip.c: what each segment is seen from, into seg_side (needs it), from
+ * the n points of list (NULL: every point); valid until the next edit */
+void polyc__find_sides(polyc__opt *o, const int32_t *list, int32_t n);
 int polyc__op_zip(polyc__opt *o);
 void polyc__op_noise(polyc__opt *o, double sigma_m);
 int polyc__op_remove_vertices(polyc__opt *o, uint32_t since);

@@ -64,14 +64,17 @@ static int covered(const polyc__opt *o, float x, float y, int32_t a, int32_t b, 
  * squared distance). Along the segment's left normal it gives its side
  * (> 0: seen from the left; as docs/evaluation.md's band15 gives a segment
  * its side). Valid for the segments not edited since zip_mark. */
-void polyc__find_sides(polyc__opt *o)
+void polyc__find_sides(polyc__opt *o, const int32_t *list, int32_t n)
 {
     const polyc__store *s = o->s;
     float *side = o->seg_side;
     const double reach2 = (double)SIDE_REACH_M * (double)SIDE_REACH_M;
     for (int32_t v = 0; v < s->v_high; v++)
         side[2 * v] = side[2 * v + 1] = 0.0f;
-    for (int32_t i = 0; i < o->d.np; i++) {
+    if (!list)
+        n = o->d.np;
+    for (int32_t j = 0; j < n; j++) {
+        int32_t i = list ? list[j] : j;
         int32_t sg = o->d.pt_seg[i];
         if (sg == POLYC__NONE || o->d.pt_cost[i] > reach2 * (double)o->d.pts[i].w)
             continue;
@@ -306,8 +309,12 @@ static int zip_pass(polyc__opt *o, uint32_t since)
 {
     polyc__store *s = o->s;
     int zipped = 0;
-    if (o->seg_side)
-        polyc__find_sides(o);
+    if (o->seg_side) {
+        /* in an online round, from the region's points: from every point
+         * each round, the sides took a tenth of freiburg-campus's updates */
+        int32_t np = polyc__region_points(o, polyc__in_region);
+        polyc__find_sides(o, np >= 0 ? o->region_pt : NULL, np);
+    }
     for (int32_t v = 0; v < s->v_high; v++) {
         for (int k = 0; k < POLYC__FIXES_PER_SEGMENT; k++) {
             if (s->v[v].line == POLYC__NONE || s->v[v].next == POLYC__NONE ||

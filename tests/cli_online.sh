@@ -68,7 +68,7 @@ run --online --format txt -o b.txt "$LOG"
 name=online-stats
 run --online --stats -o map.svg "$LOG"
 [ $rc -eq 0 ] || bad "exit $rc"
-for what in '^online +[0-9]+ scans, --work 4000' '^add ms +median [0-9.]+, p99 [0-9.]+, max' \
+for what in '^online +[0-9]+ scans, --work 8000' '^add ms +median [0-9.]+, p99 [0-9.]+, max' \
             '^add\+update ms +median [0-9.]+, p99 [0-9.]+, max' \
             '^online ms +adds and updates [0-9.]+ in all, finish [0-9.]+' \
             '^backlog +at most [0-9]+ tiles' '^final +[0-9]+ polylines'; do

@@ -67,7 +67,7 @@ ERR_EXTENT, ERR_LIMIT, ERR_RANGE, ERR_STOPPED, ERR_BUSY = 6, 7, 8, 9, 10
 FLAG_EXACT_POINTS = 0x1
 FLAG_NO_GRAZING = 0x2
 FLAG_GRID_TRACE = 0x4
-ONLINE_WORK_DEFAULT = 4000                 # POLYC_ONLINE_WORK_DEFAULT: work units of one update
+ONLINE_WORK_DEFAULT = 8000                 # POLYC_ONLINE_WORK_DEFAULT: work units of one update
 CHANGE_KINDS = {1: "added", 2: "modified", 3: "removed"}   # POLYC_CHANGE_*
 
 _f32, _f64, _u32, _u64 = ctypes.c_float, ctypes.c_double, ctypes.c_uint32, ctypes.c_uint64
