@@ -10,8 +10,7 @@
  * from tools/eval/gtscore and gttopo. Needs nothing outside the repository.
  * What the tests found is marked FIXME(name) where an assertion waits for
  * the library: changes-since-0-lists-unseen-removals,
- * online-keeps-transient-polylines, finish-keeps-walker-polyline,
- * online-stats-memory-used, stage-calls-hide-online-map,
+ * online-keeps-transient-polylines, online-stats-memory-used, stage-calls-hide-online-map,
  * nan-points-after-sums-run-out. */
 #include <stdarg.h>
 #include <stddef.h>
@@ -1082,11 +1081,8 @@ static double core_rms(const polyc_ctx *ctx, const scene *s)
 /* Measured (seed 7):
  *              batch, true poses   online drifted (updated / finished)   online corrected
  *   square     2.90 mm, 1.0000, 4 v   32.71 / 34.84 mm, 0.8500 / 0.8540  2.12 mm, 1.0000, 4 v
- *   office     4.88 mm, 0.9961, 63 v  55.33 / 55.93 mm, 0.8098 / 0.8114  15.02 mm, 0.9978, 60 v
- * (RMS, completeness, vertices); the backlog drained in 1 and 3 updates.
- * The office's corrected RMS is all one stray polyline: see
- * FIXME(finish-keeps-walker-polyline) below; its core RMS (samples within
- * 0.5 m of a wall) is that of the batch map. */
+ *   office     4.88 mm, 0.9961, 63 v  55.33 / 54.01 mm, 0.8098 / 0.8114  4.92 mm, 0.9978, 58 v
+ * (RMS, completeness, vertices); the backlog drained in 1 and 3 updates. */
 #define CORRECT_DRAIN_UPDATES 20   /* updates the backlog drains in after corrections */
 /* core RMS at most the batch's + this (measured: office +0.04 mm, square
  * -0.78 mm; with the drifted poses' accuracy pairs kept instead of learned
@@ -1157,16 +1153,11 @@ static void check_correction(const char *name)
     assert_true(fabs((double)after.vertices - (double)batch.vertices) <=
                 FINISH_VERTICES * (double)batch.vertices);
     assert_true(after_core <= batch_core + CORRECT_RMS_M);
-    /* FIXME(finish-keeps-walker-polyline): on the office a 2-point, 2 cm
-     * polyline traced before the corrections (id 94, (4.498, 8.536) to
-     * (4.478, 8.536)), 0.83 m from any wall on a walker's trail, survives
-     * the drained updates and polyc_online_finish. Its cell has 13 hits
-     * against 50 misses (m 0.21: data under data_min_m 0.2, far under the
-     * contour threshold 0.5, so the batch never traces it; its neighbours
-     * 0-7 hits against 46-233 misses). RMS 17.12 mm against the batch's
-     * 4.88 mm; the same scans online without the drift and corrections
-     * lose it at finish (5.34 mm).
-     * assert_true(after.precision_rms_m <= batch.precision_rms_m + FINISH_RMS_M); */
+    /* the whole map too: a 2 cm polyline on a walker's trail, traced before
+     * the corrections (its cell 13 hits against 50 misses, m 0.21), went
+     * only when the finishing call learned to drop short polylines under
+     * which no cell is occupied (17.12 mm before) */
+    assert_true(after.precision_rms_m <= batch.precision_rms_m + FINISH_RMS_M);
     /* and clearly better than the drifted map, updated or finished */
     assert_true(after.precision_rms_m < 0.5 * before.precision_rms_m);
     assert_true(after.precision_rms_m < 0.5 * drift_fin.precision_rms_m);
