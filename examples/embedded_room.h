@@ -73,6 +73,24 @@ static void make_scan(polyc_scan *scan, float *ranges, float x, float y, float t
 #ifdef EMBEDDED_ROOM_HOST
 #include <stdio.h>
 
+/* A run's status, the block against what it needs and, when the run
+ * failed, its message (host builds: the tests read these lines); 1 on
+ * failure, else 0 with the context's stats in *s and its memory used
+ * printed. */
+static int print_run(polyc_status st, const polyc_ctx *ctx, size_t block_size, size_t need,
+                     polyc_stats *s)
+{
+    printf("status %s\n", polyc_status_str(st));
+    printf("block %u bytes, memory_size %lu bytes\n", (unsigned)block_size, (unsigned long)need);
+    if (st != POLYC_OK) {
+        printf("error %s\n", ctx ? polyc_last_error(ctx) : "");
+        return 1;
+    }
+    polyc_get_stats(ctx, s);
+    printf("memory_used %lu bytes\n", (unsigned long)s->memory_used_bytes);
+    return 0;
+}
+
 /* The map in polyc's TXT form, a polyline a line (host builds: the tests
  * read it); 1 if a polyline could not be read, else 0. */
 static int print_polylines(const polyc_ctx *ctx)

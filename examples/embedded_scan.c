@@ -81,16 +81,10 @@ int main(void)
 {
     polyc_ctx *ctx = NULL;
     size_t need = 0;
-    polyc_status st = run(&ctx, &need);
-    printf("status %s\n", polyc_status_str(st));
-    printf("block %u bytes, memory_size %lu bytes\n", (unsigned)sizeof block, (unsigned long)need);
-    if (st != POLYC_OK) {
-        printf("error %s\n", ctx ? polyc_last_error(ctx) : "");
-        return 1;
-    }
+    polyc_status st = run(&ctx, &need); /* before print_run reads ctx and need */
     polyc_stats s;
-    polyc_get_stats(ctx, &s);
-    printf("memory_used %lu bytes\n", (unsigned long)s.memory_used_bytes);
+    if (print_run(st, ctx, sizeof block, need, &s))
+        return 1;
     printf("grid %u x %u cells, %u tiles, %lu bytes\n", (unsigned)s.grid_width,
            (unsigned)s.grid_height, (unsigned)s.grid_tiles, (unsigned long)s.grid_bytes);
     printf("polylines %u vertices %u iterations %u (initial %u, %u)\n", (unsigned)s.polylines,

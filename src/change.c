@@ -79,6 +79,11 @@ int32_t polyc__region_points(polyc__opt *o, polyc__seg_pred want)
     for (int32_t v = 0; v < s->v_high; v++)
         if (s->v[v].line != POLYC__NONE && s->v[v].next != POLYC__NONE && want(o, v))
             polyc__chg_mark_region(o, v);
+    return polyc__listed_points(o);
+}
+
+int32_t polyc__listed_points(polyc__opt *o)
+{
     const polyc__hash *h = &o->h;
     int32_t n = 0;
     for (int32_t k = 0; k < o->chg.bucket_n; k++) {

@@ -91,7 +91,7 @@ static uint32_t take_tiles(polyc_ctx *ctx, uint64_t work, int all, uint64_t *uni
     return taken;
 }
 
-/* A segment is seen from both sides when the endpoints within `reach` of
+/* A segment is seen from both sides when the endpoints within 10 cm of
  * it whose nearest it is were seen from its left and from its right in at
  * least this ratio (their unit views across it, by weight): a line drawn
  * between the two faces of a thin wall, each face 3 cm off it. Its summed
@@ -105,39 +105,16 @@ static uint32_t take_tiles(polyc_ctx *ctx, uint64_t work, int all, uint64_t *uni
  * 624 polylines, 57 of them under 10 cm long against 23. */
 #define TWO_SIDED_MIN_M 0.5f
 
-/* Each segment's weight of views from its left into o->size.seg_sum and
- * from its right into o->size.seg_w (scratch of the operators'). */
-static void find_two_sided(polyc__opt *o, float reach, const int32_t *list, int32_t n)
-{
-    const polyc__store *s = o->s;
-    float *left = o->size.seg_sum, *right = o->size.seg_w;
-    for (int32_t v = 0; v < s->v_high; v++)
-        left[v] = right[v] = 0.0f;
-    double reach2 = (double)reach * (double)reach;
-    if (!list)
-        n = o->d.np;
-    for (int32_t j = 0; j < n; j++) {
-        int32_t i = list ? list[j] : j;
-        int32_t sg = o->d.pt_seg[i];
-        if (sg == POLYC__NONE || o->d.pt_cost[i] > reach2 * (double)o->d.pts[i].w)
-            continue;
-        const polyc__vertex *a = &s->v[sg], *b = &s->v[a->next];
-        float dx = b->x - a->x, dy = b->y - a->y, len = sqrtf(dx * dx + dy * dy);
-        float vx = o->d.pt_view[2 * i], vy = o->d.pt_view[2 * i + 1], vl = sqrtf(vx * vx + vy * vy);
-        if (!(len >= TWO_SIDED_MIN_M) || !(vl > 0.0f))
-            continue;
-        float across = o->d.pts[i].w * (-vx * dy + vy * dx) / (len * vl);
-        if (across > 0.0f)
-            left[sg] += across;
-        else
-            right[sg] -= across;
-    }
-}
-
+/* Whether segment sg is seen from both sides, from the weights of views
+ * across it that polyc__find_sides left in o->size.seg_sum (from its left)
+ * and o->size.seg_w (from its right), scratch of the operators'. */
 static int two_sided(const polyc__opt *o, int32_t sg)
 {
+    const polyc__vertex *a = &o->s->v[sg], *b = &o->s->v[a->next];
+    float dx = b->x - a->x, dy = b->y - a->y;
     float l = o->size.seg_sum[sg], r = o->size.seg_w[sg];
-    return l > 0.0f && r > 0.0f && polyc__minf(l, r) >= TWO_SIDED_RATIO * polyc__maxf(l, r);
+    return dx * dx + dy * dy >= TWO_SIDED_MIN_M * TWO_SIDED_MIN_M && l > 0.0f && r > 0.0f &&
+           polyc__minf(l, r) >= TWO_SIDED_RATIO * polyc__maxf(l, r);
 }
 
 /* Whether the map explains a contour cell at (x, y), seen along (vx, vy)
@@ -224,14 +201,7 @@ static int32_t taken_points(polyc_ctx *ctx, uint32_t taken)
                 o->chg.bucket_list[o->chg.bucket_n++] = b;
             }
     }
-    int32_t n = 0;
-    for (int32_t k = 0; k < o->chg.bucket_n; k++) {
-        int32_t b = o->chg.bucket_list[k];
-        for (uint32_t i = h->pt_start[b]; i < h->pt_start[b + 1]; i++)
-            o->region_pt[n++] = (int32_t)i;
-    }
-    o->chg.bucket_n = 0;
-    return n;
+    return polyc__listed_points(o);
 }
 
 /* The taken tiles' contour cells that are occupied now and that no
@@ -251,8 +221,7 @@ static uint32_t unexplained_cells(polyc_ctx *ctx, uint32_t taken, float near, in
             np = taken_points(ctx, taken);
             list = o->region_pt;
         }
-        polyc__find_sides(o, list, np);
-        find_two_sided(o, EXPLAINED_M, list, np);
+        polyc__find_sides(o, list, np, o->size.seg_sum, o->size.seg_w);
     }
     float thr = ctx->cfg.contour_threshold;
     double ox = g->origin_x_m - ctx->frame_x, oy = g->origin_y_m - ctx->frame_y;

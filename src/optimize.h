@@ -212,6 +212,9 @@ static inline int polyc__in_region(const polyc__opt *o, int32_t v)
  * returns their count; without a region, -1 (look at every point) */
 typedef int (*polyc__seg_pred)(const polyc__opt *o, int32_t v);
 int32_t polyc__region_points(polyc__opt *o, polyc__seg_pred want);
+/* change.c: lists in o->region_pt the points of the buckets listed in
+ * o->chg.bucket_list, empties that list; returns the count */
+int32_t polyc__listed_points(polyc__opt *o);
 int polyc__eval_carve(polyc__arena *a, polyc__eval_scratch *ev, int32_t P, int32_t lsoa_cap);
 /* operators.c: split and trim scratch; model_size.c: vertex removal's */
 int polyc__split_carve(polyc__arena *a, polyc__split_scratch *sp, int32_t P, int32_t V);
@@ -356,8 +359,10 @@ int polyc__op_untangle(polyc__opt *o);
 int polyc__link_crosses(const polyc__opt *o, int32_t a, int32_t b);
 /* topology.c: stretches of map along another piece of map cut out */
 /* zip.c: what each segment is seen from, into seg_side (needs it), from
- * the n points of list (NULL: every point); valid until the next edit */
-void polyc__find_sides(polyc__opt *o, const int32_t *list, int32_t n);
+ * the n points of list (NULL: every point); valid until the next edit.
+ * With left and right (per vertex, or NULL), also the weight of unit views
+ * across each segment from its left and from its right. */
+void polyc__find_sides(polyc__opt *o, const int32_t *list, int32_t n, float *left, float *right);
 int polyc__op_zip(polyc__opt *o);
 void polyc__op_noise(polyc__opt *o, double sigma_m);
 int polyc__op_remove_vertices(polyc__opt *o, uint32_t since);

@@ -64,13 +64,16 @@ static int covered(const polyc__opt *o, float x, float y, int32_t a, int32_t b, 
  * squared distance). Along the segment's left normal it gives its side
  * (> 0: seen from the left; as docs/evaluation.md's band15 gives a segment
  * its side). Valid for the segments not edited since zip_mark. */
-void polyc__find_sides(polyc__opt *o, const int32_t *list, int32_t n)
+void polyc__find_sides(polyc__opt *o, const int32_t *list, int32_t n, float *left, float *right)
 {
     const polyc__store *s = o->s;
     float *side = o->seg_side;
     const double reach2 = (double)SIDE_REACH_M * (double)SIDE_REACH_M;
-    for (int32_t v = 0; v < s->v_high; v++)
+    for (int32_t v = 0; v < s->v_high; v++) {
         side[2 * v] = side[2 * v + 1] = 0.0f;
+        if (left)
+            left[v] = right[v] = 0.0f;
+    }
     if (!list)
         n = o->d.np;
     for (int32_t j = 0; j < n; j++) {
@@ -78,8 +81,21 @@ void polyc__find_sides(polyc__opt *o, const int32_t *list, int32_t n)
         int32_t sg = o->d.pt_seg[i];
         if (sg == POLYC__NONE || o->d.pt_cost[i] > reach2 * (double)o->d.pts[i].w)
             continue;
-        side[2 * sg] += o->d.pt_view[2 * i];
-        side[2 * sg + 1] += o->d.pt_view[2 * i + 1];
+        float vx = o->d.pt_view[2 * i], vy = o->d.pt_view[2 * i + 1];
+        side[2 * sg] += vx;
+        side[2 * sg + 1] += vy;
+        if (!left)
+            continue;
+        const polyc__vertex *a = &s->v[sg], *b = &s->v[a->next];
+        float dx = b->x - a->x, dy = b->y - a->y, len = sqrtf(dx * dx + dy * dy);
+        float vl = sqrtf(vx * vx + vy * vy);
+        if (!(len > 0.0f) || !(vl > 0.0f))
+            continue;
+        float across = o->d.pts[i].w * (-vx * dy + vy * dx) / (len * vl);
+        if (across > 0.0f)
+            left[sg] += across;
+        else
+            right[sg] -= across;
     }
 }
 
@@ -313,7 +329,7 @@ static int zip_pass(polyc__opt *o, uint32_t since)
         /* in an online round, from the region's points: from every point
          * each round, the sides took a tenth of freiburg-campus's updates */
         int32_t np = polyc__region_points(o, polyc__in_region);
-        polyc__find_sides(o, np >= 0 ? o->region_pt : NULL, np);
+        polyc__find_sides(o, np >= 0 ? o->region_pt : NULL, np, NULL, NULL);
     }
     for (int32_t v = 0; v < s->v_high; v++) {
         for (int k = 0; k < POLYC__FIXES_PER_SEGMENT; k++) {
