@@ -41,7 +41,8 @@ $(BUILD)/obj/%.o: src/%.c include/polyc.h $(wildcard src/*.h)
 $(BUILD)/tobj/%.o: tools/%.c include/polyc.h $(wildcard tools/*.h)
 	@mkdir -p $(dir $@)
 	$(CC) $(TOOL_CFLAGS) -c $< -o $@
-$(BUILD)/eobj/%.o: tools/eval/%.c include/polyc.h $(wildcard tools/*.h tools/eval/*.h)
+# (src/*.h too: fairbic.c reaches into the library's internals)
+$(BUILD)/eobj/%.o: tools/eval/%.c include/polyc.h $(wildcard tools/*.h tools/eval/*.h src/*.h)
 	@mkdir -p $(dir $@)
 	$(CC) $(EVAL_CFLAGS) -c $< -o $@
 $(BUILD)/libpolyc.a: $(LIB_OBJ)

@@ -54,6 +54,13 @@ double polyc__rng_normal(polyc__rng *r);    /* N(0, 1) */
 #define POLYC__TILE_SHIFT 5
 #define POLYC__TILE_SIDE 32
 #define POLYC__TILE_CELLS 1024
+/* an online grid's record of misses in tiles not stored: a count per block
+ * of POLYC__PRE_SIDE x POLYC__PRE_SIDE cells, POLYC__PRE_BLOCKS a tile
+ * (and half a byte per cell) */
+#define POLYC__PRE_SHIFT 3
+#define POLYC__PRE_SIDE 8
+#define POLYC__PRE_BLOCKS 16
+#define POLYC__PRE_FULL 15u
 
 typedef struct polyc__tile {
     polyc__count hits[POLYC__TILE_CELLS];
@@ -76,6 +83,13 @@ typedef struct polyc__grid {
     int out_of_tiles;              /* set when a beam needed a tile past tile_cap */
     uint32_t *wanted;              /* bit per directory entry: a tile to store */
     polyc__tile *spill;            /* where misses in tiles not stored go */
+    /* online, the misses in tiles not stored (grid.c, POLYC__PRE_*), in a
+     * pool of pre_cap records; pre_miss NULL in a batch */
+    uint32_t *pre_of;              /* per directory entry: its record + 1, or 0 */
+    uint16_t *pre_miss;            /* per record: per block, its cells' misses */
+    uint8_t *pre_cells;            /* per record: each cell's, half a byte, up to POLYC__PRE_FULL */
+    uint32_t *pre_free;            /* records given back */
+    uint32_t pre_cap, pre_high, pre_nfree;
     size_t fixed_bytes;            /* directory, bits and spill tile */
 } polyc__grid;
 

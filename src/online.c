@@ -103,6 +103,15 @@ polyc_status polyc_online_limits_for_area(const polyc_config *config, double are
     return POLYC_OK;
 }
 
+/* The grid's records of misses in tiles not stored (grid.c): for twice as
+ * many tiles as it stores (on freiburg-campus beams cross 59,893 tiles,
+ * 15,405 of them stored), and no more than the area holds. */
+static size_t pre_records(uint32_t tile_cap, size_t dir_n)
+{
+    size_t n = 2 * (size_t)tile_cap;
+    return n < dir_n ? n : dir_n;
+}
+
 /* Everything an online context carves, in the block's order, on the block
  * or on the size query's counting arena (nothing is written then); the
  * grid's tiles come last, as beams reach them. ctx->cfg and ctx->lim are set. */
@@ -151,6 +160,11 @@ static int lay_out(polyc_ctx *ctx, polyc__online *on, polyc__arena *a)
     POLYC__CARVE_ZERO(ok, a, on->tile_raw, tile_cap);
     POLYC__CARVE_ZERO(ok, a, on->tile_new, tile_cap);
     POLYC__CARVE_ZERO(ok, a, on->tile_miss, tile_cap);
+    size_t pre_cap = pre_records(tile_cap, dir_n);
+    POLYC__CARVE_ZERO(ok, a, on->pre_of, dir_n);
+    POLYC__CARVE_ZERO(ok, a, on->pre_miss, pre_cap * POLYC__PRE_BLOCKS);
+    POLYC__CARVE_ZERO(ok, a, on->pre_cells, pre_cap * (POLYC__TILE_CELLS / 2));
+    POLYC__CARVE(ok, a, on->pre_free, pre_cap);
     if (!ok)
         return 0;
     saved = ctx->arena;
@@ -160,6 +174,11 @@ static int lay_out(polyc_ctx *ctx, polyc__online *on, polyc__arena *a)
     ctx->arena = saved;
     if (st != POLYC_OK)
         return 0;
+    ctx->grid.pre_of = on->pre_of;
+    ctx->grid.pre_miss = on->pre_miss;
+    ctx->grid.pre_cells = on->pre_cells;
+    ctx->grid.pre_free = on->pre_free;
+    ctx->grid.pre_cap = (uint32_t)pre_records(tile_cap, dir_n);
     /* the tiles, and above them the largest step's scratch */
     size_t scratch = 0;
     for (int step = POLYC__STEP_TRACE; step <= POLYC__STEP_LEARN; step++) {

@@ -644,7 +644,7 @@ static void test_changes_since_version(void **state)
     scene_free(&s);
 }
 
-/* With few vertices (160: a ring of 96 removals) the office's removals
+/* With few vertices (128: a ring of 80 removals) the office's removals
  * outrun the ring: a copy too old gets POLYC_ERR_RANGE (and reads the map
  * again), a recent one still rebuilds exactly. */
 static void test_changes_forgotten(void **state)
@@ -657,7 +657,7 @@ static void test_changes_forgotten(void **state)
     config_of(&o.config);
     check_status(polyc_online_limits_for_area(&o.config, s.area_m, s.beams, &o.limits), NULL,
                  "limits");
-    o.limits.max_vertices = 160;
+    o.limits.max_vertices = 128;
     o.size = polyc_online_memory_size(&o.config, &o.limits);
     assert_true(o.size > 0);
     o.block = malloc(o.size);
@@ -694,7 +694,7 @@ static void test_changes_forgotten(void **state)
             applied++;
         }
     }
-    print_message("office, 160 vertices: %u refusals (POLYC_ERR_RANGE) of an old copy, %u "
+    print_message("office, 128 vertices: %u refusals (POLYC_ERR_RANGE) of an old copy, %u "
                   "applied; %u added, %u modified, %u removed\n",
                   refused, applied, a, m, rm);
     assert_true(refused > 0);
@@ -790,8 +790,10 @@ static void test_walker_trail(void **state)
     for (uint32_t i = 0; i < s.sim.scan_count; i++) {
         add(&o, &s.sim.scans[i], 0);
         update(&o, POLYC_ONLINE_WORK_DEFAULT, &r);
-        if (i == 110)
-            mid = stray_vertices(o.ctx, &s, 0.3);
+        if (i >= 50 && i <= 110) {
+            uint32_t n = stray_vertices(o.ctx, &s, 0.3);
+            mid = n > mid ? n : mid;
+        }
     }
     uint32_t k = 0;
     for (; r.backlog_tiles > 0 && k < 100; k++)
@@ -800,10 +802,13 @@ static void test_walker_trail(void **state)
     uint32_t drained = stray_vertices(o.ctx, &s, 0.3);
     finish(&o, &r);
     uint32_t finished = stray_vertices(o.ctx, &s, 0.3);
-    print_message("angled: vertices 0.3 m or more from a wall: %u after scan 110 (the walker "
-                  "there), %u after the last update, %u after finish\n",
+    print_message("angled: vertices 0.3 m or more from a wall: at most %u during scans 50-110 "
+                  "(the walker there), %u after the last update, %u after finish\n",
                   mid, drained, finished);
-    assert_true(mid > 0); /* the walker was mapped while there */
+    /* the walker was mapped while there (where it stood in cells the
+     * robot had seen through before, their misses hold it off: 2-4
+     * vertices at scans 63-100) */
+    assert_true(mid > 0);
     assert_int_equal(finished, 0);
     /* the walker's polylines go once beams cross its cells again (a tile
      * whose cells with hits are crossed as often as it held endpoints joins

@@ -1,0 +1,257 @@
+/* test_online_grid.c - an online grid's misses in tiles it has not stored
+ * yet (src/grid.c, "an online grid's misses in tiles not stored"): a person
+ * who steps into a round room that the robot has been seeing through is
+ * free in the grid once the person's tile is stored, as in a batch grid of
+ * the same scans; its tile has the batch's counts, cell by cell; and when
+ * the pool of records is spent the context still maps (those misses are
+ * lost, as the documented fallback says). */
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "online.h"
+
+#define BEAMS 360u
+#define PI 3.14159265358979323846
+
+typedef struct room {
+    double radius_m;           /* a round room around (0, 0) */
+    int person;                /* a disc of PERSON_R at (PERSON_X, 0) */
+    double turn;               /* the first beam's angle past -pi */
+    float range[BEAMS];
+    polyc_scan scan;
+} room;
+
+#define PERSON_X 2.0
+#define PERSON_R 0.2
+
+/* The scan from (0, 0), heading 0: the wall, or the person in front of it. */
+static const polyc_scan *room_scan(room *r)
+{
+    for (uint32_t i = 0; i < BEAMS; i++) {
+        double a = r->turn - PI + (double)i * (2.0 * PI / BEAMS);
+        double range = r->radius_m;
+        /* the ray against the person's disc: |t (cos a, sin a) - (X, 0)| = R */
+        double b = PERSON_X * cos(a), c = PERSON_X * PERSON_X - PERSON_R * PERSON_R;
+        if (r->person && b * b > c && b - sqrt(b * b - c) > 0.0)
+            range = b - sqrt(b * b - c);
+        r->range[i] = (float)range;
+    }
+    memset(&r->scan, 0, sizeof r->scan);
+    r->scan.start_angle_rad = (float)(r->turn - PI);
+    r->scan.angle_step_rad = (float)(2.0 * PI / BEAMS);
+    r->scan.min_range_m = 0.05f;
+    r->scan.max_range_m = 30.0f;
+    r->scan.beam_count = BEAMS;
+    r->scan.range_m = r->range;
+    return &r->scan;
+}
+
+typedef struct online {
+    void *block;
+    polyc_ctx *ctx;
+} online;
+
+static void open_online(online *o, double area_m, uint32_t max_tiles)
+{
+    polyc_config cfg;
+    polyc_config_default(&cfg);
+    polyc_online_limits lim;
+    assert_int_equal(polyc_online_limits_for_area(&cfg, area_m, BEAMS, &lim), POLYC_OK);
+    if (max_tiles)
+        lim.max_grid_cells = max_tiles * POLYC__TILE_CELLS;
+    size_t n = polyc_online_memory_size(&cfg, &lim);
+    assert_true(n > 0);
+    o->block = malloc(n);
+    assert_non_null(o->block);
+    assert_int_equal(polyc_online_init(o->block, n, &cfg, &lim, &o->ctx), POLYC_OK);
+}
+
+/* The cell of the online grid at (x, y) metres: its counts; 0 if its tile
+ * is not stored. */
+static int cell_at(const polyc_ctx *ctx, double x, double y, unsigned *hits, unsigned *misses)
+{
+    const polyc__grid *g = &ctx->grid;
+    int32_t ix = (int32_t)floor((x - g->origin_x_m) / (double)g->cell_m);
+    int32_t iy = (int32_t)floor((y - g->origin_y_m) / (double)g->cell_m);
+    const polyc__tile *t = polyc__grid_tile(g, ix, iy);
+    if (!t)
+        return 0;
+    *hits = t->hits[polyc__cell_index(ix, iy)];
+    *misses = t->misses[polyc__cell_index(ix, iy)];
+    return 1;
+}
+
+/* The cell with the most hits within 5 cm of (x, y): its counts. */
+static void most_hit_near(const polyc_ctx *ctx, double x, double y, unsigned *hits, unsigned *misses)
+{
+    *hits = *misses = 0;
+    for (double dy = -0.05; dy <= 0.05; dy += 0.0125)
+        for (double dx = -0.05; dx <= 0.05; dx += 0.0125) {
+            unsigned h, m;
+            if (cell_at(ctx, x + dx, y + dy, &h, &m) && h > *hits) {
+                *hits = h;
+                *misses = m;
+            }
+        }
+}
+
+static void test_person_in_a_room_seen_through(void **state)
+{
+    (void)state;
+    room r = {4.0, 0, 0.0, {0}, {0, 0, 0, 0, 0, 0, 0, 0, 0, NULL}};
+    online o;
+    open_online(&o, 12.0, 0);
+    unsigned h = 0, m = 0;
+    /* 20 scans through the empty room: the person's tile is not stored */
+    for (int k = 0; k < 20; k++)
+        assert_int_equal(polyc_online_add_scan(o.ctx, room_scan(&r), 0, NULL), POLYC_OK);
+    assert_false(cell_at(o.ctx, PERSON_X - PERSON_R + 0.01, 0.0, &h, &m));
+    /* then 3 with the person standing there: the tile is stored, and the
+     * cells the person's front lies in keep the 20 scans' misses */
+    r.person = 1;
+    for (int k = 0; k < 3; k++)
+        assert_int_equal(polyc_online_add_scan(o.ctx, room_scan(&r), 0, NULL), POLYC_OK);
+    most_hit_near(o.ctx, PERSON_X - PERSON_R, 0.0, &h, &m);
+    print_message("the person's front: %u hits, %u misses\n", h, m);
+    assert_true(h >= 3);
+    assert_true(m >= 20);
+    assert_true(m > h); /* free, as in a batch grid of the 23 scans */
+    polyc_online_report rep;
+    assert_int_equal(polyc_online_update(o.ctx, POLYC_ONLINE_WORK_DEFAULT, &rep), POLYC_OK);
+    assert_int_equal(polyc_online_finish(o.ctx, NULL, NULL, &rep), POLYC_OK);
+    /* the map is the room's wall: no polyline stands at the person */
+    for (uint32_t i = 0; i < polyc_polyline_count(o.ctx); i++) {
+        polyc_polyline pl;
+        assert_int_equal(polyc_get_polyline(o.ctx, i, &pl), POLYC_OK);
+        for (uint32_t j = 0; j < pl.point_count; j++)
+            assert_true(hypot((double)pl.xy_m[2 * j], (double)pl.xy_m[2 * j + 1]) > 3.5);
+    }
+    free(o.block);
+}
+
+/* Whether the batch grid stores the tile of its cell (ix, iy): some cell
+ * of it has hits (a tile is stored where a beam ends in a hit). */
+static int batch_stored(const polyc_ctx *batch, int32_t ix, int32_t iy)
+{
+    int32_t x0 = ix & ~(POLYC__TILE_SIDE - 1), y0 = iy & ~(POLYC__TILE_SIDE - 1);
+    for (int32_t y = y0; y < y0 + POLYC__TILE_SIDE; y++)
+        for (int32_t x = x0; x < x0 + POLYC__TILE_SIDE; x++) {
+            uint32_t h = 0;
+            if (polyc_grid_cell(batch, (uint32_t)x, (uint32_t)y, &h, NULL, NULL) == POLYC_OK && h > 0)
+                return 1;
+        }
+    return 0;
+}
+
+/* The person's tile against a batch grid of the same scans (whose cells
+ * line up with the online grid's: its origin lies a whole number of cells
+ * away): a cell crossed fewer than POLYC__PRE_FULL times before the tile
+ * was stored has the batch's counts (so a cell no beam crossed has none: a
+ * wall seen for the first time is not put under the misses of the free
+ * cells in front of it); one crossed more, at least that many misses. */
+static void test_tile_against_batch(void **state)
+{
+    (void)state;
+    room r = {4.0, 0, 0.0, {0}, {0, 0, 0, 0, 0, 0, 0, 0, 0, NULL}};
+    online o;
+    open_online(&o, 12.0, 0);
+    polyc_scan scans[21];
+    static float ranges[21][BEAMS];
+    polyc_config cfg;
+    polyc_config_default(&cfg);
+    for (int k = 0; k < 21; k++) {
+        r.person = k == 20;
+        r.turn = 0.0004 * k; /* (rays on other lines: cells crossed 1 to 20 times) */
+        scans[k] = *room_scan(&r);
+        memcpy(ranges[k], r.range, sizeof r.range);
+        scans[k].range_m = ranges[k];
+        assert_int_equal(polyc_online_add_scan(o.ctx, &scans[k], 0, NULL), POLYC_OK);
+    }
+    polyc_limits lim;
+    assert_int_equal(polyc_limits_for_scans(&cfg, scans, 21, &lim), POLYC_OK);
+    size_t n = polyc_memory_size(&cfg, &lim);
+    void *block = malloc(n);
+    assert_non_null(block);
+    polyc_ctx *batch;
+    assert_int_equal(polyc_init(block, n, &cfg, &lim, &batch), POLYC_OK);
+    for (int k = 0; k < 21; k++)
+        assert_int_equal(polyc_add_scan(batch, &scans[k]), POLYC_OK);
+    assert_int_equal(polyc_build_grid(batch), POLYC_OK);
+    double bx, by;
+    float cell;
+    assert_int_equal(polyc_grid_info(batch, &bx, &by, &cell, NULL, NULL), POLYC_OK);
+    const polyc__grid *g = &o.ctx->grid;
+    double sx = (bx - g->origin_x_m) / (double)cell, sy = (by - g->origin_y_m) / (double)cell;
+    assert_true(fabs(sx - floor(sx + 0.5)) < 1e-3 && fabs(sy - floor(sy + 0.5)) < 1e-3);
+    int32_t ox = (int32_t)floor(sx + 0.5), oy = (int32_t)floor(sy + 0.5);
+    int32_t ix0 = (int32_t)floor((PERSON_X - g->origin_x_m) / (double)cell) & ~(POLYC__TILE_SIDE - 1);
+    int32_t iy0 = (int32_t)floor((0.0 - g->origin_y_m) / (double)cell) & ~(POLYC__TILE_SIDE - 1);
+    const polyc__tile *t = polyc__grid_tile(g, ix0, iy0);
+    assert_non_null(t);
+    uint32_t exact = 0, low = 0, full = 0, full_ok = 0;
+    for (int idx = 0; idx < POLYC__TILE_CELLS; idx++) {
+        int32_t ix = ix0 + (idx & (POLYC__TILE_SIDE - 1)), iy = iy0 + (idx >> POLYC__TILE_SHIFT);
+        uint32_t h, m;
+        if (!batch_stored(batch, ix - ox, iy - oy))
+            continue; /* (reads 0 there) */
+        assert_int_equal(polyc_grid_cell(batch, (uint32_t)(ix - ox), (uint32_t)(iy - oy), &h, &m, NULL),
+                         POLYC_OK);
+        if (m < POLYC__PRE_FULL) {
+            low++;
+            exact += t->hits[idx] == h && t->misses[idx] == m;
+        } else {
+            full++;
+            full_ok += t->misses[idx] >= POLYC__PRE_FULL;
+        }
+    }
+    print_message("the person's tile: %u cells with fewer than %u misses (%u exact), %u with "
+                  "more (%u at least that many online)\n",
+                  low, POLYC__PRE_FULL, exact, full, full_ok);
+    assert_true(low > 0 && full > 0);
+    assert_true(exact >= low - low / 50); /* (the two grids round a beam's end apart) */
+    assert_true(full_ok >= full - full / 50);
+    free(block);
+    free(o.block);
+}
+
+/* Records for twice as many tiles as stored: a large room seen through
+ * from its middle, in a grid of few tiles, spends them. The context maps
+ * on (the misses of the tiles past the pool are lost). */
+static void test_pool_spent(void **state)
+{
+    (void)state;
+    room r = {12.0, 0, 0.0, {0}, {0, 0, 0, 0, 0, 0, 0, 0, 0, NULL}};
+    online o;
+    open_online(&o, 30.0, 160);
+    polyc_online_report rep;
+    for (int k = 0; k < 10; k++) {
+        assert_int_equal(polyc_online_add_scan(o.ctx, room_scan(&r), 0, NULL), POLYC_OK);
+        assert_int_equal(polyc_online_update(o.ctx, POLYC_ONLINE_WORK_DEFAULT, &rep), POLYC_OK);
+    }
+    const polyc__grid *g = &o.ctx->grid;
+    print_message("pool: %u of %u records, %u tiles stored\n", g->pre_high, g->pre_cap,
+                  g->tile_count);
+    assert_int_equal(g->pre_high, g->pre_cap);
+    r.person = 1;
+    assert_int_equal(polyc_online_add_scan(o.ctx, room_scan(&r), 0, NULL), POLYC_OK);
+    assert_int_equal(polyc_online_finish(o.ctx, NULL, NULL, &rep), POLYC_OK);
+    assert_true(rep.polylines >= 1);
+    free(o.block);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_person_in_a_room_seen_through),
+        cmocka_unit_test(test_tile_against_batch),
+        cmocka_unit_test(test_pool_spent),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
