@@ -227,9 +227,11 @@ typedef struct count_pass {
  * through for minutes would look as solid as a wall (the sweep's
  * thinwalls seed 8 drew one 29.7 mm off the walls against the batch's
  * 2.8; freiburg-campus had 3,340 polylines against the batch's 2,540).
- * So each tile not stored keeps its misses at half a byte a cell, exact
- * up to POLYC__PRE_FULL, and per block of 8 x 8 cells their sum (544
- * bytes a directory entry, not a tile's 4 KiB). A tile stored later takes
+ * So a tile not stored that beams cross takes a record from a pool (548
+ * bytes, not a tile's 4 KiB; online.c sizes the pool): its misses at half
+ * a byte a cell, exact up to POLYC__PRE_FULL, and per block of 8 x 8 cells
+ * their sum. When the pool is spent, a tile's misses are lost as before.
+ * A tile stored later takes
  * them: a cell below the cap its own count, a cell at the cap its share of
  * what its block's sum holds beyond the cells below the cap. A cell next
  * to a wall, crossed by a few grazing beams, keeps those few (a block's
