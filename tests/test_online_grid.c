@@ -221,7 +221,7 @@ static void test_tile_against_batch(void **state)
     free(o.block);
 }
 
-/* Records for twice as many tiles as stored: a large room seen through
+/* Records for four times as many tiles as stored: a large room seen through
  * from its middle, in a grid of few tiles, spends them. The context maps
  * on (the misses of the tiles past the pool are lost). */
 static void test_pool_spent(void **state)
