@@ -230,10 +230,10 @@ typedef struct count_pass {
  * So a tile not stored that beams cross takes a record from a pool (548
  * bytes, not a tile's 4 KiB; online.c sizes the pool): its misses at half
  * a byte a cell, exact up to POLYC__PRE_FULL, and per block of 8 x 8 cells
- * their sum. When the pool is spent, a tile's misses are lost as before.
- * A tile stored later takes
- * them: a cell below the cap its own count, a cell at the cap its share of
- * what its block's sum holds beyond the cells below the cap. A cell next
+ * their sum. (When the pool is spent, a tile's cells start from the misses
+ * counted once it is stored.) A tile stored later takes them: a cell below
+ * the cap its own count, a cell at the cap its share of what its block's
+ * sum holds beyond the cells below the cap. A cell next
  * to a wall, crossed by a few grazing beams, keeps those few (a block's
  * mean there put a wall first seen late under the free cells' misses: the
  * map of intel's first 100 scans scored 1.19 times the batch's BIC). */
@@ -264,7 +264,7 @@ static int64_t pre_record(polyc__grid *g, size_t d, int take)
     else if (g->pre_high < g->pre_cap)
         r = g->pre_high++;
     else
-        return -1; /* (those misses are lost, as before a pool existed) */
+        return -1; /* (the pool is spent: those misses are lost) */
     g->pre_of[d] = r + 1;
     return r;
 }

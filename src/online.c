@@ -163,11 +163,16 @@ static int lay_out(polyc_ctx *ctx, polyc__online *on, polyc__arena *a)
     POLYC__CARVE_ZERO(ok, a, on->tile_raw, tile_cap);
     POLYC__CARVE_ZERO(ok, a, on->tile_new, tile_cap);
     POLYC__CARVE_ZERO(ok, a, on->tile_miss, tile_cap);
+    /* the grid's records of misses in tiles not stored: carved here, set in
+     * the grid below (its layout clears the grid) */
     size_t pre_cap = pre_records(tile_cap, dir_n);
-    POLYC__CARVE_ZERO(ok, a, on->pre_of, dir_n);
-    POLYC__CARVE_ZERO(ok, a, on->pre_miss, pre_cap * POLYC__PRE_BLOCKS);
-    POLYC__CARVE_ZERO(ok, a, on->pre_cells, pre_cap * (POLYC__TILE_CELLS / 2));
-    POLYC__CARVE(ok, a, on->pre_free, pre_cap);
+    uint32_t *pre_of = NULL, *pre_free = NULL;
+    uint16_t *pre_miss = NULL;
+    uint8_t *pre_cells = NULL;
+    POLYC__CARVE_ZERO(ok, a, pre_of, dir_n);
+    POLYC__CARVE_ZERO(ok, a, pre_miss, pre_cap * POLYC__PRE_BLOCKS);
+    POLYC__CARVE_ZERO(ok, a, pre_cells, pre_cap * (POLYC__TILE_CELLS / 2));
+    POLYC__CARVE(ok, a, pre_free, pre_cap);
     if (!ok)
         return 0;
     saved = ctx->arena;
@@ -177,11 +182,11 @@ static int lay_out(polyc_ctx *ctx, polyc__online *on, polyc__arena *a)
     ctx->arena = saved;
     if (st != POLYC_OK)
         return 0;
-    ctx->grid.pre_of = on->pre_of;
-    ctx->grid.pre_miss = on->pre_miss;
-    ctx->grid.pre_cells = on->pre_cells;
-    ctx->grid.pre_free = on->pre_free;
-    ctx->grid.pre_cap = (uint32_t)pre_records(tile_cap, dir_n);
+    ctx->grid.pre_of = pre_of;
+    ctx->grid.pre_miss = pre_miss;
+    ctx->grid.pre_cells = pre_cells;
+    ctx->grid.pre_free = pre_free;
+    ctx->grid.pre_cap = (uint32_t)pre_cap;
     /* the tiles, and above them the largest step's scratch */
     size_t scratch = 0;
     for (int step = POLYC__STEP_TRACE; step <= POLYC__STEP_LEARN; step++) {

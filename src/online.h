@@ -78,10 +78,6 @@ typedef struct polyc__online {
     double *tile_raw;
     uint32_t *tile_new;            /* per stored tile: endpoints in or out since its refresh */
     uint32_t *tile_miss;           /* and misses counted in its cells with hits */
-    /* the grid's records of misses in tiles not stored (its pre_*) */
-    uint32_t *pre_of, *pre_free;
-    uint16_t *pre_miss;
-    uint8_t *pre_cells;
 
     polyc__opt opt;                /* the optimiser (its arrays in the block) */
     int opt_ready;                 /* it holds the map (0 before the first update) */

@@ -127,6 +127,7 @@ static void test_person_in_a_room_seen_through(void **state)
     assert_int_equal(polyc_online_update(o.ctx, POLYC_ONLINE_WORK_DEFAULT, &rep), POLYC_OK);
     assert_int_equal(polyc_online_finish(o.ctx, NULL, NULL, &rep), POLYC_OK);
     /* the map is the room's wall: no polyline stands at the person */
+    assert_true(polyc_polyline_count(o.ctx) > 0);
     for (uint32_t i = 0; i < polyc_polyline_count(o.ctx); i++) {
         polyc_polyline pl;
         assert_int_equal(polyc_get_polyline(o.ctx, i, &pl), POLYC_OK);
