@@ -411,7 +411,8 @@ POLYC_API polyc_status polyc_online_finish(polyc_ctx *ctx, polyc_progress_fn pro
                                            polyc_online_report *out);
 /* Gives kept scan `scan_id` a new pose (after a loop closure): its hits,
  * misses and data leave the grid exactly and come back at the new pose;
- * the regions both poses saw are re-optimised by the next updates.
+ * the next update casts its contour (with every scan kept: every scan's)
+ * and the regions both poses saw are re-optimised by the next updates.
  * POLYC_ERR_RANGE for a scan that is not kept (or unknown). */
 POLYC_API polyc_status polyc_online_correct(polyc_ctx *ctx, uint32_t scan_id, double pose_x_m,
                                             double pose_y_m, double pose_theta_rad);

@@ -126,6 +126,7 @@ static int lay_out(polyc_ctx *ctx, polyc__online *on, polyc__arena *a)
     POLYC__CARVE(ok, a, ctx->scans, slots);
     POLYC__CARVE(ok, a, ctx->ranges, (size_t)ol->max_scan_beams + ol->keep_beams);
     POLYC__CARVE(ok, a, on->kept_id, ol->keep_scans + 1);
+    POLYC__CARVE_ZERO(ok, a, on->relabel, ol->keep_scans / 32u + 1u);
     int32_t V = polyc__max_vertices(&ctx->lim);
     if (!ok || !polyc__store_init(a, &ctx->store, V))
         return 0;
@@ -446,12 +447,14 @@ static void label_contour(polyc_ctx *ctx, const polyc__scan *s)
     }
 }
 
-/* The scan's beams into the grid, its endpoints into the sums, its first
- * occupied cells into the contour and (learn) its lines into the prior; or,
- * with take_back, its counts and sums out again (the prior and the contour
- * keep what it gave: see docs/algorithm.md, "Online"). */
+/* The scan's beams into the grid and its endpoints into the sums; a new
+ * scan's (fresh) first occupied cells into the contour and its lines into
+ * the prior. With take_back, its counts and sums out again (the prior and
+ * the contour keep what it gave: see docs/algorithm.md, "Online"). A
+ * corrected scan's contour is cast at the next update, once the other
+ * corrections are in the grid (polyc__online_after_corrections). */
 static polyc_status accumulate(polyc_ctx *ctx, const polyc__scan *s, uint32_t number, int take_back,
-                               int learn)
+                               int fresh)
 {
     polyc__online *on = ctx->online;
     const polyc__grid *g = &ctx->grid;
@@ -459,8 +462,8 @@ static polyc_status accumulate(polyc_ctx *ctx, const polyc__scan *s, uint32_t nu
     int sums_ok = sum_endpoints(ctx, s, take_back ? -1.0f : 1.0f);
     if (take_back)
         return st;
-    label_contour(ctx, s);
-    if (learn) {
+    if (fresh) {
+        label_contour(ctx, s);
         /* (the block is sized for it; without it, NULL: the same lines,
          * the endpoints computed twice) */
         size_t mark = ctx->arena.used;
@@ -610,6 +613,10 @@ polyc_status polyc_online_correct(polyc_ctx *ctx, uint32_t scan_id, double pose_
     store_scan(ctx, d, &moved, d->first);
     if (st == POLYC_OK)
         st = accumulate(ctx, d, scan_id, 0, 0); /* the prior has its lines already */
+    if (!((on->relabel[lo >> 5] >> (lo & 31)) & 1u)) {
+        on->relabel[lo >> 5] |= 1u << (lo & 31);
+        on->relabel_n++;
+    }
     on->last_x = lx; /* the robot is where the latest scan was */
     on->last_y = ly;
     on->pending++;
@@ -621,19 +628,41 @@ polyc_status polyc_online_correct(polyc_ctx *ctx, uint32_t scan_id, double pose_
     return st;
 }
 
-/* The angle prior and the accuracy forgotten and learned again from the
- * kept scans (all of them, at their poses now), and every tile in the
+/* The corrected scans' contour, cast on the grid with every correction in
+ * it. Cast as each correction came, a scan taken back early would look
+ * through its wall at the new pose: the cells there still held the misses
+ * of the scans not corrected yet, and the wall was never traced. When every
+ * scan is kept, the contour is the batch's: cleared and cast again from all
+ * of them, so that the drifted poses' contour goes too. */
+static void relabel(polyc_ctx *ctx, int all)
+{
+    polyc__online *on = ctx->online;
+    polyc__grid *g = &ctx->grid;
+    if (all)
+        for (uint32_t t = 0; t < g->tile_count; t++)
+            memset(g->tiles[t].contour, 0, sizeof g->tiles[t].contour);
+    for (uint32_t k = 0; k < on->kept_n; k++)
+        if (all || ((on->relabel[k >> 5] >> (k & 31)) & 1u))
+            label_contour(ctx, &ctx->scans[1 + k]);
+    memset(on->relabel, 0, (on->lim.keep_scans / 32u + 1u) * sizeof *on->relabel);
+    on->relabel_n = 0;
+}
+
+/* After corrections, the corrected scans' contour (relabel), and, when
+ * every scan is kept, the angle prior and the accuracy forgotten and
+ * learned again from all of them at their poses now, and every tile in the
  * backlog: its points' weights change. Without it the drifted scans' pairs
  * stay, and the weights they give (a band's, where the drift spread a wall)
  * fit the corrected map loosely: intel's drift experiment came out at 1.23
  * times the batch map's BIC on the true poses' data. */
-void polyc__online_relearn(polyc_ctx *ctx)
+void polyc__online_after_corrections(polyc_ctx *ctx)
 {
     polyc__online *on = ctx->online;
-    if (!on->relearn)
-        return;
+    int all = on->relearn && on->kept_n == on->scans;
+    if (on->relabel_n > 0)
+        relabel(ctx, all);
     on->relearn = 0;
-    if (on->kept_n != on->scans)
+    if (!all)
         return;
     polyc__prior_forget(&on->prior);
     polyc__accuracy_forget(&on->acc);

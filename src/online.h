@@ -55,6 +55,8 @@ typedef struct polyc__online {
     uint32_t *kept_id;
     uint32_t kept_n, kept_beams;
     int relearn;                   /* corrections came while every scan was kept */
+    uint32_t *relabel;             /* bit per kept scan: corrected, its contour not cast yet */
+    uint32_t relabel_n;
 
     /* the angle prior and the accuracy, learned scan by scan */
     polyc__prior prior;
@@ -106,8 +108,9 @@ void polyc__online_stage_limits(const polyc_online_limits *ol, polyc_limits *lim
  * the backlog (every few scans); every stored tile (the finishing call) */
 void polyc__online_backlog_misses(polyc_ctx *ctx);
 void polyc__online_backlog_all(polyc_ctx *ctx);
-/* after corrections (relearn): the prior and the accuracy learned again */
-void polyc__online_relearn(polyc_ctx *ctx);
+/* after corrections: the corrected scans' contour cast on the grid as it
+ * stands now, and (relearn) the prior and the accuracy learned again */
+void polyc__online_after_corrections(polyc_ctx *ctx);
 /* the sum of the view vectors of a cell's endpoints (0, 0: none) */
 void polyc__online_cell_view(const polyc_ctx *ctx, int32_t ix, int32_t iy, float *vx, float *vy);
 /* online_data.c: the points of the n taken tiles (the first n of the

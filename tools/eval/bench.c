@@ -49,6 +49,9 @@ static const char usage_text[] =
     "  --occupancy-only only the occupancy-map section\n"
     "  --no-online      no online section\n"
     "  --online-only    only the online section (its batch builds: one run each)\n"
+    "  --drift R,X,Y    the pose-correction row's drift at the last scan: a turn\n"
+    "                   of R rad about the first pose and a shift of (X, Y) m\n"
+    "                   (default 0.02,0.30,-0.20)\n"
     "  -h, --help       this text\n"
     "Columns: stage times in ms (parse = reading the log, add = polyc_add_scan,\n"
     "grid, contour, trace, optimise, output = JSON to /dev/null); block and used\n"
@@ -284,6 +287,9 @@ static int parse_options(int argc, char **argv, options *o)
     o->gamma = o->grazing = o->data_min = -1.0;
     o->seed = -1;
     o->online = 1;
+    o->drift[0] = 0.02;
+    o->drift[1] = 0.30;
+    o->drift[2] = -0.20;
     for (i = 1; i < argc; i++) {
         const char *a = argv[i];
         if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
@@ -324,6 +330,12 @@ static int parse_options(int argc, char **argv, options *o)
             o->online = 0;
         } else if (strcmp(a, "--online-only") == 0) {
             o->online_only = 1;
+        } else if (strcmp(a, "--drift") == 0 && i + 1 < argc) {
+            char tail;
+            if (sscanf(argv[++i], "%lf,%lf,%lf%c", &o->drift[0], &o->drift[1], &o->drift[2],
+                       &tail) != 3 ||
+                !(fabs(o->drift[0]) <= 1.0 && fabs(o->drift[1]) <= 10.0 && fabs(o->drift[2]) <= 10.0))
+                return -1;
         } else if (strcmp(a, "--only") == 0 && i + 1 < argc) {
             o->only = argv[++i];
         } else if (a[0] == '-' || o->data) {

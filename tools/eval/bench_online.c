@@ -23,12 +23,6 @@
                              with twice the limits, up to this many times in all */
 #define PASSES 10u        /* the memory row: intel this many times over */
 #define SETTLE_MAX 200u   /* the correction row: updates to re-converge, at most */
-/* The correction row's drift: 0 at the first scan, growing linearly to a
- * turn of DRIFT_RAD about the first pose and a shift of (DRIFT_X_M,
- * DRIFT_Y_M) at the last. */
-#define DRIFT_RAD 0.02
-#define DRIFT_X_M 0.30
-#define DRIFT_Y_M (-0.20)
 #define MEMORY_SCENE "intel" /* the memory and correction rows' log */
 
 /* ---- a scene's data ------------------------------------------------------ */
@@ -689,8 +683,9 @@ static int memory_row(const options *o, const scene *s, const scene_result *one)
 }
 
 /* scans with the correction row's drift on their poses (copies; the ranges
- * are shared). */
-static polyc_scan *drifted(const polyc_scan *scans, uint32_t n)
+ * are shared): 0 at the first scan, growing linearly to a turn of drift[0]
+ * about the first pose and a shift of (drift[1], drift[2]) at the last. */
+static polyc_scan *drifted(const polyc_scan *scans, uint32_t n, const double *drift)
 {
     polyc_scan *out = malloc(n * sizeof *out);
     double x0 = scans[0].pose_x_m, y0 = scans[0].pose_y_m;
@@ -699,11 +694,11 @@ static polyc_scan *drifted(const polyc_scan *scans, uint32_t n)
         return NULL;
     for (i = 0; i < n; i++) {
         double s = n > 1u ? (double)i / (double)(n - 1u) : 0.0;
-        double a = DRIFT_RAD * s, c = cos(a), sn = sin(a);
+        double a = drift[0] * s, c = cos(a), sn = sin(a);
         double dx = scans[i].pose_x_m - x0, dy = scans[i].pose_y_m - y0;
         out[i] = scans[i];
-        out[i].pose_x_m = x0 + c * dx - sn * dy + DRIFT_X_M * s;
-        out[i].pose_y_m = y0 + sn * dx + c * dy + DRIFT_Y_M * s;
+        out[i].pose_x_m = x0 + c * dx - sn * dy + drift[1] * s;
+        out[i].pose_y_m = y0 + sn * dx + c * dy + drift[2] * s;
         out[i].pose_theta_rad = scans[i].pose_theta_rad + a;
     }
     return out;
@@ -740,18 +735,22 @@ static int correction_row(const options *o, const scene *s, const scene_result *
            "of them), updates\nuntil the backlog is 0 (at most %u), polyc_online_finish; "
            "drifted = the map before\nthe corrections as the updates left it, corrected = "
            "after them and the finish (both\nscored against the true poses' endpoints)\n",
-           s->name, DRIFT_RAD, DRIFT_X_M, DRIFT_Y_M, SETTLE_MAX);
+           s->name, o->drift[0], o->drift[1], o->drift[2], SETTLE_MAX);
     printf("%-24s %6s %9s | %8s | %9s %6s | %7s %8s | %8s %-10s\n", "scene", "kept", "blockMiB",
            "replay", "correct", "scans", "updates", "updates", "finish", "status");
     printf("%-24s %6s %9s | %8s | %9s %6s | %7s %8s | %8s %-10s\n", "", "", "", "ms", "ms", "",
            "", "ms", "ms", "");
     bench_config(o, &config);
-    bad = drifted(d.log.scans, n);
+    bad = drifted(d.log.scans, n, o->drift);
     ids = malloc(n * sizeof *ids);
     if (!bad || !ids || limits_for(&config, &d, bad, 1, &on.limits) != POLYC_OK) {
         printf("%-24s error: out of memory or no limits\n", one->label);
         goto done;
     }
+    /* tiles stay stored once a hit made them, so the grid holds the tiles
+     * of both poses; the data cells hold both while the corrections go in */
+    on.limits.max_grid_cells = on.limits.max_grid_cells > UINT32_MAX / 2u ? UINT32_MAX : 2u * on.limits.max_grid_cells;
+    on.limits.max_points = on.limits.max_points > UINT32_MAX / 2u ? UINT32_MAX : 2u * on.limits.max_points;
     if (replay_run(o, &on, bad, n, 1, 1, ids, 0, 0, &r, one->label) != 0)
         goto failed;
     score_map(&d, on.ctx, &before);
