@@ -409,10 +409,13 @@ POLYC_API polyc_status polyc_online_update(polyc_ctx *ctx, uint64_t work,
  * it; progress as for polyc_optimize. */
 POLYC_API polyc_status polyc_online_finish(polyc_ctx *ctx, polyc_progress_fn progress, void *user,
                                            polyc_online_report *out);
-/* Gives kept scan `scan_id` a new pose (after a loop closure): its hits,
- * misses and data leave the grid exactly and come back at the new pose;
- * the next update casts its contour (with every scan kept: every scan's)
- * and the regions both poses saw are re-optimised by the next updates.
+/* Gives kept scan `scan_id` a new pose (after a loop closure). The pose
+ * waits; the next update, finish or add applies every waiting correction:
+ * the scans' hits, misses and data leave the grid exactly and come back at
+ * their new poses (with every scan kept and at least half of them moved,
+ * every kept scan is counted afresh), their contour is cast, and the
+ * regions both poses saw are re-optimised by the updates. An error there
+ * (POLYC_ERR_NOMEM: the new poses' tiles) is that call's.
  * POLYC_ERR_RANGE for a scan that is not kept (or unknown). */
 POLYC_API polyc_status polyc_online_correct(polyc_ctx *ctx, uint32_t scan_id, double pose_x_m,
                                             double pose_y_m, double pose_theta_rad);

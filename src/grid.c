@@ -557,6 +557,30 @@ polyc_status polyc__grid_online_init(polyc_ctx *ctx, double side_m, uint32_t max
     return grid_lay_out(ctx, -0.5 * side_m, -0.5 * side_m, side_m, side_m, tiles);
 }
 
+void polyc__grid_want(polyc_ctx *ctx, const polyc__scan *s)
+{
+    want_hits(ctx, s);
+}
+
+/* Every count to 0, in the stored tiles and in the records of the tiles
+ * not stored, which go back to the pool; the tiles stay stored. */
+void polyc__grid_clear_counts(polyc__grid *g)
+{
+    for (uint32_t t = 0; t < g->tile_count; t++) {
+        polyc__tile *tile = &g->tiles[t];
+        memset(tile->hits, 0, sizeof tile->hits);
+        memset(tile->misses, 0, sizeof tile->misses);
+        memset(tile->contour, 0, sizeof tile->contour);
+    }
+    if (!g->pre_miss)
+        return;
+    memset(g->pre_of, 0, (size_t)g->tiles_x * (size_t)g->tiles_y * sizeof *g->pre_of);
+    memset(g->pre_cells, 0, (size_t)g->pre_high * (POLYC__TILE_CELLS / 2));
+    memset(g->pre_miss, 0, (size_t)g->pre_high * POLYC__PRE_BLOCKS * sizeof *g->pre_miss);
+    g->pre_high = 0;
+    g->pre_nfree = 0;
+}
+
 polyc_status polyc__grid_add_scan(polyc_ctx *ctx, const polyc__scan *s, int take_back,
                                   uint32_t *on_hits)
 {

@@ -295,6 +295,11 @@ polyc_status polyc__grid_build(polyc_ctx *ctx);
 polyc_status polyc__grid_online_init(polyc_ctx *ctx, double side_m, uint32_t max_cells);
 polyc_status polyc__grid_add_scan(polyc_ctx *ctx, const polyc__scan *s, int take_back,
                                   uint32_t *on_hits);
+/* online: the tiles the scan's hits end in wanted (stored when a beam
+ * reaches them), before any scan is counted again; every count to 0 (the
+ * tiles stay stored, the records go back to the pool) */
+void polyc__grid_want(polyc_ctx *ctx, const polyc__scan *s);
+void polyc__grid_clear_counts(polyc__grid *g);
 polyc__tile *polyc__grid_tile(const polyc__grid *g, int32_t ix, int32_t iy);
 /* NULL for cells outside the grid or in tiles not stored (no beam ends in a
  * hit there: free space or never reached) */

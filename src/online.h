@@ -54,9 +54,9 @@ typedef struct polyc__online {
      * scan's; kept_id[k], ascending, is scan k's number */
     uint32_t *kept_id;
     uint32_t kept_n, kept_beams;
-    int relearn;                   /* corrections came while every scan was kept */
-    uint32_t *relabel;             /* bit per kept scan: corrected, its contour not cast yet */
-    uint32_t relabel_n;
+    uint32_t *moved;               /* bit per kept scan: a correction waits */
+    double *new_pose;              /* per kept scan: the waiting pose (x, y, theta) */
+    uint32_t moved_n;
 
     /* the angle prior and the accuracy, learned scan by scan */
     polyc__prior prior;
@@ -108,9 +108,10 @@ void polyc__online_stage_limits(const polyc_online_limits *ol, polyc_limits *lim
  * the backlog (every few scans); every stored tile (the finishing call) */
 void polyc__online_backlog_misses(polyc_ctx *ctx);
 void polyc__online_backlog_all(polyc_ctx *ctx);
-/* after corrections: the corrected scans' contour cast on the grid as it
- * stands now, and (relearn) the prior and the accuracy learned again */
-void polyc__online_after_corrections(polyc_ctx *ctx);
+/* the corrections given since the last update (or add) into the grid, the
+ * sums and the contour; when every scan is kept, the prior and the
+ * accuracy learned again (online.c, "pose corrections") */
+polyc_status polyc__online_apply_corrections(polyc_ctx *ctx);
 /* the sum of the view vectors of a cell's endpoints (0, 0: none) */
 void polyc__online_cell_view(const polyc_ctx *ctx, int32_t ix, int32_t iy, float *vx, float *vy);
 /* online_data.c: the points of the n taken tiles (the first n of the
@@ -143,6 +144,8 @@ uint32_t polyc__cell_find(const polyc__online *on, uint32_t key);
 uint32_t polyc__cell_add(polyc__online *on, uint32_t key);
 /* entry (1 + its index) out: its cell has no endpoints left */
 void polyc__cell_drop(polyc__online *on, uint32_t entry);
+/* every entry out: the table empty (tiles: the grid's stored tiles) */
+void polyc__cells_clear(polyc__online *on, uint32_t tiles);
 
 /* points.c: the weighted points from the cells' sums (online) */
 /* opt_setup.c: the optimiser of an online context, carved once; and its

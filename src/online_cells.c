@@ -95,3 +95,11 @@ void polyc__cell_drop(polyc__online *on, uint32_t entry)
     on->sums[entry - 1].n = on->sums_free;
     on->sums_free = entry;
 }
+
+void polyc__cells_clear(polyc__online *on, uint32_t tiles)
+{
+    memset(on->cell_at, 0, ((size_t)on->cell_mask + 1u) * sizeof *on->cell_at);
+    memset(on->tile_cells, 0, (size_t)tiles * sizeof *on->tile_cells);
+    on->sums_n = 0;
+    on->sums_free = 0;
+}

@@ -488,7 +488,8 @@ polyc_status polyc_online_update(polyc_ctx *ctx, uint64_t work, polyc_online_rep
         return st;
     if (work == 0)
         return polyc__fail(ctx, POLYC_ERR_CONFIG, "a work budget of 0 (POLYC_ONLINE_WORK_DEFAULT is the default)");
-    polyc__online_after_corrections(ctx);
+    if ((st = polyc__online_apply_corrections(ctx)) != POLYC_OK)
+        return st;
     polyc__online *on = ctx->online;
     uint64_t spent = 0;
     uint32_t changed = 0;
@@ -591,7 +592,8 @@ polyc_status polyc_online_finish(polyc_ctx *ctx, polyc_progress_fn progress, voi
     polyc_status st = online_ctx(ctx);
     if (st != POLYC_OK)
         return st;
-    polyc__online_after_corrections(ctx);
+    if ((st = polyc__online_apply_corrections(ctx)) != POLYC_OK)
+        return st;
     polyc__online *on = ctx->online;
     polyc__opt *o = &on->opt;
     uint64_t spent = 0;

@@ -4,8 +4,9 @@
  * free in the grid once the person's tile is stored, as in a batch grid of
  * the same scans; its tile has the batch's counts, cell by cell; and when
  * the pool of records is spent the context still maps (those misses are
- * lost, as the documented fallback says); and after every kept scan's pose
- * is corrected, the contour is the batch contour of the true poses. */
+ * lost, as the documented fallback says); and after pose corrections, the
+ * counts are those of the true poses and, with every scan kept, the contour
+ * is the batch contour of the true poses. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -316,6 +317,69 @@ static void test_corrected_contour_is_batch(void **state)
     free(o.block);
 }
 
+/* Scans 1..N-1 added at drifted poses (scan 0 at its true pose: the frame),
+ * the kept ones corrected: the grid then holds, cell by cell, the counts of
+ * a context that was given the true poses, in every tile that context
+ * stores, and no hit elsewhere. keep_every 1: every scan kept, so the
+ * corrections are counted afresh; 4: a quarter kept, each corrected scan
+ * taken out and put back. */
+static void check_corrected_counts(uint32_t keep_every)
+{
+    enum { N = 16 };
+    room r = {4.0, 1, 0.0, {0}, {0, 0, 0, 0, 0, 0, 0, 0, 0, NULL}};
+    online fixed, truth;
+    open_keeping(&fixed, 12.0, 0, N);
+    open_online(&truth, 12.0, 0);
+    polyc_online_report rep;
+    for (uint32_t k = 0; k < N; k++) {
+        r.turn = 0.0004 * k;
+        polyc_scan scan = *room_scan(&r);
+        int keep = k % keep_every == 0;
+        polyc_scan drifted = scan;
+        if (keep && k > 0) {
+            drifted.pose_x_m = 0.2 * k / (N - 1);
+            drifted.pose_theta_rad = 0.04 * k / (N - 1);
+        }
+        assert_int_equal(polyc_online_add_scan(fixed.ctx, &drifted, keep, NULL), POLYC_OK);
+        assert_int_equal(polyc_online_add_scan(truth.ctx, &scan, 0, NULL), POLYC_OK);
+        assert_int_equal(polyc_online_update(fixed.ctx, POLYC_ONLINE_WORK_DEFAULT, &rep), POLYC_OK);
+    }
+    for (uint32_t k = keep_every; k < N; k += keep_every)
+        assert_int_equal(polyc_online_correct(fixed.ctx, k, 0.0, 0.0, 0.0), POLYC_OK);
+    assert_int_equal(polyc_online_update(fixed.ctx, POLYC_ONLINE_WORK_DEFAULT, &rep), POLYC_OK);
+    const polyc__grid *g = &fixed.ctx->grid, *t = &truth.ctx->grid;
+    assert_true(g->origin_x_m == t->origin_x_m && g->origin_y_m == t->origin_y_m);
+    uint32_t cells = 0, same = 0, stray = 0;
+    for (int32_t iy = 0; iy < g->height; iy++)
+        for (int32_t ix = 0; ix < g->width; ix++) {
+            const polyc__tile *a = polyc__grid_tile(g, ix, iy), *b = polyc__grid_tile(t, ix, iy);
+            int idx = polyc__cell_index(ix, iy);
+            if (b) {
+                cells++;
+                same += a && a->hits[idx] == b->hits[idx] && a->misses[idx] == b->misses[idx];
+            } else if (a) {
+                stray += a->hits[idx] != 0;
+            }
+        }
+    print_message("keep every %u: %u cells of the true poses' tiles, %u with their counts; "
+                  "%u hits left elsewhere\n",
+                  keep_every, cells, same, stray);
+    assert_true(cells > 0);
+    assert_int_equal(same, cells);
+    assert_int_equal(stray, 0);
+    assert_int_equal(polyc_online_finish(fixed.ctx, NULL, NULL, &rep), POLYC_OK);
+    assert_true(rep.polylines >= 1);
+    free(fixed.block);
+    free(truth.block);
+}
+
+static void test_corrected_counts(void **state)
+{
+    (void)state;
+    check_corrected_counts(1);
+    check_corrected_counts(4);
+}
+
 /* Records for four times as many tiles as stored: a large room seen through
  * from its middle, in a grid of few tiles, spends them. The context maps
  * on (the misses of the tiles past the pool are lost). */
@@ -348,6 +412,7 @@ int main(void)
         cmocka_unit_test(test_tile_against_batch),
         cmocka_unit_test(test_pool_spent),
         cmocka_unit_test(test_corrected_contour_is_batch),
+        cmocka_unit_test(test_corrected_counts),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

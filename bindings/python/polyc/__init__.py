@@ -878,8 +878,10 @@ class OnlineMap(_Block):
 
     def correct(self, scan_id, pose):
         """Gives kept scan scan_id the pose (x_m, y_m, theta_rad), after a
-        loop closure; the next updates re-optimise what changed. A scan not
-        kept (or unknown): PolycError POLYC_ERR_RANGE."""
+        loop closure. The pose waits: the next update(), finish() or
+        add_scan() applies every waiting correction, and the updates
+        re-optimise what changed. A scan not kept (or unknown): PolycError
+        POLYC_ERR_RANGE."""
         self._enter("correct")
         scan_id = _int_field("scan_id", scan_id, _u32)
         x, y, theta = (_real_field("pose", v) for v in pose)
