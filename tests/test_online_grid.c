@@ -322,8 +322,9 @@ static void test_corrected_contour_is_batch(void **state)
  * a context that was given the true poses, in every tile that context
  * stores, and no hit elsewhere. keep_every 1: every scan kept, so the
  * corrections are counted afresh; 4: a quarter kept, each corrected scan
- * taken out and put back. */
-static void check_corrected_counts(uint32_t keep_every)
+ * taken out and put back. by_add: the corrections are applied by adding
+ * one more scan (not kept) instead of by an update. */
+static void check_corrected_counts(uint32_t keep_every, int by_add)
 {
     enum { N = 16 };
     room r = {4.0, 1, 0.0, {0}, {0, 0, 0, 0, 0, 0, 0, 0, 0, NULL}};
@@ -346,7 +347,14 @@ static void check_corrected_counts(uint32_t keep_every)
     }
     for (uint32_t k = keep_every; k < N; k += keep_every)
         assert_int_equal(polyc_online_correct(fixed.ctx, k, 0.0, 0.0, 0.0), POLYC_OK);
-    assert_int_equal(polyc_online_update(fixed.ctx, POLYC_ONLINE_WORK_DEFAULT, &rep), POLYC_OK);
+    if (by_add) {
+        r.turn = 0.0004 * N;
+        const polyc_scan *last = room_scan(&r);
+        assert_int_equal(polyc_online_add_scan(fixed.ctx, last, 0, NULL), POLYC_OK);
+        assert_int_equal(polyc_online_add_scan(truth.ctx, last, 0, NULL), POLYC_OK);
+    } else {
+        assert_int_equal(polyc_online_update(fixed.ctx, POLYC_ONLINE_WORK_DEFAULT, &rep), POLYC_OK);
+    }
     const polyc__grid *g = &fixed.ctx->grid, *t = &truth.ctx->grid;
     assert_true(g->origin_x_m == t->origin_x_m && g->origin_y_m == t->origin_y_m);
     uint32_t cells = 0, same = 0, stray = 0;
@@ -361,9 +369,9 @@ static void check_corrected_counts(uint32_t keep_every)
                 stray += a->hits[idx] != 0;
             }
         }
-    print_message("keep every %u: %u cells of the true poses' tiles, %u with their counts; "
+    print_message("keep every %u%s: %u cells of the true poses' tiles, %u with their counts; "
                   "%u hits left elsewhere\n",
-                  keep_every, cells, same, stray);
+                  keep_every, by_add ? ", applied by an add" : "", cells, same, stray);
     assert_true(cells > 0);
     assert_int_equal(same, cells);
     assert_int_equal(stray, 0);
@@ -376,8 +384,9 @@ static void check_corrected_counts(uint32_t keep_every)
 static void test_corrected_counts(void **state)
 {
     (void)state;
-    check_corrected_counts(1);
-    check_corrected_counts(4);
+    check_corrected_counts(1, 0);
+    check_corrected_counts(4, 0);
+    check_corrected_counts(1, 1);
 }
 
 /* Records for four times as many tiles as stored: a large room seen through
