@@ -49,10 +49,13 @@ static const char usage_text[] =
     "  --occupancy-only only the occupancy-map section\n"
     "  --no-online      no online section\n"
     "  --online-only    only the online section (its batch builds: one run each)\n"
+    "  --rows-log NAME  the real log of the online memory and pose-correction\n"
+    "                   rows (default intel; with --only, it must be among them)\n"
     "  --drift R,X,Y    the pose-correction row's drift at the last scan: a turn\n"
     "                   of R rad about the first pose and a shift of (X, Y) m\n"
     "                   (default 0.02,0.30,-0.20)\n"
-    "  -h, --help       this text\n"
+    "  -h, --help       this text\n";
+static const char usage_columns[] =
     "Columns: stage times in ms (parse = reading the log, add = polyc_add_scan,\n"
     "grid, contour, trace, optimise, output = JSON to /dev/null); block and used\n"
     "= the context's memory block and its high-water mark; rss = peak resident\n"
@@ -104,7 +107,8 @@ static const char usage_online[] =
     "scans so far (worst ratio, and at which scan). Then the final online map\n"
     "beside the batch map (lines, verts, BIC, band15, cross, dcov, uns20, end20;\n"
     "sims: core, compl), intel's block and 10 passes in the block of one, and\n"
-    "intel's scans with a pose drift corrected by polyc_online_correct.\n"
+    "intel's scans with a pose drift corrected by polyc_online_correct (another\n"
+    "real log with --rows-log).\n"
     "Exit: 0 ok; 1 a scene failed (its row says why); 2 usage error, or\n"
     "DATA_DIR missing: 'bench: data directory DIR not found (pass DATA=path)'.\n";
 
@@ -287,6 +291,7 @@ static int parse_options(int argc, char **argv, options *o)
     o->gamma = o->grazing = o->data_min = -1.0;
     o->seed = -1;
     o->online = 1;
+    o->rows_log = "intel";
     o->drift[0] = 0.02;
     o->drift[1] = 0.30;
     o->drift[2] = -0.20;
@@ -294,6 +299,7 @@ static int parse_options(int argc, char **argv, options *o)
         const char *a = argv[i];
         if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
             fputs(usage_text, stdout);
+            fputs(usage_columns, stdout);
             fputs(usage_online, stdout);
             exit(0);
         } else if (strcmp(a, "--runs") == 0 && i + 1 < argc) {
@@ -330,6 +336,8 @@ static int parse_options(int argc, char **argv, options *o)
             o->online = 0;
         } else if (strcmp(a, "--online-only") == 0) {
             o->online_only = 1;
+        } else if (strcmp(a, "--rows-log") == 0 && i + 1 < argc) {
+            o->rows_log = argv[++i];
         } else if (strcmp(a, "--drift") == 0 && i + 1 < argc) {
             char tail;
             if (sscanf(argv[++i], "%lf,%lf,%lf%c", &o->drift[0], &o->drift[1], &o->drift[2],
@@ -361,6 +369,7 @@ int main(int argc, char **argv)
 
     if (parse_options(argc, argv, &o) != 0) {
         fputs(usage_text, stderr);
+        fputs(usage_columns, stderr);
         fputs(usage_online, stderr);
         return EXIT_USAGE;
     }

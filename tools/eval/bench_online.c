@@ -23,7 +23,6 @@
                              with twice the limits, up to this many times in all */
 #define PASSES 10u        /* the memory row: intel this many times over */
 #define SETTLE_MAX 200u   /* the correction row: updates to re-converge, at most */
-#define MEMORY_SCENE "intel" /* the memory and correction rows' log */
 
 /* ---- a scene's data ------------------------------------------------------ */
 
@@ -607,7 +606,7 @@ static int online_scene(const options *o, const scene *s, const bench_figures *t
     return rc;
 }
 
-/* ---- intel: memory and pose corrections ----------------------------------- */
+/* ---- one real log (intel, --rows-log): memory and pose corrections ---------- */
 
 /* The memory row: intel's online block against its batch block, then intel
  * PASSES times over in the block of one pass. */
@@ -829,7 +828,7 @@ int bench_online_section(const options *o, const scene *list, size_t count,
     for (i = 0; i < count; i++) {
         if (online_scene(o, &list[i], batch ? &batch[i] : NULL, &res[i]) != 0)
             failed = 1;
-        if (strcmp(list[i].name, MEMORY_SCENE) == 0 && strcmp(list[i].kind, "carmen") == 0)
+        if (strcmp(list[i].name, o->rows_log) == 0 && strcmp(list[i].kind, "carmen") == 0)
             intel = i;
     }
     printf("\nonline maps after polyc_online_finish beside the batch maps (%s); figures "
