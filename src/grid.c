@@ -563,14 +563,14 @@ void polyc__grid_want(polyc_ctx *ctx, const polyc__scan *s)
 }
 
 /* Every count to 0, in the stored tiles and in the records of the tiles
- * not stored, which go back to the pool; the tiles stay stored. */
+ * not stored, which go back to the pool; the tiles stay stored (their
+ * contour bits too: the caller casts the contour again). */
 void polyc__grid_clear_counts(polyc__grid *g)
 {
     for (uint32_t t = 0; t < g->tile_count; t++) {
         polyc__tile *tile = &g->tiles[t];
         memset(tile->hits, 0, sizeof tile->hits);
         memset(tile->misses, 0, sizeof tile->misses);
-        memset(tile->contour, 0, sizeof tile->contour);
     }
     if (!g->pre_miss)
         return;
