@@ -113,6 +113,69 @@ static void test_zip_same_side_band(void **state)
     fx_close(&f);
 }
 
+/* A T junction: polyline B runs up a stem to (0, 0) and on along the wall
+ * y = 0; polyline A comes along the wall from the left and runs `over` past
+ * the junction, along B. Wall points are seen from below (y = -2), the
+ * stem's from its right; A is seen from above (y = +2) when a_above (then
+ * it is the other face of a partition 4.5 cm thick: a_y = 0.045). */
+static void t_case(fixture *f, float over, float a_y, int a_above)
+{
+    static ptlist p;
+    static float seen[2 * MAX_PTS];
+    p.n = 0;
+    pts_line(&p, -1.0f, 0.0f, 1.0f, 0.0f, 0.02f);
+    int wall = p.n;
+    pts_line(&p, 0.0f, -1.0f, 0.0f, -0.04f, 0.02f);
+    int stem = p.n;
+    if (a_above)
+        pts_line(&p, -1.0f, a_y, 0.0f, a_y, 0.02f);
+    for (int i = 0; i < p.n; i++) {
+        seen[2 * i] = i < wall ? p.xy[2 * i] : i < stem ? 2.0f : p.xy[2 * i];
+        seen[2 * i + 1] = i < wall ? -2.0f : i < stem ? p.xy[2 * i + 1] : 2.0f;
+    }
+    set_points_seen(f, p.xy, seen, p.n);
+    clear_lines(&f->o);
+    const float a[4] = {-1.0f, a_y, over, a_y}, b[6] = {0.0f, -1.0f, 0.0f, 0.0f, 1.0f, 0.0f};
+    add_line(&f->o, a, 2, 0);
+    add_line(&f->o, b, 3, 0);
+    rebuild(&f->o);
+}
+
+/* An end 11 cm past a T junction, along the other polyline and seen from
+ * the same side (too short a stretch for the zip's runs) is pulled back to
+ * the junction; the other polyline is left as it was. One that ends at the
+ * junction stays. */
+static void test_zip_end_past_t_junction(void **state)
+{
+    (void)state;
+    static fixture f;
+    const float overs[2] = {0.11f, 0.0f};
+    for (int k = 0; k < 2; k++) {
+        fx_open_hand(&f, 0.0f);
+        t_case(&f, overs[k], 0.0f, 0);
+        polyc__op_zip(&f.o);
+        check_books(&f.o, "end past a T junction");
+        assert_int_equal(live_lines(&f.o), 2);
+        assert_int_equal(f.o.s->v_live, 5);
+        assert_true(line_with_end(&f.o, -1.0f, 0.0f) != POLYC__NONE);
+        assert_true(nearest_vertex(&f.o, 1.0f, 0.0f) < 1e-4f);
+        assert_true(nearest_vertex(&f.o, 0.0f, 0.0f) < 1e-4f);
+        /* A's other end: at the junction, within a centimetre */
+        const polyc__line *ln = &f.o.s->l[line_with_end(&f.o, -1.0f, 0.0f)];
+        int32_t e = f.o.s->v[ln->head].x < -0.5f ? ln->tail : ln->head;
+        assert_true(fabsf(f.o.s->v[e].x) <= 0.01f);
+        assert_true(fabsf(f.o.s->v[e].y) <= 1e-4f);
+        fx_close(&f);
+    }
+    /* the other face of a partition 4.5 cm thick, seen from above: stays */
+    fx_open_hand(&f, 0.0f);
+    t_case(&f, 0.11f, 0.045f, 1);
+    polyc__op_zip(&f.o);
+    assert_int_equal(live_lines(&f.o), 2);
+    assert_true(nearest_vertex(&f.o, 0.11f, 0.045f) < 1e-4f);
+    fx_close(&f);
+}
+
 /* An X of two polylines, each wall seen on both sides of the crossing
  * except the second below the first: the second's overshoot goes, the
  * first is left whole, no crossing remains. */
@@ -220,6 +283,7 @@ int main(void)
         cmocka_unit_test(test_zip_parallel_lines_become_one),
         cmocka_unit_test(test_zip_leaves_walls_10cm_apart),
         cmocka_unit_test(test_zip_same_side_band),
+        cmocka_unit_test(test_zip_end_past_t_junction),
         cmocka_unit_test(test_untangle_resolves_x),
         cmocka_unit_test(test_untangle_hairpin_through_wall),
         cmocka_unit_test(test_spike_past_corner_removed),
