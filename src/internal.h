@@ -344,6 +344,11 @@ static inline float polyc__turn_rad(float cross, float dot)
 }
 /* m > threshold, evaluated without division: hits > t * (hits + misses) */
 int polyc__cell_occupied(const polyc__tile *t, int idx, float threshold);
+/* contour.c: whether cell (ix, iy) holds data with no occupied cell near
+ * it, which the end of a reflection that met no occupied cell labels as
+ * contour (`bits`: the tiles' marks hold the occupied cells, as in the
+ * contour pass; else from the counts) */
+int polyc__contour_data_alone(const polyc_ctx *ctx, int32_t ix, int32_t iy, int bits);
 /* beam geometry shared by the grid and contour passes */
 typedef struct polyc__beam {
     float sx, sy, ex, ey;          /* grid coordinates (cells) of sensor and end */

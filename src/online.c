@@ -400,9 +400,10 @@ static int sum_endpoints(polyc_ctx *ctx, const polyc__scan *s, float sign)
     return ok;
 }
 
-/* Labels the first occupied cell along each beam as contour, on the grid
- * as it stands with this scan counted (the batch casts once more on the
- * final grid). */
+/* Labels the first occupied cell along each beam as contour, or a
+ * reflection's end cell by the data fallback (contour.c), on the grid as it
+ * stands with this scan counted (the batch casts once more on the final
+ * grid). */
 static void label_contour(polyc_ctx *ctx, const polyc__scan *s)
 {
     const polyc__grid *g = &ctx->grid;
@@ -443,7 +444,8 @@ static void label_contour(polyc_ctx *ctx, const polyc__scan *s)
                 in = polyc__walk_enter(&w, g->width, g->height);
         }
         polyc__tile *e = polyc__grid_tile(g, cx, cy);
-        if (e && polyc__cell_occupied(e, polyc__cell_index(cx, cy), thr))
+        if (e && (polyc__cell_occupied(e, polyc__cell_index(cx, cy), thr) ||
+                  (b.hit && polyc__contour_data_alone(ctx, cx, cy, 0))))
             e->contour[cy & (POLYC__TILE_SIDE - 1)] |= 1u << (cx & (POLYC__TILE_SIDE - 1));
     }
 }

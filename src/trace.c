@@ -244,11 +244,36 @@ static uint32_t simplify(int32_t *xy, uint32_t n)
     return m;
 }
 
+/* A walk on none but the contour's data cells (contour.c: returns no
+ * occupied cell explains) this short is not traced: a chair's legs, a
+ * person who stood still for a moment. A wall seen at grazing angles is
+ * longer. */
+#define DATA_ONLY_MIN_M 0.5f
+
+/* Whether the walk holds no occupied cell and is shorter than
+ * DATA_ONLY_MIN_M along its cells. */
+static int short_data_only(const polyc_ctx *ctx, const walk *w)
+{
+    const polyc__grid *g = &ctx->grid;
+    float len = 0.0f;
+    for (uint32_t i = 0; i < w->n; i++) {
+        int32_t ix = w->xy[2 * i], iy = w->xy[2 * i + 1];
+        const polyc__tile *t = polyc__grid_tile(g, ix, iy);
+        if (t && polyc__cell_occupied(t, polyc__cell_index(ix, iy), ctx->cfg.contour_threshold))
+            return 0;
+        if (i > 0) {
+            float dx = (float)(ix - w->xy[2 * i - 2]), dy = (float)(iy - w->xy[2 * i - 1]);
+            len += sqrtf(dx * dx + dy * dy);
+        }
+    }
+    return len * g->cell_m < DATA_ONLY_MIN_M;
+}
+
 static polyc_status emit(polyc_ctx *ctx, walk *w, int closed)
 {
     const polyc__grid *g = &ctx->grid;
     polyc__store *s = &ctx->store;
-    if (w->n < 2)
+    if (w->n < 2 || short_data_only(ctx, w))
         return POLYC_OK; /* a lone cell gives no segment */
     /* drop redundant points in place */
     uint32_t m = 1;

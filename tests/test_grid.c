@@ -3,7 +3,8 @@
  * callback per cell that keeps every tile a beam crosses: the grid stores
  * exactly the tiles where some beam ends in a hit, in the order beams first
  * reach them, with the same counters in every cell; the contour list is the
- * same, in the same order. Scenes: a room with clutter, no-return, short and
+ * same, in the same order (with the data fallback, checked by brute force
+ * over the cells around each end). Scenes: a room with clutter, no-return, short and
  * NaN ranges at several cell sizes; one pose seen 200 times (the sensor's
  * cell saturates); the contour within its budget; and the walk's skip
  * over tiles against its steps, beam by beam. */
@@ -113,6 +114,8 @@ typedef struct oracle {
     int32_t *list;
     uint32_t count;
     float threshold;
+    float data_min;                /* the data rule's m */
+    int32_t alone;                 /* the data fallback's square, cells each way */
 } oracle;
 
 static void inc(polyc__count *a, polyc__count *b)
@@ -152,16 +155,36 @@ static int count_visit(void *u, int32_t ix, int32_t iy, float t_enter, int last)
     return 0;
 }
 
+/* The data fallback, brute force: the cell holds data (m >= data_min) and
+ * no cell within `alone` of it (a square) is occupied. */
+static int data_alone(const oracle *o, int32_t ix, int32_t iy)
+{
+    size_t c = (size_t)iy * (size_t)o->g->width + (size_t)ix;
+    unsigned h = o->hits[c], m = o->misses[c];
+    if (h == 0 || (float)h < o->data_min * (float)(h + m))
+        return 0;
+    for (int32_t y = iy - o->alone; y <= iy + o->alone; y++)
+        for (int32_t x = ix - o->alone; x <= ix + o->alone; x++) {
+            if (!in_grid(o->g, x, y))
+                continue;
+            size_t k = (size_t)y * (size_t)o->g->width + (size_t)x;
+            unsigned hk = o->hits[k], mk = o->misses[k];
+            if (hk > 0 && (float)hk > o->threshold * (float)(hk + mk))
+                return 0;
+        }
+    return 1;
+}
+
 static int contour_visit(void *u, int32_t ix, int32_t iy, float t_enter, int last)
 {
     (void)t_enter;
-    (void)last;
     oracle *o = u;
     if (!in_grid(o->g, ix, iy) || !o->tile_rank[tile_of(o->g, ix, iy)])
         return 1;
     size_t c = (size_t)iy * (size_t)o->g->width + (size_t)ix;
     unsigned h = o->hits[c], m = o->misses[c];
-    if (!(h > 0 && (float)h > o->threshold * (float)(h + m)))
+    if (!(h > 0 && (float)h > o->threshold * (float)(h + m)) &&
+        !(last && o->beam->hit && data_alone(o, ix, iy)))
         return 0;
     if (!o->labelled[c]) {
         o->labelled[c] = 1;
@@ -187,6 +210,8 @@ static void oracle_run(oracle *o, const polyc_ctx *ctx)
     o->wanted = calloc(dir_n, 1);
     o->list = calloc((size_t)ctx->lim.max_beams * 2 + 2, sizeof *o->list);
     o->threshold = ctx->cfg.contour_threshold;
+    o->data_min = ctx->cfg.data_min_m;
+    o->alone = (int32_t)ceilf(2.0f * ctx->cfg.search_radius_m / g->cell_m); /* contour.c */
     assert_true(o->hits && o->misses && o->labelled && o->tile_rank);
     assert_true(o->touched && o->wanted && o->list);
     for (int pass = 0; pass < 2; pass++)
