@@ -91,32 +91,6 @@ static uint32_t take_tiles(polyc_ctx *ctx, uint64_t work, int all, uint64_t *uni
     return taken;
 }
 
-/* A segment is seen from both sides when the endpoints within 10 cm of
- * it whose nearest it is were seen from its left and from its right in at
- * least this ratio (their unit views across it, by weight): a line drawn
- * between the two faces of a thin wall, each face 3 cm off it. Its summed
- * view nearly cancels, and the side rule of explained() left both faces to
- * it: on the sweep's thin walls, one line between the faces for most of a
- * wall's length, core precision 3 times the batch map's (seeds 2 and 6:
- * 7.0 and 6.4 mm; 1.9 and 2.8 mm with the rule, the batch's 2.3 and 2.8). */
-#define TWO_SIDED_RATIO 0.25f
-/* Only segments this long: on short ones (furniture, chair legs seen from
- * all round) the rule traced bits of clutter, orebro's finished map 523 ->
- * 624 polylines, 57 of them under 10 cm long against 23. */
-#define TWO_SIDED_MIN_M 0.5f
-
-/* Whether segment sg is seen from both sides, from the weights of views
- * across it that polyc__find_sides left in o->size.seg_sum (from its left)
- * and o->size.seg_w (from its right), scratch of the operators'. */
-static int two_sided(const polyc__opt *o, int32_t sg)
-{
-    const polyc__vertex *a = &o->s->v[sg], *b = &o->s->v[a->next];
-    float dx = b->x - a->x, dy = b->y - a->y;
-    float l = o->size.seg_sum[sg], r = o->size.seg_w[sg];
-    return dx * dx + dy * dy >= TWO_SIDED_MIN_M * TWO_SIDED_MIN_M && l > 0.0f && r > 0.0f &&
-           polyc__minf(l, r) >= TWO_SIDED_RATIO * polyc__maxf(l, r);
-}
-
 /* Whether the map explains a contour cell at (x, y), seen along (vx, vy)
  * (its endpoints' vectors to their sensors, summed): a segment passes
  * within `near` (a diagonal neighbour) of it; or one passes within `far`
@@ -142,7 +116,7 @@ static int explained(const polyc__opt *o, float x, float y, float near, float fa
             float d2 = polyc__seg_dist2(x, y, a->x, a->y, b->x, b->y);
             if (d2 <= near * near)
                 return 1;
-            if (d2 > far * far || (sides && two_sided(o, sg)))
+            if (d2 > far * far || (sides && polyc__two_sided(o, sg)))
                 continue;
             float dx = b->x - a->x, dy = b->y - a->y, len = sqrtf(dx * dx + dy * dy);
             if (!(len > 0.0f))

@@ -363,6 +363,9 @@ int polyc__link_crosses(const polyc__opt *o, int32_t a, int32_t b);
  * With left and right (per vertex, or NULL), also the weight of unit views
  * across each segment from its left and from its right. */
 void polyc__find_sides(polyc__opt *o, const int32_t *list, int32_t n, float *left, float *right);
+/* zip.c: whether segment sg is seen from both sides, from the left and
+ * right weights polyc__find_sides left in o->size.seg_sum and seg_w */
+int polyc__two_sided(const polyc__opt *o, int32_t sg);
 int polyc__op_zip(polyc__opt *o);
 void polyc__op_noise(polyc__opt *o, double sigma_m);
 int polyc__op_remove_vertices(polyc__opt *o, uint32_t since);

@@ -113,6 +113,42 @@ static void test_zip_same_side_band(void **state)
     fx_close(&f);
 }
 
+/* Two polylines 8 cm apart along one thin wall seen from both sides
+ * through a band of pose error (its two sides' returns mixed over the
+ * band): the lower line's points are seen 3 in 5 from below and 2 in 5 from
+ * above, the upper line's the other way round. Their sides are opposite,
+ * as two faces' would be, but both are seen from both sides: one goes.
+ * (test_zip_leaves_walls_10cm_apart: each face seen only from its own side
+ * stays.) */
+static void test_zip_two_sided_band(void **state)
+{
+    (void)state;
+    static fixture f;
+    static ptlist p;
+    static float seen[2 * MAX_PTS];
+    fx_open_hand(&f, 0.0f);
+    p.n = 0;
+    pts_line(&p, -1.0f, 0.0f, 1.0f, 0.0f, 0.02f);
+    int lower = p.n;
+    pts_line(&p, -1.0f, 0.08f, 1.0f, 0.08f, 0.02f);
+    for (int i = 0; i < p.n; i++) {
+        int k = i < lower ? i : i - lower, below = (k % 5 < 3) == (i < lower);
+        seen[2 * i] = p.xy[2 * i];
+        seen[2 * i + 1] = below ? -2.0f : 2.0f;
+    }
+    set_points_seen(&f, p.xy, seen, p.n);
+    clear_lines(&f.o);
+    const float a[4] = {-1.0f, 0.0f, 1.0f, 0.0f}, b[4] = {-1.0f, 0.08f, 1.0f, 0.08f};
+    add_line(&f.o, a, 2, 0);
+    add_line(&f.o, b, 2, 0);
+    rebuild(&f.o);
+    assert_true(polyc__op_zip(&f.o) >= 1);
+    check_books(&f.o, "two-sided band zip");
+    assert_int_equal(live_lines(&f.o), 1);
+    assert_int_equal(f.o.s->v_live, 2);
+    fx_close(&f);
+}
+
 /* A T junction: polyline B runs up a stem to (0, 0) and on along the wall
  * y = 0; polyline A comes along the wall from the left and runs `over` past
  * the junction, along B. Wall points are seen from below (y = -2), the
@@ -284,6 +320,7 @@ int main(void)
         cmocka_unit_test(test_zip_leaves_walls_10cm_apart),
         cmocka_unit_test(test_zip_same_side_band),
         cmocka_unit_test(test_zip_end_past_t_junction),
+        cmocka_unit_test(test_zip_two_sided_band),
         cmocka_unit_test(test_untangle_resolves_x),
         cmocka_unit_test(test_untangle_hairpin_through_wall),
         cmocka_unit_test(test_spike_past_corner_removed),
