@@ -245,28 +245,32 @@ static uint32_t simplify(int32_t *xy, uint32_t n)
 }
 
 /* A walk on none but the contour's data cells (contour.c: returns no
- * occupied cell explains) this short is not traced: a chair's legs, a
- * person who stood still for a moment. A wall seen at grazing angles is
+ * occupied cell explains) that spans less than this (the larger side of
+ * its cells' bounding box) is not traced: a chair, a person who stood still
+ * for a while (the sweep's shelves seed 4: a ring round a standing person,
+ * 0.4 m across, a 0.6 m walk, took the map's RMS from 2.4 to 94 mm when
+ * the walk's length was the measure). A wall seen at grazing angles is
  * longer. */
 #define DATA_ONLY_MIN_M 0.5f
 
-/* Whether the walk holds no occupied cell and is shorter than
- * DATA_ONLY_MIN_M along its cells. */
+/* Whether the walk holds no occupied cell and spans less than
+ * DATA_ONLY_MIN_M. */
 static int short_data_only(const polyc_ctx *ctx, const walk *w)
 {
     const polyc__grid *g = &ctx->grid;
-    float len = 0.0f;
+    int32_t x0 = INT32_MAX, y0 = INT32_MAX, x1 = INT32_MIN, y1 = INT32_MIN;
     for (uint32_t i = 0; i < w->n; i++) {
         int32_t ix = w->xy[2 * i], iy = w->xy[2 * i + 1];
         const polyc__tile *t = polyc__grid_tile(g, ix, iy);
         if (t && polyc__cell_occupied(t, polyc__cell_index(ix, iy), ctx->cfg.contour_threshold))
             return 0;
-        if (i > 0) {
-            float dx = (float)(ix - w->xy[2 * i - 2]), dy = (float)(iy - w->xy[2 * i - 1]);
-            len += sqrtf(dx * dx + dy * dy);
-        }
+        x0 = ix < x0 ? ix : x0;
+        x1 = ix > x1 ? ix : x1;
+        y0 = iy < y0 ? iy : y0;
+        y1 = iy > y1 ? iy : y1;
     }
-    return len * g->cell_m < DATA_ONLY_MIN_M;
+    int32_t span = (x1 - x0 > y1 - y0 ? x1 - x0 : y1 - y0) + 1;
+    return (float)span * g->cell_m < DATA_ONLY_MIN_M;
 }
 
 static polyc_status emit(polyc_ctx *ctx, walk *w, int closed)

@@ -25,6 +25,8 @@
 
 #define POSES 8u
 
+/* len > 0: the wall; len < 0: a disc of radius -len at (3, 2) (a person
+ * standing still) */
 static void scene(scansim_scene *sc, double len, int with_wall)
 {
     scansim_scene_init(sc, "door", 5u);
@@ -33,9 +35,11 @@ static void scene(scansim_scene *sc, double len, int with_wall)
     sc->laser.angle_step_rad = (float)(3.14159265358979 / 360.0);
     sc->laser.range_sigma_m = 0.005f;
     assert_int_equal(scansim_add_box(sc, 0.0, 0.0, 6.0, 4.0), 0);
-    if (with_wall) {
+    if (with_wall && len > 0.0) {
         const double xy[4] = {3.0 - len / 2.0, 2.0, 3.0 + len / 2.0, 2.0};
         assert_int_equal(scansim_add_wall(sc, xy, 2u, 0), 0);
+    } else if (with_wall) {
+        assert_int_equal(scansim_add_circle(sc, 3.0, 2.0, -len, 24u), 0);
     }
     for (uint32_t k = 0; k < POSES; k++)
         assert_int_equal(scansim_add_pose(sc, 2.3 + 0.2 * (double)k, 1.0, 1.5707963), 0);
@@ -44,7 +48,8 @@ static void scene(scansim_scene *sc, double len, int with_wall)
 
 /* The batch map of the scans (the first `seen` with the wall): the
  * length of map within 3 cm of the wall's line y = 2 inside the room's
- * middle (|x - 3| <= len / 2 + 0.1). */
+ * middle (|x - 3| <= len / 2 + 0.1); for a disc (len < 0), the length
+ * within its radius + 0.1 m of its centre. */
 static double wall_drawn(double len, uint32_t seen)
 {
     static scansim_scene with, without;
@@ -73,8 +78,10 @@ static double wall_drawn(double len, uint32_t seen)
         for (uint32_t j = 0; j + 1 < n; j++) {
             const float *p = &pl.xy_m[2 * j], *q = &pl.xy_m[2 * ((j + 1) % pl.point_count)];
             double ax = (double)p[0], ay = (double)p[1], bx = (double)q[0], by = (double)q[1];
-            int near_a = fabs(ay - 2.0) <= 0.03 && fabs(ax - 3.0) <= len / 2.0 + 0.1;
-            int near_b = fabs(by - 2.0) <= 0.03 && fabs(bx - 3.0) <= len / 2.0 + 0.1;
+            int near_a = len > 0.0 ? fabs(ay - 2.0) <= 0.03 && fabs(ax - 3.0) <= len / 2.0 + 0.1
+                                   : hypot(ax - 3.0, ay - 2.0) <= 0.1 - len;
+            int near_b = len > 0.0 ? fabs(by - 2.0) <= 0.03 && fabs(bx - 3.0) <= len / 2.0 + 0.1
+                                   : hypot(bx - 3.0, by - 2.0) <= 0.1 - len;
             if (near_a && near_b)
                 drawn += hypot(bx - ax, by - ay);
         }
@@ -102,12 +109,22 @@ static void test_rare_wall_not_drawn(void **state)
 }
 
 /* Seen by 3 of 8, a piece 30 cm long is not traced: the trace leaves
- * walks on such cells alone shorter than 0.5 m (a chair, a person who
+ * walks on such cells alone that span less than 0.5 m (a chair, a person who
  * stood still). */
 static void test_short_data_piece_not_drawn(void **state)
 {
     (void)state;
     assert_true(wall_drawn(0.3, 3u) == 0.0);
+}
+
+/* Seen by 3 of 8, a disc 0.4 m across (a person who stood still) is not
+ * traced: its walk round the disc is 0.6 m long but spans 0.4 m. Seen by
+ * all 8 it is occupied and drawn. */
+static void test_standing_person_not_drawn(void **state)
+{
+    (void)state;
+    assert_true(wall_drawn(-0.2, 3u) == 0.0);
+    assert_true(wall_drawn(-0.2, POSES) >= 0.4);
 }
 
 /* Seen by every scan, the wall is occupied and drawn, as always. */
@@ -123,6 +140,7 @@ int main(void)
         cmocka_unit_test(test_data_wall_drawn),
         cmocka_unit_test(test_rare_wall_not_drawn),
         cmocka_unit_test(test_short_data_piece_not_drawn),
+        cmocka_unit_test(test_standing_person_not_drawn),
         cmocka_unit_test(test_solid_wall_drawn),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
