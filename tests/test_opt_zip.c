@@ -35,11 +35,24 @@ static int brute_crossings(const polyc__opt *o)
     return n;
 }
 
-/* Data along two parallel 2 m walls `gap` apart, with a polyline on each. */
+/* The hand case's data (n points, each seen from its seen_xy) and two
+ * polylines, a (na points) and b (nb), in place of the room's. */
+static void two_lines_case(fixture *f, const float *xy, const float *seen, int n, const float *a,
+                           int na, const float *b, int nb)
+{
+    set_points_seen(f, xy, seen, n);
+    clear_lines(&f->o);
+    add_line(&f->o, a, na, 0);
+    add_line(&f->o, b, nb, 0);
+    rebuild(&f->o);
+}
+
 /* Two polylines along y = 0 and y = gap with their data; the points of the
  * second are seen from above (y = 2) and those of the first from below
- * (y = -2), or from above too when same_side. */
-static void parallel_case(fixture *f, float gap, int same_side)
+ * (y = -2); with `sides` SAME_SIDE from above too; with MIXED 3 in 5 of
+ * each line's points as said and 2 in 5 from the other side. */
+enum { OWN_SIDES, SAME_SIDE, MIXED };
+static void parallel_case(fixture *f, float gap, int sides)
 {
     static ptlist p;
     static float seen[2 * MAX_PTS];
@@ -48,15 +61,30 @@ static void parallel_case(fixture *f, float gap, int same_side)
     int first = p.n;
     pts_line(&p, -1.0f, gap, 1.0f, gap, 0.02f);
     for (int i = 0; i < p.n; i++) {
+        int k = i < first ? i : i - first;
+        int below = i < first && sides != SAME_SIDE;
+        if (sides == MIXED && k % 5 >= 3)
+            below = !below;
         seen[2 * i] = p.xy[2 * i];
-        seen[2 * i + 1] = i < first && !same_side ? -2.0f : 2.0f;
+        seen[2 * i + 1] = below ? -2.0f : 2.0f;
     }
-    set_points_seen(f, p.xy, seen, p.n);
-    clear_lines(&f->o);
     const float a[4] = {-1.0f, 0.0f, 1.0f, 0.0f}, b[4] = {-1.0f, gap, 1.0f, gap};
-    add_line(&f->o, a, 2, 0);
-    add_line(&f->o, b, 2, 0);
-    rebuild(&f->o);
+    two_lines_case(f, p.xy, seen, p.n, a, 2, b, 2);
+}
+
+/* The parallel case zips to one line, left whole, and a second zip finds
+ * nothing. */
+static void check_zipped_to_one(float gap, int sides, const char *what)
+{
+    static fixture f;
+    fx_open_hand(&f, 0.0f);
+    parallel_case(&f, gap, sides);
+    assert_true(polyc__op_zip(&f.o) >= 1);
+    check_books(&f.o, what);
+    assert_int_equal(live_lines(&f.o), 1);
+    assert_int_equal(f.o.s->v_live, 2);
+    assert_int_equal(polyc__op_zip(&f.o), 0);
+    fx_close(&f);
 }
 
 /* Two polylines 3 cm apart along one wall (its data a band between them):
@@ -64,28 +92,26 @@ static void parallel_case(fixture *f, float gap, int same_side)
 static void test_zip_parallel_lines_become_one(void **state)
 {
     (void)state;
-    static fixture f;
-    fx_open_hand(&f, 0.0f);
-    parallel_case(&f, 0.03f, 0);
-    assert_true(polyc__op_zip(&f.o) >= 1);
-    check_books(&f.o, "zip");
-    assert_int_equal(live_lines(&f.o), 1);
-    assert_int_equal(f.o.s->v_live, 2);
-    assert_int_equal(polyc__op_zip(&f.o), 0);
-    fx_close(&f);
+    check_zipped_to_one(0.03f, OWN_SIDES, "zip");
 }
 
 /* The two faces of a wall 10 cm thick, each seen from its own side, are two
  * lines: nothing is zipped. */
-static void test_zip_leaves_walls_10cm_apart(void **state)
+/* The parallel case is left as it is: two lines, nothing zipped. */
+static void check_left_as_two(float gap, int sides)
 {
-    (void)state;
     static fixture f;
     fx_open_hand(&f, 0.0f);
-    parallel_case(&f, 0.10f, 0);
+    parallel_case(&f, gap, sides);
     assert_int_equal(polyc__op_zip(&f.o), 0);
     assert_int_equal(live_lines(&f.o), 2);
     fx_close(&f);
+}
+
+static void test_zip_leaves_walls_10cm_apart(void **state)
+{
+    (void)state;
+    check_left_as_two(0.10f, OWN_SIDES);
 }
 
 /* Two lines 10 and 18 cm apart, both seen from the same side, are one wall
@@ -94,23 +120,10 @@ static void test_zip_leaves_walls_10cm_apart(void **state)
 static void test_zip_same_side_band(void **state)
 {
     (void)state;
-    static fixture f;
     const float gaps[2] = {0.10f, 0.18f};
-    for (int k = 0; k < 2; k++) {
-        fx_open_hand(&f, 0.0f);
-        parallel_case(&f, gaps[k], 1);
-        assert_true(polyc__op_zip(&f.o) >= 1);
-        check_books(&f.o, "band zip");
-        assert_int_equal(live_lines(&f.o), 1);
-        assert_int_equal(f.o.s->v_live, 2);
-        assert_int_equal(polyc__op_zip(&f.o), 0);
-        fx_close(&f);
-    }
-    fx_open_hand(&f, 0.0f);
-    parallel_case(&f, 0.25f, 1);
-    assert_int_equal(polyc__op_zip(&f.o), 0);
-    assert_int_equal(live_lines(&f.o), 2);
-    fx_close(&f);
+    for (int k = 0; k < 2; k++)
+        check_zipped_to_one(gaps[k], SAME_SIDE, "band zip");
+    check_left_as_two(0.25f, SAME_SIDE);
 }
 
 /* Two polylines 8 cm apart along one thin wall seen from both sides
@@ -123,30 +136,7 @@ static void test_zip_same_side_band(void **state)
 static void test_zip_two_sided_band(void **state)
 {
     (void)state;
-    static fixture f;
-    static ptlist p;
-    static float seen[2 * MAX_PTS];
-    fx_open_hand(&f, 0.0f);
-    p.n = 0;
-    pts_line(&p, -1.0f, 0.0f, 1.0f, 0.0f, 0.02f);
-    int lower = p.n;
-    pts_line(&p, -1.0f, 0.08f, 1.0f, 0.08f, 0.02f);
-    for (int i = 0; i < p.n; i++) {
-        int k = i < lower ? i : i - lower, below = (k % 5 < 3) == (i < lower);
-        seen[2 * i] = p.xy[2 * i];
-        seen[2 * i + 1] = below ? -2.0f : 2.0f;
-    }
-    set_points_seen(&f, p.xy, seen, p.n);
-    clear_lines(&f.o);
-    const float a[4] = {-1.0f, 0.0f, 1.0f, 0.0f}, b[4] = {-1.0f, 0.08f, 1.0f, 0.08f};
-    add_line(&f.o, a, 2, 0);
-    add_line(&f.o, b, 2, 0);
-    rebuild(&f.o);
-    assert_true(polyc__op_zip(&f.o) >= 1);
-    check_books(&f.o, "two-sided band zip");
-    assert_int_equal(live_lines(&f.o), 1);
-    assert_int_equal(f.o.s->v_live, 2);
-    fx_close(&f);
+    check_zipped_to_one(0.08f, MIXED, "two-sided band zip");
 }
 
 /* A T junction: polyline B runs up a stem to (0, 0) and on along the wall
@@ -169,12 +159,8 @@ static void t_case(fixture *f, float over, float a_y, int a_above)
         seen[2 * i] = i < wall ? p.xy[2 * i] : i < stem ? 2.0f : p.xy[2 * i];
         seen[2 * i + 1] = i < wall ? -2.0f : i < stem ? p.xy[2 * i + 1] : 2.0f;
     }
-    set_points_seen(f, p.xy, seen, p.n);
-    clear_lines(&f->o);
     const float a[4] = {-1.0f, a_y, over, a_y}, b[6] = {0.0f, -1.0f, 0.0f, 0.0f, 1.0f, 0.0f};
-    add_line(&f->o, a, 2, 0);
-    add_line(&f->o, b, 3, 0);
-    rebuild(&f->o);
+    two_lines_case(f, p.xy, seen, p.n, a, 2, b, 3);
 }
 
 /* An end 11 cm past a T junction, along the other polyline and seen from
