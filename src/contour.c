@@ -1,7 +1,9 @@
 /* contour.c - the contour (paper section III, second ray casting).
  * Takes: the hit/miss grid and the scans. Gives: the cells where a beam
- * first meets a cell with m > contour_threshold, as bits in the tiles and as
- * a list (each beam labels at most one cell, so the list is bounded). */
+ * first meets a cell with m > contour_threshold, or, for a reflection that
+ * meets none, its end cell when the data fallback takes it (below); as bits
+ * in the tiles and as a list (each beam labels at most one cell, so the
+ * list is bounded). */
 #include "walk.h"
 
 #include <stddef.h>
