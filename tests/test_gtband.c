@@ -91,6 +91,50 @@ static void test_parallel_same_side(void **state)
     }
 }
 
+/* The runs reported by gtband_score_map_runs: how many, their summed
+ * length and the last one's ends. */
+typedef struct runs_seen {
+    int n;
+    double sum_m;
+    double last[4];
+} runs_seen;
+
+static void see_run(void *user, const double run_xy_m[4], double length_m)
+{
+    runs_seen *r = user;
+    r->n++;
+    r->sum_m += length_m;
+    memcpy(r->last, run_xy_m, sizeof r->last);
+}
+
+/* The two parallel lines 8 cm apart seen from below: two runs, one on each
+ * line, 1 m each (a's 0 .. 1 m on y = 0, b's on y = 0.08), summing to
+ * band15; seen from opposite sides, none. */
+static void test_runs_reported(void **state)
+{
+    static const float a[] = {0.0f, 0.0f, 1.0f, 0.0f};
+    static const float b[] = {0.0f, 0.08f, 1.0f, 0.08f};
+    polyc_polyline lines[2] = {{a, 2, 0}, {b, 2, 0}};
+    static data d;
+    gtband_score sc;
+    runs_seen r;
+    (void)state;
+    for (int side = 0; side < 2; side++) {
+        memset(&d, 0, sizeof d);
+        memset(&r, 0, sizeof r);
+        add_points(&d, 0.0, 0.0, 1.0, 0.0, 49, -1.0);
+        add_points(&d, 0.0, 0.08, 1.0, 0.0, 49, side ? 1.0 : -1.0);
+        assert_int_equal(gtband_score_map_runs(lines, 2, d.xy, d.from, d.n, &sc, see_run, &r), 0);
+        assert_int_equal(r.n, side ? 0 : 2);
+        assert_near(r.sum_m, sc.band_m, 1e-9);
+        if (!side) {
+            assert_near(r.sum_m, 2.0, 1e-9);
+            assert_near(r.last[1], 0.08, 1e-6); /* b's run, on y = 0.08 (float vertices) */
+            assert_near(fabs(r.last[2] - r.last[0]), 1.0, 0.011);
+        }
+    }
+}
+
 /* The same lines, the upper one shifted by 0.5 m (0.5 .. 1.5 m): a's
  * samples lie within 15 cm of b from x >= 0.5 - sqrt(0.15^2 - 0.08^2) =
  * 0.3731 m (0.38 .. 0.99: 62 samples), b's up to x <= 1.1269 m (0.50 ..
@@ -301,6 +345,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_parallel_same_side),
+        cmocka_unit_test(test_runs_reported),
         cmocka_unit_test(test_parallel_overlap),
         cmocka_unit_test(test_step),
         cmocka_unit_test(test_not_bands),

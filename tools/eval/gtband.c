@@ -144,7 +144,8 @@ static int doubled(const gtscore_index *ix, const band_seg *segs, uint32_t s, do
     return gtscore_index_any_near(ix, x, y, GTBAND_REACH_M, band_accepts, &p);
 }
 
-static void band(const gtscore_index *ix, const band_seg *segs, gtband_score *out)
+static void band(const gtscore_index *ix, const band_seg *segs, gtband_score *out,
+                 gtband_run_fn report, void *user)
 {
     /* parallel within the angle: |sin| of the angle between them (to 1e-12) */
     double sin_max = sin(GTBAND_ANGLE_DEG * 3.14159265358979323846 / 180.0) + 1e-12;
@@ -166,8 +167,15 @@ static void band(const gtscore_index *ix, const band_seg *segs, gtband_score *ou
                     continue;
                 }
             }
-            if ((double)run * spacing > GTBAND_RUN_M + RUN_EPS_M)
+            if ((double)run * spacing > GTBAND_RUN_M + RUN_EPS_M) {
                 out->band_m += (double)run * spacing;
+                if (report) {
+                    double u0 = (double)(k - run) / (double)t->pieces, u1 = (double)k / (double)t->pieces;
+                    const double xy[4] = {g[0] + (g[2] - g[0]) * u0, g[1] + (g[3] - g[1]) * u0,
+                                          g[0] + (g[2] - g[0]) * u1, g[1] + (g[3] - g[1]) * u1};
+                    report(user, xy, (double)run * spacing);
+                }
+            }
             run = 0;
         }
     }
@@ -175,6 +183,14 @@ static void band(const gtscore_index *ix, const band_seg *segs, gtband_score *ou
 
 int gtband_score_map(const polyc_polyline *lines, uint32_t count, const double *points_xy_m,
                      const double *sensors_xy_m, uint64_t point_count, gtband_score *out)
+{
+    return gtband_score_map_runs(lines, count, points_xy_m, sensors_xy_m, point_count, out, NULL,
+                                 NULL);
+}
+
+int gtband_score_map_runs(const polyc_polyline *lines, uint32_t count, const double *points_xy_m,
+                          const double *sensors_xy_m, uint64_t point_count, gtband_score *out,
+                          gtband_run_fn run, void *user)
 {
     gtscore_index ix;
     band_seg *segs = NULL;
@@ -210,7 +226,7 @@ int gtband_score_map(const polyc_polyline *lines, uint32_t count, const double *
         t->fy = t->ux * (double)t->side;
         out->sided_segments += t->side != 0;
     }
-    band(&ix, segs, out);
+    band(&ix, segs, out, run, user);
     rc = 0;
 done:
     free(segs);

@@ -65,12 +65,23 @@ typedef struct gtband_score {
     uint32_t sided_segments;
 } gtband_score;
 
+/* Each run band15 counts, as gtband_score_map_runs finds it: its start and
+ * end on the segment (x0, y0, x1, y1, metres) and its length. */
+typedef void (*gtband_run_fn)(void *user, const double run_xy_m[4], double length_m);
+
 /* Scores the map `lines` (count records) against point_count data points:
  * points_xy_m and sensors_xy_m hold x, y interleaved, the point and the
  * position it was seen from (both may be NULL when point_count is 0: no
  * segment has a side). *out is zeroed first. */
 int gtband_score_map(const polyc_polyline *lines, uint32_t count, const double *points_xy_m,
                      const double *sensors_xy_m, uint64_t point_count, gtband_score *out);
+
+/* The same, and each run that band15 counts to run(user, ...) (none when
+ * run is NULL), segment by segment in the index's order: where a map is
+ * drawn as a band, to look at. */
+int gtband_score_map_runs(const polyc_polyline *lines, uint32_t count, const double *points_xy_m,
+                          const double *sensors_xy_m, uint64_t point_count, gtband_score *out,
+                          gtband_run_fn run, void *user);
 
 /* The endpoints of the reflected beams (gtscore_beam_reflected) of `scans`
  * in gttopo_scan_points' order, and for each its scan's pose (x, y): two

@@ -25,7 +25,7 @@
 #define EXIT_USAGE 2
 
 static const char usage_text[] =
-    "usage: mapscore LOG [MAP.txt]\n"
+    "usage: mapscore [--runs] LOG [MAP.txt]\n"
     "Scores MAP (as `polyc --format txt` writes it; without MAP: the log mapped\n"
     "with the library's defaults) against LOG's scan endpoints, one row:\n"
     "lines, verts; len = map length (m); dcov (m, and % of len), cross, uns20,\n"
@@ -34,6 +34,9 @@ static const char usage_text[] =
     "end5 = share of endpoints within 20 / 10 / 5 cm of the map\n"
     "(tools/eval/gtband.h, docs/evaluation.md); libms = the library's time\n"
     "(without MAP; 0 with it), scorems = the scorers' time.\n"
+    "--runs: then each run band15 counts, one a line: `run X0 Y0 X1 Y1 LEN`\n"
+    "(its ends on its segment and its length, metres), to find where a map\n"
+    "draws a wall as a band.\n"
     "Exit: 0 ok; 1 the log, the map or the library failed; 2 usage.\n";
 
 /* The polylines of a TXT map: "open|closed N x1 y1 ... xN yN" per line.
@@ -96,6 +99,31 @@ static void free_lines(polyc_polyline *lines, uint32_t count, int owned_points)
     free(lines);
 }
 
+/* The runs band15 counts, kept for printing after the row. */
+typedef struct run_list {
+    double *xy_len;                /* 5 per run: x0, y0, x1, y1, length */
+    size_t n, cap;
+    int failed;
+} run_list;
+
+static void keep_run(void *user, const double run_xy_m[4], double length_m)
+{
+    run_list *r = user;
+    if (r->n == r->cap) {
+        size_t cap = r->cap ? 2 * r->cap : 64;
+        double *grown = realloc(r->xy_len, cap * 5 * sizeof *grown);
+        if (!grown) {
+            r->failed = 1;
+            return;
+        }
+        r->xy_len = grown;
+        r->cap = cap;
+    }
+    memcpy(&r->xy_len[5 * r->n], run_xy_m, 4 * sizeof *run_xy_m);
+    r->xy_len[5 * r->n + 4] = length_m;
+    r->n++;
+}
+
 int main(int argc, char **argv)
 {
     scanlog log;
@@ -107,12 +135,19 @@ int main(int argc, char **argv)
     double *xy = NULL, *from = NULL, lib_ms = 0.0, t0;
     uint64_t n = 0;
     FILE *f;
-    int rc = EXIT_FAILED, from_file = argc == 3;
+    int rc = EXIT_FAILED, from_file, want_runs = 0;
+    run_list runs = {NULL, 0, 0, 0};
 
     if (argc == 2 && (strcmp(argv[1], "-h") == 0 || strcmp(argv[1], "--help") == 0)) {
         fputs(usage_text, stdout);
         return 0;
     }
+    if (argc >= 2 && strcmp(argv[1], "--runs") == 0) {
+        want_runs = 1;
+        argv++;
+        argc--;
+    }
+    from_file = argc == 3;
     if (argc < 2 || argc > 3 || argv[1][0] == '-' || (from_file && argv[2][0] == '-')) {
         fputs(usage_text, stderr);
         return EXIT_USAGE;
@@ -153,7 +188,9 @@ int main(int argc, char **argv)
     t0 = pipeline_now_ms();
     if (gtband_scan_points(log.scans, log.count, &xy, &from, &n) != 0 ||
         gttopo_score_map(lines, count, xy, n, &topo) != 0 ||
-        gtband_score_map(lines, count, xy, from, n, &band) != 0) {
+        gtband_score_map_runs(lines, count, xy, from, n, &band, want_runs ? keep_run : NULL,
+                              &runs) != 0 ||
+        runs.failed) {
         fprintf(stderr, "mapscore: the scorers ran out of memory\n");
         goto done;
     }
@@ -169,8 +206,13 @@ int main(int argc, char **argv)
            band.band_m, band.map_length_m > 0.0 ? 100.0 * band.band_m / band.map_length_m : 0.0,
            gtband_share(band.within_20, band.points), gtband_share(band.within_10, band.points),
            gtband_share(band.within_5, band.points), lib_ms, pipeline_now_ms() - t0);
+    for (size_t k = 0; k < runs.n; k++) {
+        const double *r = &runs.xy_len[5 * k];
+        printf("run %.3f %.3f %.3f %.3f %.3f\n", r[0], r[1], r[2], r[3], r[4]);
+    }
     rc = 0;
 done:
+    free(runs.xy_len);
     free(xy);
     free(from);
     free_lines(lines, count, from_file);
