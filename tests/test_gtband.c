@@ -41,6 +41,10 @@ static void add_points(data *d, double x0, double y0, double dx, double dy, int 
     }
 }
 
+/* Two parallel 1 m lines 8 cm apart, the cases' map. */
+static const float LOWER[] = {0.0f, 0.0f, 1.0f, 0.0f};
+static const float UPPER[] = {0.0f, 0.08f, 1.0f, 0.08f};
+
 static gtband_score score(const polyc_polyline *lines, uint32_t count, const data *d)
 {
     gtband_score sc;
@@ -67,9 +71,7 @@ static gtband_score score_two_runs(const polyc_polyline *lines, double x_b, doub
  * upper line from y = +1, a thin wall): 0. */
 static void test_parallel_same_side(void **state)
 {
-    static const float a[] = {0.0f, 0.0f, 1.0f, 0.0f};
-    static const float b[] = {0.0f, 0.08f, 1.0f, 0.08f};
-    polyc_polyline lines[2] = {{a, 2, 0}, {b, 2, 0}};
+    polyc_polyline lines[2] = {{LOWER, 2, 0}, {UPPER, 2, 0}};
     gtband_score sc;
     (void)state;
     sc = score_two_runs(lines, 0.0, 0.08, 1.0, 0.0, -1.0);
@@ -112,9 +114,7 @@ static void see_run(void *user, const double run_xy_m[4], double length_m)
  * band15; seen from opposite sides, none. */
 static void test_runs_reported(void **state)
 {
-    static const float a[] = {0.0f, 0.0f, 1.0f, 0.0f};
-    static const float b[] = {0.0f, 0.08f, 1.0f, 0.08f};
-    polyc_polyline lines[2] = {{a, 2, 0}, {b, 2, 0}};
+    polyc_polyline lines[2] = {{LOWER, 2, 0}, {UPPER, 2, 0}};
     static data d;
     gtband_score sc;
     runs_seen r;
@@ -224,9 +224,7 @@ static void test_not_bands(void **state)
  * the votes' sum: 30 votes from below and 20 from above make it "below". */
 static void test_votes(void **state)
 {
-    static const float a[] = {0.0f, 0.0f, 1.0f, 0.0f};
-    static const float b[] = {0.0f, 0.08f, 1.0f, 0.08f};
-    polyc_polyline lines[2] = {{a, 2, 0}, {b, 2, 0}};
+    polyc_polyline lines[2] = {{LOWER, 2, 0}, {UPPER, 2, 0}};
     static data d;
     gtband_score sc;
     (void)state;
