@@ -78,13 +78,21 @@ static int occupied(const polyc__tile *t, int idx)
  * cells alone (trace.c). */
 #define DATA_ALONE_RADII 2.0f
 
-/* Whether cell idx of tile t is occupied: from the tile's marks (`bits`,
- * as the contour pass sets them) or from its counts. */
-static int occupied_at(const polyc_ctx *ctx, const polyc__tile *t, int idx, int bits)
+/* Whether an occupied cell lies in columns c0..c1 (within one tile) of row
+ * r of tile t: from the tile's marks (`bits`, as the contour pass sets
+ * them) or from its counts. */
+static int occupied_in_row(const polyc_ctx *ctx, const polyc__tile *t, int r, int c0, int c1,
+                           int bits)
 {
-    if (bits)
-        return occupied(t, idx);
-    return polyc__cell_occupied(t, idx, ctx->cfg.contour_threshold);
+    if (bits) {
+        uint32_t below_c1 = c1 == POLYC__TILE_SIDE - 1 ? ~0u : (1u << (c1 + 1)) - 1u;
+        uint32_t mask = below_c1 & ~((1u << c0) - 1u);
+        return (t->mark[r] & mask) != 0;
+    }
+    for (int c = c0; c <= c1; c++)
+        if (polyc__cell_occupied(t, (r << POLYC__TILE_SHIFT) | c, ctx->cfg.contour_threshold))
+            return 1;
+    return 0;
 }
 
 int polyc__contour_data_alone(const polyc_ctx *ctx, int32_t ix, int32_t iy, int bits)
@@ -93,19 +101,19 @@ int polyc__contour_data_alone(const polyc_ctx *ctx, int32_t ix, int32_t iy, int 
     const polyc__tile *t = polyc__grid_tile(g, ix, iy);
     if (!t)
         return 0;
-    int idx = polyc__cell_index(ix, iy);
-    unsigned h = t->hits[idx], m = t->misses[idx];
-    if (h == 0 || (float)h < ctx->cfg.data_min_m * (float)(h + m))
+    if (!polyc__cell_holds_data(t, polyc__cell_index(ix, iy), ctx->cfg.data_min_m))
         return 0;
     int32_t r = (int32_t)ceilf(DATA_ALONE_RADII * ctx->cfg.search_radius_m / g->cell_m);
-    for (int32_t y = iy - r; y <= iy + r; y++)
-        for (int32_t x = ix - r; x <= ix + r; x++) {
-            const polyc__tile *u = x >= 0 && y >= 0 && x < g->width && y < g->height ? polyc__grid_tile(g, x, y) : NULL;
-            if (!u) { /* no tile: no occupied cell up to its edge */
-                x |= POLYC__TILE_SIDE - 1;
-                continue;
-            }
-            if (occupied_at(ctx, u, polyc__cell_index(x, y), bits))
+    int32_t x_lo = ix - r > 0 ? ix - r : 0, x_hi = ix + r < g->width - 1 ? ix + r : g->width - 1;
+    int32_t y_lo = iy - r > 0 ? iy - r : 0, y_hi = iy + r < g->height - 1 ? iy + r : g->height - 1;
+    for (int32_t y = y_lo; y <= y_hi; y++)
+        for (int32_t x = x_lo; x <= x_hi; x = (x | (POLYC__TILE_SIDE - 1)) + 1) {
+            /* the row's cells in one tile at a time (none where no tile
+             * is stored: no beam ended in a hit there) */
+            int32_t end = x | (POLYC__TILE_SIDE - 1);
+            const polyc__tile *u = polyc__grid_tile(g, x, y);
+            if (u && occupied_in_row(ctx, u, y & (POLYC__TILE_SIDE - 1), x & (POLYC__TILE_SIDE - 1),
+                                     (end < x_hi ? end : x_hi) & (POLYC__TILE_SIDE - 1), bits))
                 return 0;
         }
     return 1;
@@ -118,7 +126,8 @@ static int end_cell(polyc_ctx *ctx, const polyc__walk *w, int hit)
     const polyc__tile *t = polyc__grid_tile(&ctx->grid, w->ex, w->ey);
     if (!t)
         return 1;
-    if (occupied(t, polyc__cell_index(w->ex, w->ey)) || (hit && polyc__contour_data_alone(ctx, w->ex, w->ey, 1)))
+    if (occupied(t, polyc__cell_index(w->ex, w->ey)) ||
+        (hit && polyc__contour_data_alone(ctx, w->ex, w->ey, 1)))
         return label(ctx, w->ex, w->ey);
     return 1;
 }

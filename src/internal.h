@@ -344,6 +344,14 @@ static inline float polyc__turn_rad(float cross, float dot)
 }
 /* m > threshold, evaluated without division: hits > t * (hits + misses) */
 int polyc__cell_occupied(const polyc__tile *t, int idx, float threshold);
+/* the data rule: a cell with hits that the grid does not judge free,
+ * m >= data_min (config.data_min_m: points.c's data points, contour.c's
+ * fallback); inline, for points.c's passes over every cell */
+static inline int polyc__cell_holds_data(const polyc__tile *t, int idx, float data_min)
+{
+    unsigned h = t->hits[idx], m = t->misses[idx];
+    return h > 0 && (float)h >= data_min * (float)(h + m);
+}
 /* contour.c: whether cell (ix, iy) holds data with no occupied cell near
  * it, which the end of a reflection that met no occupied cell labels as
  * contour (`bits`: the tiles' marks hold the occupied cells, as in the

@@ -179,7 +179,8 @@ static int32_t taken_points(polyc_ctx *ctx, uint32_t taken)
 }
 
 /* The taken tiles' contour cells that are occupied now (or data alone now:
- * contour.c's fallback) and that no polyline explains, marked and listed for the trace; returns their count.
+ * contour.c's fallback) and that no polyline explains, marked and listed
+ * for the trace; returns their count.
  * `all`: every tile is taken (the sides from every point). */
 static uint32_t unexplained_cells(polyc_ctx *ctx, uint32_t taken, float near, int all)
 {
@@ -213,7 +214,8 @@ static uint32_t unexplained_cells(polyc_ctx *ctx, uint32_t taken, float near, in
             for (int c = 0; t->contour[r] != 0 && c < POLYC__TILE_SIDE; c++) {
                 int idx = (r << POLYC__TILE_SHIFT) | c;
                 if (!((t->contour[r] >> c) & 1u) || n >= on->cells_cap ||
-                    (!polyc__cell_occupied(t, idx, thr) && !polyc__contour_data_alone(ctx, tx + c, ty + r, 0)))
+                    (!polyc__cell_occupied(t, idx, thr) &&
+                     !polyc__contour_data_alone(ctx, tx + c, ty + r, 0)))
                     continue;
                 float x = (float)(ox + ((double)(tx + c) + 0.5) * (double)g->cell_m);
                 float y = (float)(oy + ((double)(ty + r) + 0.5) * (double)g->cell_m);

@@ -15,13 +15,6 @@ typedef struct endpoint {
     float vx, vy;                  /* from the endpoint to its sensor, metres */
 } endpoint;
 
-/* The data rule: a cell with hits that the grid does not judge free. */
-static int cell_holds_data(const polyc_ctx *ctx, const polyc__tile *t, int idx)
-{
-    unsigned h = t->hits[idx], m = t->misses[idx];
-    return h > 0 && (float)h >= ctx->cfg.data_min_m * (float)(h + m);
-}
-
 static int endpoint_of(const polyc_ctx *ctx, const polyc__scan *s, uint32_t i, endpoint *e)
 {
     polyc__beam b;
@@ -38,7 +31,7 @@ static int endpoint_of(const polyc_ctx *ctx, const polyc__scan *s, uint32_t i, e
      * accepting points next to solid cells, lets people walking along walls
      * in: measured on the corridor scene, it tripled the vertex count.) */
     const polyc__tile *t = polyc__grid_tile(&ctx->grid, e->ix, e->iy);
-    return t && cell_holds_data(ctx, t, polyc__cell_index(e->ix, e->iy));
+    return t && polyc__cell_holds_data(t, polyc__cell_index(e->ix, e->iy), ctx->cfg.data_min_m);
 }
 
 static float cell_centre(double origin, int32_t i, float cell)
@@ -86,7 +79,8 @@ static void mark_tile(const polyc_ctx *ctx, polyc__tile *t)
             any |= word;
         }
         for (int32_t c = 0; any != 0 && c < side; c++)
-            if (t->hits[r * side + c] != 0 && cell_holds_data(ctx, t, r * side + c))
+            if (t->hits[r * side + c] != 0 &&
+                polyc__cell_holds_data(t, r * side + c, ctx->cfg.data_min_m))
                 t->mark[r & block] |= 1u << (c & block);
     }
 }
@@ -232,7 +226,7 @@ static double sum_tile(const polyc_ctx *ctx, int32_t d, polyc__point *tmp, float
     const polyc__tile *t = &g->tiles[k];
     double raw = 0.0;
     for (int idx = 0; idx < POLYC__TILE_CELLS; idx++) {
-        if (!t->hits[idx] || !cell_holds_data(ctx, t, idx))
+        if (!t->hits[idx] || !polyc__cell_holds_data(t, idx, ctx->cfg.data_min_m))
             continue;
         uint32_t e = polyc__cell_find(on, polyc__cell_key(k, idx));
         if (!e)

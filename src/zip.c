@@ -483,7 +483,8 @@ static int zip_pass(polyc__opt *o, uint32_t since)
                 float nx = 0.0f, ny = 0.0f;
                 int32_t cand[BAND_CANDIDATES];
                 seen_normal(o, v, &nx, &ny);
-                q = band_other(o, mx, my, cand, band_candidates(o, v, nx, ny, two_sided_now(o, v), cand));
+                int n_cand = band_candidates(o, v, nx, ny, two_sided_now(o, v), cand);
+                q = band_other(o, mx, my, cand, n_cand);
             } else {
                 float qd2;
                 q = nearest_other(o, mx, my, v, w, &qd2);

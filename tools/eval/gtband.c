@@ -170,7 +170,8 @@ static void band(const gtscore_index *ix, const band_seg *segs, gtband_score *ou
             if ((double)run * spacing > GTBAND_RUN_M + RUN_EPS_M) {
                 out->band_m += (double)run * spacing;
                 if (report) {
-                    double u0 = (double)(k - run) / (double)t->pieces, u1 = (double)k / (double)t->pieces;
+                    double u0 = (double)(k - run) / (double)t->pieces;
+                    double u1 = (double)k / (double)t->pieces;
                     const double xy[4] = {g[0] + (g[2] - g[0]) * u0, g[1] + (g[3] - g[1]) * u0,
                                           g[0] + (g[2] - g[0]) * u1, g[1] + (g[3] - g[1]) * u1};
                     report(user, xy, (double)run * spacing);
