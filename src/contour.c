@@ -40,7 +40,8 @@ size_t polyc__contour_bytes(const polyc_limits *lim)
     return a.peak;
 }
 
-/* Labels cell (ix, iy) once; 0 when the list is full. */
+/* Labels cell (ix, iy) once; 0 when the list is full. An online context
+ * keeps no list (contour_xy NULL): the bits alone. */
 static int label(polyc_ctx *ctx, int32_t ix, int32_t iy)
 {
     polyc__tile *t = polyc__grid_tile(&ctx->grid, ix, iy);
@@ -48,6 +49,10 @@ static int label(polyc_ctx *ctx, int32_t ix, int32_t iy)
     uint32_t *row = &t->contour[iy & (POLYC__TILE_SIDE - 1)];
     if (*row & bit)
         return 1;
+    if (!ctx->contour_xy) {
+        *row |= bit;
+        return 1;
+    }
     if (ctx->contour_count >= ctx->lim.max_beams)
         return 0;
     *row |= bit;
@@ -202,18 +207,15 @@ static int contour_beam(polyc_ctx *ctx, const uint32_t *busy, const polyc__beam 
     return walk_tiles(ctx, busy, &w, b->hit);
 }
 
-polyc_status polyc__contour_build(polyc_ctx *ctx)
+/* The tiles' marks (m > threshold, once per cell), their contour bits
+ * cleared if `clear`, and the busy bits: a directory entry's tile holds an
+ * occupied cell. */
+static void mark_occupied(polyc__grid *g, float threshold, int clear, uint32_t *busy)
 {
-    polyc__grid *g = &ctx->grid;
-    ctx->contour_count = 0;
-    ctx->contour_xy = polyc__contour_list(&ctx->arena, &ctx->lim);
-    if (!ctx->contour_xy)
-        return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the contour");
-    /* m > threshold once per cell, as bits in the scratch marks */
-    float threshold = ctx->cfg.contour_threshold;
     for (uint32_t k = 0; k < g->tile_count; k++) {
         polyc__tile *t = &g->tiles[k];
-        memset(t->contour, 0, sizeof t->contour);
+        if (clear)
+            memset(t->contour, 0, sizeof t->contour);
         for (int r = 0; r < POLYC__TILE_SIDE; r++) {
             uint32_t bits = 0;
             for (int c = 0; c < POLYC__TILE_SIDE; c++)
@@ -222,11 +224,7 @@ polyc_status polyc__contour_build(polyc_ctx *ctx)
             t->mark[r] = bits;
         }
     }
-    /* a bit per directory entry: the tile holds an occupied cell (scratch) */
-    size_t mark = ctx->arena.used, dir_n = (size_t)g->tiles_x * (size_t)g->tiles_y;
-    uint32_t *busy = busy_bits(&ctx->arena, dir_n);
-    if (!busy)
-        return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the contour");
+    size_t dir_n = (size_t)g->tiles_x * (size_t)g->tiles_y;
     for (size_t d = 0; g->dir && d < dir_n; d++)
         if (g->dir[d] != 0) {
             const polyc__tile *t = &g->tiles[g->dir[d] - 1];
@@ -236,9 +234,28 @@ polyc_status polyc__contour_build(polyc_ctx *ctx)
             if (any)
                 busy[d >> 5] |= 1u << (d & 31);
         }
+}
+
+size_t polyc__contour_cast_bytes(size_t dir_n)
+{
+    return polyc__bytes(dir_n / 32 + 1, sizeof(uint32_t));
+}
+
+/* Marks the grid and casts scans[0 .. n-1] (only those whose bit is set
+ * in `only`, if given); the busy bits are scratch on the arena. 0: no room for them; -1: the list is full. */
+static int cast(polyc_ctx *ctx, const polyc__scan *scans, uint32_t n, int clear, const uint32_t *only)
+{
+    polyc__grid *g = &ctx->grid;
+    size_t mark = ctx->arena.used;
+    uint32_t *busy = busy_bits(&ctx->arena, (size_t)g->tiles_x * (size_t)g->tiles_y);
+    if (!busy)
+        return 0;
+    mark_occupied(g, ctx->cfg.contour_threshold, clear, busy);
     int full = 0;
-    for (uint32_t si = 0; si < ctx->scan_count; si++) {
-        const polyc__scan *s = &ctx->scans[si];
+    for (uint32_t si = 0; si < n; si++) {
+        if (only && !((only[si >> 5] >> (si & 31)) & 1u))
+            continue;
+        const polyc__scan *s = &scans[si];
         for (uint32_t i = 0; i < s->count; i++) {
             polyc__beam b;
             if (polyc__beam_path(ctx, s, i, &b) && !contour_beam(ctx, busy, &b))
@@ -246,8 +263,25 @@ polyc_status polyc__contour_build(polyc_ctx *ctx)
         }
     }
     ctx->arena.used = mark;
-    POLYC_ASSERT(!full);
-    (void)full;
+    return full ? -1 : 1;
+}
+
+int polyc__contour_cast(polyc_ctx *ctx, const polyc__scan *scans, uint32_t n, int clear,
+                        const uint32_t *only)
+{
+    return cast(ctx, scans, n, clear, only) > 0;
+}
+
+polyc_status polyc__contour_build(polyc_ctx *ctx)
+{
+    ctx->contour_count = 0;
+    ctx->contour_xy = polyc__contour_list(&ctx->arena, &ctx->lim);
+    if (!ctx->contour_xy)
+        return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the contour");
+    int r = cast(ctx, ctx->scans, ctx->scan_count, 1, NULL);
+    if (r == 0)
+        return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the contour");
+    POLYC_ASSERT(r > 0);
     ctx->stats.contour_cells = ctx->contour_count;
     return POLYC_OK;
 }

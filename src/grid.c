@@ -216,6 +216,7 @@ typedef struct count_pass {
     polyc__arena *a;
     const uint32_t *wanted;
     polyc__tile *spill;
+    int records;                   /* online: misses in tiles not stored into their records */
 } count_pass;
 
 /* ---- an online grid's misses in tiles not stored ----
@@ -388,7 +389,7 @@ static inline void count_beam(const count_pass *p, const polyc__beam *b, int tak
     if (w.n > 0 && (!polyc__walk_enter(&w, g->width, g->height) || !(t = tile_get(p, w.ix, w.iy))))
         return;
     while (w.n > 0) {
-        if (t == p->spill && g->pre_miss) {
+        if (t == p->spill && p->records) {
             /* online: into the record of this tile not stored */
             int left = pre_walk(g, dir_index(g, w.ix, w.iy), &w, miss_end, take_back);
             if (left && w.n > 0 &&
@@ -490,9 +491,10 @@ static void want_hits(polyc_ctx *ctx, const polyc__scan *s)
     }
 }
 
-/* Counts (or takes back) every beam of the scan. */
+/* Counts (or takes back) every beam of the scan; with `records`, an online
+ * grid's misses in the tiles not stored too. */
 static polyc_status count_scan(polyc_ctx *ctx, const polyc__scan *s, int take_back,
-                               uint32_t *on_hits)
+                               uint32_t *on_hits, int records)
 {
     polyc__grid *g = &ctx->grid;
     count_pass p;
@@ -500,6 +502,7 @@ static polyc_status count_scan(polyc_ctx *ctx, const polyc__scan *s, int take_ba
     p.a = &ctx->arena;
     p.wanted = g->wanted;
     p.spill = g->spill;
+    p.records = records && g->pre_miss;
     step_rot rot = {cosf(s->step_rad), sinf(s->step_rad)};
     for (uint32_t i = 0; i < s->count; i++) {
         polyc__beam b;
@@ -526,6 +529,98 @@ static void grid_stats(polyc_ctx *ctx)
     ctx->stats.grid_bytes = (uint64_t)g->fixed_bytes + (uint64_t)g->tile_count * sizeof(polyc__tile);
 }
 
+/* ---- the records made again after a recount ----
+ * Counting every kept scan again (a pose correction of most of them) as
+ * the batch counts, over the tiles not stored in one move, saves walking
+ * their cells: on intel, 910 scans in 70 ms instead of 105. The records
+ * those misses belong to are made again afterwards, a slice of scans at a
+ * time (online.c): each scan's beams walk the tiles that were not stored
+ * at the recount (redo_need) and skip the others, whose counts are
+ * complete. A tile still not stored takes the misses into its record; one
+ * stored since (a later scan's hit) into its counts, which hold the later
+ * scans' misses and its record's share already. Until every scan is done
+ * a tile stored meanwhile misses the rest's misses for a while; nothing
+ * else reads the records. */
+
+void polyc__grid_redo_begin(polyc__grid *g)
+{
+    size_t dir_n = (size_t)g->tiles_x * (size_t)g->tiles_y;
+    memset(g->redo_need, 0, (dir_n / 32 + 1) * sizeof *g->redo_need);
+    for (size_t d = 0; d < dir_n; d++)
+        if (g->dir[d] == 0)
+            g->redo_need[d >> 5] |= 1u << (d & 31);
+}
+
+static int redo_needs(const polyc__grid *g, size_t d)
+{
+    return (g->redo_need[d >> 5] >> (d & 31)) & 1u;
+}
+
+static void redo_beam(polyc__grid *g, const polyc__beam *b, uint32_t *on_hits)
+{
+    polyc__walk w;
+    polyc__walk_start(&w, b);
+    const float miss_end = b->miss_end;
+    if (w.n > 0 && !polyc__walk_enter(&w, g->width, g->height))
+        return;
+    while (w.n > 0) {
+        size_t d = dir_index(g, w.ix, w.iy);
+        if (!redo_needs(g, d)) {
+            int to = polyc__walk_skip_tiles(&w, g->width, g->height, g->tiles_x, g->redo_need);
+            if (to < 0)
+                return;
+            if (to == 0)
+                break;
+            if (!polyc__walk_enter(&w, g->width, g->height))
+                return;
+            continue;
+        }
+        int left;
+        if (g->dir[d] == 0) {
+            left = pre_walk(g, d, &w, miss_end, 0);
+        } else {
+            polyc__tile *t = &g->tiles[g->dir[d] - 1];
+            do {
+                if (polyc__walk_t(&w) < miss_end) {
+                    count_one(0, &t->misses[w.idx], &t->hits[w.idx]);
+                    if (on_hits && t->hits[w.idx])
+                        on_hits[t - g->tiles]++;
+                }
+                left = polyc__walk_step(&w);
+            } while (!left && w.n > 0);
+        }
+        if (left && w.n > 0 && !polyc__walk_enter(&w, g->width, g->height))
+            return;
+    }
+    /* the end cell: a miss past the last reflection's reach, counted only
+     * in a stored tile (as count_beam) */
+    if (b->hit || w.ex < 0 || w.ey < 0 || w.ex >= g->width || w.ey >= g->height ||
+        polyc__walk_t(&w) >= miss_end)
+        return;
+    size_t d = dir_index(g, w.ex, w.ey);
+    if (redo_needs(g, d) && g->dir[d] != 0) {
+        polyc__tile *t = &g->tiles[g->dir[d] - 1];
+        count_one(0, &t->misses[polyc__cell_index(w.ex, w.ey)], &t->hits[polyc__cell_index(w.ex, w.ey)]);
+    }
+}
+
+void polyc__grid_redo_scan(polyc_ctx *ctx, const polyc__scan *s, uint32_t *on_hits)
+{
+    step_rot rot = {cosf(s->step_rad), sinf(s->step_rad)};
+    for (uint32_t i = 0; i < s->count; i++) {
+        polyc__beam b;
+        if (beam_fill(ctx, s, i, &b, 1, &rot))
+            redo_beam(&ctx->grid, &b, on_hits);
+    }
+}
+
+polyc_status polyc__grid_recount_scan(polyc_ctx *ctx, const polyc__scan *s)
+{
+    polyc_status st = count_scan(ctx, s, 0, NULL, 0);
+    grid_stats(ctx);
+    return st;
+}
+
 polyc_status polyc__grid_build(polyc_ctx *ctx)
 {
     polyc__grid *g = &ctx->grid;
@@ -544,7 +639,7 @@ polyc_status polyc__grid_build(polyc_ctx *ctx)
     for (uint32_t si = 0; si < ctx->scan_count; si++)
         want_hits(ctx, &ctx->scans[si]);
     for (uint32_t si = 0; si < ctx->scan_count; si++)
-        if ((st = count_scan(ctx, &ctx->scans[si], 0, NULL)) != POLYC_OK)
+        if ((st = count_scan(ctx, &ctx->scans[si], 0, NULL, 0)) != POLYC_OK)
             return st;
     grid_stats(ctx);
     return POLYC_OK;
@@ -586,7 +681,7 @@ polyc_status polyc__grid_add_scan(polyc_ctx *ctx, const polyc__scan *s, int take
 {
     if (!take_back)
         want_hits(ctx, s);
-    polyc_status st = count_scan(ctx, s, take_back, on_hits);
+    polyc_status st = count_scan(ctx, s, take_back, on_hits, 1);
     grid_stats(ctx);
     return st;
 }

@@ -90,6 +90,10 @@ typedef struct polyc__grid {
     uint8_t *pre_cells;            /* per record: each cell's, half a byte, up to POLYC__PRE_FULL */
     uint32_t *pre_free;            /* records given back */
     uint32_t pre_cap, pre_high, pre_nfree;
+    /* bit per directory entry: the tile was not stored when the counts were
+     * made again without their records (polyc__grid_recount_scan), whose
+     * misses polyc__grid_redo_scan puts back */
+    uint32_t *redo_need;
     size_t fixed_bytes;            /* directory, bits and spill tile */
 } polyc__grid;
 
@@ -300,6 +304,14 @@ polyc_status polyc__grid_add_scan(polyc_ctx *ctx, const polyc__scan *s, int take
  * tiles stay stored, the records go back to the pool) */
 void polyc__grid_want(polyc_ctx *ctx, const polyc__scan *s);
 void polyc__grid_clear_counts(polyc__grid *g);
+/* online, counting every kept scan again on cleared counts: one scan in as
+ * a batch counts it, its misses in tiles not stored left out; then the
+ * tiles not stored at that point noted (redo_need), and later each scan's
+ * misses in them put back, into their records or, in those stored since,
+ * into their counts (misses on cells with hits tallied in on_hits) */
+polyc_status polyc__grid_recount_scan(polyc_ctx *ctx, const polyc__scan *s); /* (wanted first) */
+void polyc__grid_redo_begin(polyc__grid *g);
+void polyc__grid_redo_scan(polyc_ctx *ctx, const polyc__scan *s, uint32_t *on_hits);
 polyc__tile *polyc__grid_tile(const polyc__grid *g, int32_t ix, int32_t iy);
 /* NULL for cells outside the grid or in tiles not stored (no beam ends in a
  * hit there: free space or never reached) */
@@ -388,6 +400,15 @@ int32_t *polyc__contour_list(polyc__arena *a, const polyc_limits *lim);
 void polyc__contour_reserve(polyc__arena *a, const polyc_limits *lim);
 size_t polyc__contour_bytes(const polyc_limits *lim);
 polyc_status polyc__contour_build(polyc_ctx *ctx);
+/* The contour of scans[0 .. n-1] (those with their bit set in `only`, if
+ * given) cast on the grid as it stands (its marks set from the counts
+ * first; the contour bits cleared first if `clear`), into the tiles' bits,
+ * and into the list when ctx->contour_xy is set. Its scratch on
+ * ctx->arena, polyc__contour_cast_bytes of a directory of dir_n entries; 0
+ * when there is no room for it. */
+int polyc__contour_cast(polyc_ctx *ctx, const polyc__scan *scans, uint32_t n, int clear,
+                        const uint32_t *only);
+size_t polyc__contour_cast_bytes(size_t dir_n);
 
 /* polyline.c */
 /* the store's vertex capacity: limits.max_vertices, or max_beams + 1024 */

@@ -57,6 +57,9 @@ typedef struct polyc__online {
     uint32_t *moved;               /* bit per kept scan: a correction waits */
     double *new_pose;              /* per kept scan: the waiting pose (x, y, theta) */
     uint32_t moved_n;
+    /* the kept scans redo_next .. redo_end - 1 still to put their misses
+     * back into the records after a recount (grid.c) */
+    uint32_t redo_next, redo_end;
 
     /* the angle prior and the accuracy, learned scan by scan */
     polyc__prior prior;
@@ -112,6 +115,9 @@ void polyc__online_backlog_all(polyc_ctx *ctx);
  * sums and the contour; when every scan is kept, the prior and the
  * accuracy learned again (online.c, "pose corrections") */
 polyc_status polyc__online_apply_corrections(polyc_ctx *ctx);
+/* after a recount, the records' misses of the next kept scans put back,
+ * some `beams` of them at least one scan (UINT32_MAX: all) */
+void polyc__online_redo_records(polyc_ctx *ctx, uint32_t beams);
 /* the sum of the view vectors of a cell's endpoints (0, 0: none) */
 void polyc__online_cell_view(const polyc_ctx *ctx, int32_t ix, int32_t iy, float *vx, float *vy);
 /* online_data.c: the points of the n taken tiles (the first n of the

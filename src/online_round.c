@@ -39,6 +39,10 @@
 #define ROUND_WAIT_SCANS 8u
 /* The tile taken in a round is marked so in dirty_since until it is done. */
 #define TAKEN UINT32_MAX
+/* After a recount (pose corrections), each update puts back the records of
+ * this many of the kept scans' beams (online.c): intel's 910 scans in 10
+ * updates, some 4 ms each. */
+#define REDO_BEAMS 16384u
 
 static float tile_key(const polyc_ctx *ctx, uint32_t d)
 {
@@ -394,6 +398,7 @@ static polyc_status round_in(polyc_ctx *ctx, uint64_t work, int all, uint64_t *s
         ctx->contour_xy = on->cells;
         ctx->contour_count = n;
         st = polyc__trace_more(ctx);
+        ctx->contour_xy = NULL; /* (scratch: an online context keeps no list) */
         ctx->contour_count = 0;
         if (st == POLYC_OK)
             st = polyc__online_add_lines(ctx, last_id);
@@ -467,6 +472,7 @@ polyc_status polyc_online_update(polyc_ctx *ctx, uint64_t work, polyc_online_rep
         return polyc__fail(ctx, POLYC_ERR_CONFIG, "a work budget of 0 (POLYC_ONLINE_WORK_DEFAULT is the default)");
     if ((st = polyc__online_apply_corrections(ctx)) != POLYC_OK)
         return st;
+    polyc__online_redo_records(ctx, REDO_BEAMS);
     polyc__online *on = ctx->online;
     uint64_t spent = 0;
     uint32_t changed = 0;
@@ -571,6 +577,7 @@ polyc_status polyc_online_finish(polyc_ctx *ctx, polyc_progress_fn progress, voi
         return st;
     if ((st = polyc__online_apply_corrections(ctx)) != POLYC_OK)
         return st;
+    polyc__online_redo_records(ctx, UINT32_MAX);
     polyc__online *on = ctx->online;
     polyc__opt *o = &on->opt;
     uint64_t spent = 0;

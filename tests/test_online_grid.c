@@ -317,6 +317,37 @@ static void test_corrected_contour_is_batch(void **state)
     free(o.block);
 }
 
+/* The cells of the tiles `truth` stores: how many, and how many of them
+ * `g` holds with the same counts (with `full_ok`, a cell the truth has
+ * POLYC__PRE_FULL misses or more in may hold any count at least that);
+ * and the hits `g` holds in the tiles the truth does not store. */
+static void compare_counts_in(const polyc_ctx *a_ctx, const polyc_ctx *t_ctx, int full_ok,
+                              uint32_t *cells, uint32_t *same, uint32_t *stray)
+{
+    const polyc__grid *g = &a_ctx->grid, *t = &t_ctx->grid;
+    assert_true(g->origin_x_m == t->origin_x_m && g->origin_y_m == t->origin_y_m);
+    *cells = *same = *stray = 0;
+    for (int32_t iy = 0; iy < g->height; iy++)
+        for (int32_t ix = 0; ix < g->width; ix++) {
+            const polyc__tile *a = polyc__grid_tile(g, ix, iy), *b = polyc__grid_tile(t, ix, iy);
+            int idx = polyc__cell_index(ix, iy);
+            if (b) {
+                (*cells)++;
+                *same += a && a->hits[idx] == b->hits[idx] &&
+                         (a->misses[idx] == b->misses[idx] ||
+                          (full_ok && b->misses[idx] >= POLYC__PRE_FULL && a->misses[idx] >= POLYC__PRE_FULL));
+            } else if (a) {
+                *stray += a->hits[idx] != 0;
+            }
+        }
+}
+
+static void compare_counts(const polyc_ctx *a, const polyc_ctx *t, uint32_t *cells, uint32_t *same,
+                           uint32_t *stray)
+{
+    compare_counts_in(a, t, 0, cells, same, stray);
+}
+
 /* Scans 1..N-1 added at drifted poses (scan 0 at its true pose: the frame),
  * the kept ones corrected: the grid then holds, cell by cell, the counts of
  * a context that was given the true poses, in every tile that context
@@ -355,20 +386,8 @@ static void check_corrected_counts(uint32_t keep_every, int by_add)
     } else {
         assert_int_equal(polyc_online_update(fixed.ctx, POLYC_ONLINE_WORK_DEFAULT, &rep), POLYC_OK);
     }
-    const polyc__grid *g = &fixed.ctx->grid, *t = &truth.ctx->grid;
-    assert_true(g->origin_x_m == t->origin_x_m && g->origin_y_m == t->origin_y_m);
-    uint32_t cells = 0, same = 0, stray = 0;
-    for (int32_t iy = 0; iy < g->height; iy++)
-        for (int32_t ix = 0; ix < g->width; ix++) {
-            const polyc__tile *a = polyc__grid_tile(g, ix, iy), *b = polyc__grid_tile(t, ix, iy);
-            int idx = polyc__cell_index(ix, iy);
-            if (b) {
-                cells++;
-                same += a && a->hits[idx] == b->hits[idx] && a->misses[idx] == b->misses[idx];
-            } else if (a) {
-                stray += a->hits[idx] != 0;
-            }
-        }
+    uint32_t cells, same, stray;
+    compare_counts(fixed.ctx, truth.ctx, &cells, &same, &stray);
     print_message("keep every %u%s: %u cells of the true poses' tiles, %u with their counts; "
                   "%u hits left elsewhere\n",
                   keep_every, by_add ? ", applied by an add" : "", cells, same, stray);
@@ -387,6 +406,104 @@ static void test_corrected_counts(void **state)
     check_corrected_counts(1, 0);
     check_corrected_counts(4, 0);
     check_corrected_counts(1, 1);
+}
+
+/* Every scan kept, of the empty room, at drifted poses; all corrected, so
+ * counted afresh, their misses in the tiles not stored put back into the
+ * records by the updates after (grid.c, "the records made again after a
+ * recount"); then the person steps in. The person's tile, stored only
+ * now, holds the misses of every scan before, as in a context given the
+ * true poses from the start:
+ * - UPDATE_FIRST: the update makes the records again before the person
+ *   comes: cell by cell the same counts;
+ * - PERSON_FIRST: the add of the person's scan applies the corrections and
+ *   stores the tile before the records are made again: the same counts
+ *   below POLYC__PRE_FULL misses (the updates put the rest into its
+ *   counts, exactly, where the records cap a cell);
+ * - ONE_MORE: one scan is left at its drifted pose, a scan is added (which
+ *   applies the corrections), and that one scan is corrected on its own,
+ *   taken out and put back, while the records wait: they are made again
+ *   first, so it takes its misses out of complete records; the same
+ *   counts but in a cell or two whose record reached the cap before the
+ *   scan was taken out (a record counts a cell exactly up to
+ *   POLYC__PRE_FULL, grid.c; a capped cell keeps its count). Taken out of the records as they waited, it
+ *   would take out misses they did not hold yet and then put them in
+ *   twice (112 cells off). */
+enum { UPDATE_FIRST, PERSON_FIRST, ONE_MORE };
+
+static void check_records_after_recount(int mode)
+{
+    enum { N = 16, LEFT = 3 };
+    static const char *const name[] = {"the update first", "the person first", "one more correction"};
+    room r = {4.0, 0, 0.0, {0}, {0, 0, 0, 0, 0, 0, 0, 0, 0, NULL}};
+    online fixed, truth;
+    open_keeping(&fixed, 12.0, 0, N + 2);
+    open_online(&truth, 12.0, 0);
+    polyc_online_report rep;
+    polyc_scan drifted[N];
+    static float ranges[N][BEAMS];
+    for (uint32_t k = 0; k < N; k++) {
+        r.turn = 0.0004 * k;
+        polyc_scan scan = *room_scan(&r);
+        memcpy(ranges[k], r.range, sizeof r.range);
+        scan.range_m = ranges[k];
+        drifted[k] = scan;
+        drifted[k].pose_x_m = 0.2 * k / (N - 1);
+        drifted[k].pose_theta_rad = 0.04 * k / (N - 1);
+        assert_int_equal(polyc_online_add_scan(fixed.ctx, &drifted[k], 1, NULL), POLYC_OK);
+        assert_int_equal(polyc_online_add_scan(truth.ctx, &scan, 0, NULL), POLYC_OK);
+        assert_int_equal(polyc_online_update(fixed.ctx, POLYC_ONLINE_WORK_DEFAULT, &rep), POLYC_OK);
+    }
+    for (uint32_t k = 1; k < N; k++)
+        if (mode != ONE_MORE || k != LEFT)
+            assert_int_equal(polyc_online_correct(fixed.ctx, k, 0.0, 0.0, 0.0), POLYC_OK);
+    if (mode == UPDATE_FIRST)
+        assert_int_equal(polyc_online_update(fixed.ctx, POLYC_ONLINE_WORK_DEFAULT, &rep), POLYC_OK);
+    if (mode == ONE_MORE) {
+        r.turn = 0.0004 * N;
+        const polyc_scan *more = room_scan(&r);
+        assert_int_equal(polyc_online_add_scan(fixed.ctx, more, 1, NULL), POLYC_OK);
+        assert_int_equal(polyc_online_add_scan(truth.ctx, more, 0, NULL), POLYC_OK);
+        assert_true(fixed.ctx->online->redo_next < fixed.ctx->online->redo_end); /* waiting */
+        assert_int_equal(polyc_online_correct(fixed.ctx, LEFT, 0.0, 0.0, 0.0), POLYC_OK);
+        assert_int_equal(polyc_online_update(fixed.ctx, POLYC_ONLINE_WORK_DEFAULT, &rep), POLYC_OK);
+    }
+    const polyc__grid *g = &fixed.ctx->grid;
+    int32_t px = (int32_t)floor((PERSON_X - PERSON_R - g->origin_x_m) / (double)g->cell_m);
+    int32_t py = (int32_t)floor((0.0 - g->origin_y_m) / (double)g->cell_m);
+    assert_null(polyc__grid_tile(g, px, py));
+    r.person = 1;
+    r.turn = 0.0004 * (N + 1);
+    const polyc_scan *last = room_scan(&r);
+    assert_int_equal(polyc_online_add_scan(fixed.ctx, last, 1, NULL), POLYC_OK);
+    assert_int_equal(polyc_online_add_scan(truth.ctx, last, 0, NULL), POLYC_OK);
+    assert_non_null(polyc__grid_tile(g, px, py));
+    if (mode == PERSON_FIRST)
+        assert_int_equal(polyc_online_update(fixed.ctx, POLYC_ONLINE_WORK_DEFAULT, &rep), POLYC_OK);
+    unsigned h = 0, m = 0, th = 0, tm = 0;
+    most_hit_near(fixed.ctx, PERSON_X - PERSON_R, 0.0, &h, &m);
+    most_hit_near(truth.ctx, PERSON_X - PERSON_R, 0.0, &th, &tm);
+    uint32_t cells, same, stray;
+    compare_counts_in(fixed.ctx, truth.ctx, mode == PERSON_FIRST, &cells, &same, &stray);
+    print_message("%s: the person's front %u hits, %u misses (true poses: %u, %u); %u cells of "
+                  "the true poses' tiles, %u with their counts; %u hits left elsewhere\n",
+                  name[mode], h, m, th, tm, cells, same, stray);
+    assert_true(m >= N && m > h);
+    if (mode == ONE_MORE)
+        assert_true(same >= cells - 4);
+    else
+        assert_int_equal(same, cells);
+    assert_int_equal(stray, 0);
+    free(fixed.block);
+    free(truth.block);
+}
+
+static void test_records_after_recount(void **state)
+{
+    (void)state;
+    check_records_after_recount(UPDATE_FIRST);
+    check_records_after_recount(PERSON_FIRST);
+    check_records_after_recount(ONE_MORE);
 }
 
 /* Records for four times as many tiles as stored: a large room seen through
@@ -422,6 +539,7 @@ int main(void)
         cmocka_unit_test(test_pool_spent),
         cmocka_unit_test(test_corrected_contour_is_batch),
         cmocka_unit_test(test_corrected_counts),
+        cmocka_unit_test(test_records_after_recount),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
