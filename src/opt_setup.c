@@ -89,6 +89,7 @@ static polyc__policy policy_for(polyc__input kind)
     p.gain_share = grid ? GRID_GAIN : 0.0;
     p.noise_spares_patience = p.recover = !grid;
     p.gaps_free_only = grid;
+    p.noise_skip = 0;
     return p;
 }
 

@@ -136,6 +136,8 @@ polyc_status polyc__search(polyc__opt *o, polyc_progress_fn progress, void *user
     polyc__flat_from_store(&o->best, o->s);
     double best = polyc__bic(o);
     double sigma = (double)cfg->noise_m;
+    for (uint8_t k = 0; k < o->pol.noise_skip; k++)
+        sigma *= (double)cfg->noise_decay;
     uint32_t quiet = 0, it;
     polyc_status result = POLYC_OK;
     uint32_t prev_start = 0, prev_mark = 0;

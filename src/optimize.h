@@ -122,6 +122,9 @@ typedef struct polyc__policy {
      * the noise do not spare the patience; a gap in the data is cut only as
      * far as the grid has free cells along it (split.c) */
     uint8_t noise_spares_patience, recover, gaps_free_only;
+    /* the noise starts this many decays in (an online map the updates
+     * fitted: the finishing call, online_round.c) */
+    uint8_t noise_skip;
 } polyc__policy;
 
 /* The optimiser's long-lived state: the model and its terms, the spatial

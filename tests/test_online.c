@@ -996,6 +996,56 @@ static void test_finish_stopped(void **state)
     scene_free(&s);
 }
 
+/* The finishing search starts its noise two decays in (online_round.c,
+ * FINISH_NOISE_SKIP): its first noisy iteration shakes the map by
+ * noise_m x noise_decay^2, where a batch build's shakes it by noise_m. */
+typedef struct first_noise {
+    double noise_m;            /* the first iteration's with noise, 0: none yet */
+} first_noise;
+
+static int note_first_noise(void *user, const polyc_iteration *it)
+{
+    first_noise *f = user;
+    if (f->noise_m == 0.0 && it->noise_m > 0.0)
+        f->noise_m = it->noise_m;
+    return 0;
+}
+
+static void test_finish_noise_starts_cooler(void **state)
+{
+    (void)state;
+    scene s;
+    scene_make(&s, "office", SCENE_SEED);
+    online o;
+    polyc_online_report r;
+    online_open(&o, &s, 0);
+    for (uint32_t i = 0; i < s.sim.scan_count; i++) {
+        add(&o, &s.sim.scans[i], 0);
+        update(&o, POLYC_ONLINE_WORK_DEFAULT, &r);
+    }
+    first_noise on = {0.0}, batch = {0.0};
+    assert_int_equal(polyc_online_finish(o.ctx, note_first_noise, &on, &r), POLYC_OK);
+    polyc_config cfg;
+    polyc_config_default(&cfg);
+    double cooler = (double)cfg.noise_m * (double)cfg.noise_decay * (double)cfg.noise_decay;
+    polyc_limits lim;
+    assert_int_equal(polyc_limits_for_scans(&cfg, s.sim.scans, s.sim.scan_count, &lim), POLYC_OK);
+    size_t n = polyc_memory_size(&cfg, &lim);
+    void *block = malloc(n);
+    assert_non_null(block);
+    polyc_ctx *b;
+    assert_int_equal(polyc_init(block, n, &cfg, &lim, &b), POLYC_OK);
+    for (uint32_t i = 0; i < s.sim.scan_count; i++)
+        assert_int_equal(polyc_add_scan(b, &s.sim.scans[i]), POLYC_OK);
+    assert_int_equal(polyc_build(b, note_first_noise, &batch), POLYC_OK);
+    print_message("first noise: finish %.4f m, batch %.4f m\n", on.noise_m, batch.noise_m);
+    assert_true(fabs(on.noise_m - cooler) < 1e-6);
+    assert_true(fabs(batch.noise_m - (double)cfg.noise_m) < 1e-6);
+    free(block);
+    online_close(&o);
+    scene_free(&s);
+}
+
 /* ---- 5. ten passes in the block for one ---------------------------------- */
 
 /* What the requirement asks: ten passes run in the block sized for one,
@@ -1685,6 +1735,7 @@ int main(void)
         cmocka_unit_test(test_finish_against_batch),
         cmocka_unit_test(test_finish_then_more),
         cmocka_unit_test(test_finish_stopped),
+        cmocka_unit_test(test_finish_noise_starts_cooler),
         cmocka_unit_test(test_ten_passes),
         cmocka_unit_test(test_pose_correction),
         cmocka_unit_test(test_bad_use),
