@@ -418,6 +418,8 @@ static polyc_status round_in(polyc_ctx *ctx, uint64_t work, int all, uint64_t *s
      * lie along, are zipped now */
     if (o->pol.restructure && (stamp_near_ends(o, since) > 0 || edited_after_zip(o)))
         polyc__op_zip(o);
+    if (polyc__op_unfold(o) > 0) /* (the map between updates draws no wall twice) */
+        polyc__op_untangle(o);
     o->pol.add_vertices = add;
     o->region_since = 0;
     POLYC__CHECKS_ITERATION(o);

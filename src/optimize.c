@@ -46,7 +46,8 @@ static polyc_status restore_best(polyc__opt *o, polyc_status st)
  * zipped stretches) can leave two ends a centimetre apart that the next
  * iteration would have joined. Then the rules the map must keep whatever
  * its BIC: every data gap split (a pass cuts one gap a segment), ends
- * trimmed, no double cover, no crossing. Returns a status (the store holds
+ * trimmed, no double cover, no fold doubling a wall (op_unfold), no
+ * crossing. Returns a status (the store holds
  * the result, scored). */
 static polyc_status polish(polyc__opt *o, double best)
 {
@@ -71,6 +72,7 @@ static polyc_status polish(polyc__opt *o, double best)
         polyc__op_trim_ends(o);
         polyc__op_zip(o);
     }
+    polyc__op_unfold(o);
     polyc__op_untangle(o);
     return POLYC_OK;
 }

@@ -354,6 +354,8 @@ int polyc__op_merge(polyc__opt *o);
 int polyc__op_split(polyc__opt *o);
 int polyc__op_adjust(polyc__opt *o, int max_rounds, uint32_t since);
 int polyc__op_zigzag(polyc__opt *o);
+/* folds that draw a short stretch of wall twice, removed whatever the BIC */
+int polyc__op_unfold(polyc__opt *o);
 int polyc__op_corners(polyc__opt *o, uint32_t since);
 int polyc__op_trim_ends(polyc__opt *o);
 /* topology.c: every crossing of two segments resolved (not in the paper) */

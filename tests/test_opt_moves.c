@@ -149,6 +149,58 @@ static void test_zigzag_keeps_sharp_corner_with_data(void **state)
     fx_close(&f);
 }
 
+/* A wall drawn 14 cm past its corner and back (acapulco's batch map): a
+ * fold whose short leg lies on the long one. The data along the overshoot
+ * keep it through zigzag's BIC test; op_unfold takes it out whatever the
+ * BIC, leaving a corner and no fold. */
+static void test_unfold_corner_overshoot(void **state)
+{
+    (void)state;
+    static fixture f;
+    static ptlist p;
+    fx_open_hand(&f, 0.0f);
+    p.n = 0;
+    pts_line(&p, 0.0f, 0.0f, 0.0f, 2.14f, 0.01f);
+    pts_line(&p, 0.0f, 2.0f, 2.0f, 2.0f, 0.01f);
+    set_points(&f, p.xy, p.n);
+    clear_lines(&f.o);
+    const float xy[8] = {0.0f, 0.0f, 0.0f, 2.14f, 0.0f, 2.0f, 2.0f, 2.0f};
+    int32_t l = add_line(&f.o, xy, 4, 0);
+    rebuild(&f.o);
+    assert_int_equal(polyc__op_zigzag(&f.o), 0); /* the BIC keeps it */
+    assert_int_equal(polyc__op_unfold(&f.o), 1);
+    check_books(&f.o, "unfold");
+    const polyc__store *s = f.o.s;
+    assert_int_equal(s->l[l].count, 3);
+    int32_t a = s->l[l].head, c = s->v[a].next, b = s->v[c].next;
+    float ux = s->v[c].x - s->v[a].x, uy = s->v[c].y - s->v[a].y;
+    float wx = s->v[b].x - s->v[c].x, wy = s->v[b].y - s->v[c].y;
+    assert_true(fabsf(ux * wx + uy * wy) < 0.2f * sqrtf((ux * ux + uy * uy) * (wx * wx + wy * wy)));
+    assert_int_equal(polyc__op_unfold(&f.o), 0);
+    fx_close(&f);
+}
+
+/* A thin wall's end drawn round (two 1 m faces 6 cm apart) folds on two
+ * long legs: it is a wall's two faces, not one face twice, and stays. */
+static void test_unfold_keeps_thin_wall_end(void **state)
+{
+    (void)state;
+    static fixture f;
+    static ptlist p;
+    fx_open_hand(&f, 0.0f);
+    p.n = 0;
+    pts_line(&p, 0.0f, 0.0f, 1.0f, 0.0f, 0.01f);
+    pts_line(&p, 1.0f, 0.06f, 0.0f, 0.06f, 0.01f);
+    set_points(&f, p.xy, p.n);
+    clear_lines(&f.o);
+    const float xy[6] = {0.0f, 0.0f, 1.0f, 0.03f, 0.0f, 0.06f};
+    int32_t l = add_line(&f.o, xy, 3, 0);
+    rebuild(&f.o);
+    assert_int_equal(polyc__op_unfold(&f.o), 0);
+    assert_line_is(&f.o, l, xy, 3);
+    fx_close(&f);
+}
+
 /* ---- F: noise ---- */
 
 static void test_noise_deterministic_and_sized(void **state)
@@ -351,6 +403,8 @@ int main(void)
         cmocka_unit_test(test_bic_checked_operators_never_raise_bic),
         cmocka_unit_test(test_zigzag_removes_hairpin),
         cmocka_unit_test(test_zigzag_keeps_sharp_corner_with_data),
+        cmocka_unit_test(test_unfold_corner_overshoot),
+        cmocka_unit_test(test_unfold_keeps_thin_wall_end),
         cmocka_unit_test(test_noise_deterministic_and_sized),
         cmocka_unit_test(test_remove_collinear_vertex),
         cmocka_unit_test(test_remove_keeps_true_corner),
