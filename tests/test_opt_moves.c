@@ -129,21 +129,30 @@ static void test_zigzag_removes_hairpin(void **state)
     fx_close(&f);
 }
 
+/* A hand-made case: data along the two walls (x0, y0, x1, y1 each) and
+ * the polyline xy of n points over them, scored; returns its line. */
+static int32_t two_walls_case(fixture *f, ptlist *p, const float *walls, const float *xy, int n)
+{
+    fx_open_hand(f, 0.0f);
+    p->n = 0;
+    pts_line(p, walls[0], walls[1], walls[2], walls[3], 0.01f);
+    pts_line(p, walls[4], walls[5], walls[6], walls[7], 0.01f);
+    set_points(f, p->xy, p->n);
+    clear_lines(&f->o);
+    int32_t l = add_line(&f->o, xy, n, 0);
+    rebuild(&f->o);
+    return l;
+}
+
 static void test_zigzag_keeps_sharp_corner_with_data(void **state)
 {
     (void)state;
     static fixture f;
     static ptlist p;
-    fx_open_hand(&f, 0.0f);
     /* two walls meeting at 15 degrees: the tip turns by 165 degrees */
     const float xy[6] = {-1.0f, 0.1317f, 0.0f, 0.0f, -1.0f, -0.1317f};
-    p.n = 0;
-    pts_line(&p, xy[0], xy[1], xy[2], xy[3], 0.01f);
-    pts_line(&p, xy[2], xy[3], xy[4], xy[5], 0.01f);
-    set_points(&f, p.xy, p.n);
-    clear_lines(&f.o);
-    int32_t l = add_line(&f.o, xy, 3, 0);
-    rebuild(&f.o);
+    const float walls[8] = {xy[0], xy[1], xy[2], xy[3], xy[2], xy[3], xy[4], xy[5]};
+    int32_t l = two_walls_case(&f, &p, walls, xy, 3);
     assert_int_equal(polyc__op_zigzag(&f.o), 0);
     assert_line_is(&f.o, l, xy, 3);
     fx_close(&f);
@@ -158,15 +167,9 @@ static void test_unfold_corner_overshoot(void **state)
     (void)state;
     static fixture f;
     static ptlist p;
-    fx_open_hand(&f, 0.0f);
-    p.n = 0;
-    pts_line(&p, 0.0f, 0.0f, 0.0f, 2.14f, 0.01f);
-    pts_line(&p, 0.0f, 2.0f, 2.0f, 2.0f, 0.01f);
-    set_points(&f, p.xy, p.n);
-    clear_lines(&f.o);
+    const float walls[8] = {0.0f, 0.0f, 0.0f, 2.14f, 0.0f, 2.0f, 2.0f, 2.0f};
     const float xy[8] = {0.0f, 0.0f, 0.0f, 2.14f, 0.0f, 2.0f, 2.0f, 2.0f};
-    int32_t l = add_line(&f.o, xy, 4, 0);
-    rebuild(&f.o);
+    int32_t l = two_walls_case(&f, &p, walls, xy, 4);
     assert_int_equal(polyc__op_zigzag(&f.o), 0); /* the BIC keeps it */
     assert_int_equal(polyc__op_unfold(&f.o), 1);
     check_books(&f.o, "unfold");
@@ -187,15 +190,9 @@ static void test_unfold_keeps_thin_wall_end(void **state)
     (void)state;
     static fixture f;
     static ptlist p;
-    fx_open_hand(&f, 0.0f);
-    p.n = 0;
-    pts_line(&p, 0.0f, 0.0f, 1.0f, 0.0f, 0.01f);
-    pts_line(&p, 1.0f, 0.06f, 0.0f, 0.06f, 0.01f);
-    set_points(&f, p.xy, p.n);
-    clear_lines(&f.o);
+    const float walls[8] = {0.0f, 0.0f, 1.0f, 0.0f, 1.0f, 0.06f, 0.0f, 0.06f};
     const float xy[6] = {0.0f, 0.0f, 1.0f, 0.03f, 0.0f, 0.06f};
-    int32_t l = add_line(&f.o, xy, 3, 0);
-    rebuild(&f.o);
+    int32_t l = two_walls_case(&f, &p, walls, xy, 3);
     assert_int_equal(polyc__op_unfold(&f.o), 0);
     assert_line_is(&f.o, l, xy, 3);
     fx_close(&f);
