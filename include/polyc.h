@@ -405,8 +405,9 @@ POLYC_API polyc_status polyc_online_add_scan(polyc_ctx *ctx, const polyc_scan *s
 POLYC_API polyc_status polyc_online_update(polyc_ctx *ctx, uint64_t work,
                                            polyc_online_report *out);
 /* Converges the map as a batch build would: the backlog, then the full
- * search (noise, patience) from the current map. Scans may be added after
- * it; progress as for polyc_optimize. */
+ * search (noise, patience) from the current map, its noise starting two
+ * decays in (docs/api.md). Scans may be added after it; progress as for
+ * polyc_optimize. */
 POLYC_API polyc_status polyc_online_finish(polyc_ctx *ctx, polyc_progress_fn progress, void *user,
                                            polyc_online_report *out);
 /* Gives kept scan `scan_id` a new pose (after a loop closure). The pose
