@@ -242,8 +242,10 @@ size_t polyc__contour_cast_bytes(size_t dir_n)
 }
 
 /* Marks the grid and casts scans[0 .. n-1] (only those whose bit is set
- * in `only`, if given); the busy bits are scratch on the arena. 0: no room for them; -1: the list is full. */
-static int cast(polyc_ctx *ctx, const polyc__scan *scans, uint32_t n, int clear, const uint32_t *only)
+ * in `only`, if given); the busy bits are scratch on the arena. Returns 1,
+ * 0 when there is no room for them, -1 when the list is full. */
+static int cast(polyc_ctx *ctx, const polyc__scan *scans, uint32_t n, int clear,
+                const uint32_t *only)
 {
     polyc__grid *g = &ctx->grid;
     size_t mark = ctx->arena.used;

@@ -600,7 +600,8 @@ static void redo_beam(polyc__grid *g, const polyc__beam *b, uint32_t *on_hits)
     size_t d = dir_index(g, w.ex, w.ey);
     if (redo_needs(g, d) && g->dir[d] != 0) {
         polyc__tile *t = &g->tiles[g->dir[d] - 1];
-        count_one(0, &t->misses[polyc__cell_index(w.ex, w.ey)], &t->hits[polyc__cell_index(w.ex, w.ey)]);
+        int idx = polyc__cell_index(w.ex, w.ey);
+        count_one(0, &t->misses[idx], &t->hits[idx]);
     }
 }
 

@@ -721,7 +721,7 @@ void polyc__online_redo_records(polyc_ctx *ctx, uint32_t beams)
 {
     polyc__online *on = ctx->online;
     uint32_t done = 0;
-    while (on->redo_next < on->redo_end && (done == 0 || done < beams)) {
+    while (on->redo_next < on->redo_end && done < beams) {
         const polyc__scan *s = &ctx->scans[1 + on->redo_next++];
         polyc__grid_redo_scan(ctx, s, on->tile_miss);
         done += s->count > 0 ? s->count : 1;
@@ -740,7 +740,7 @@ static polyc_status move_each(polyc_ctx *ctx)
         st = accumulate(ctx, d, on->kept_id[k], SCAN_OUT);
         take_new_pose(ctx, k);
         if (st == POLYC_OK)
-            st = accumulate(ctx, d, on->kept_id[k], SCAN_MOVED); /* the prior has its lines already */
+            st = accumulate(ctx, d, on->kept_id[k], SCAN_MOVED); /* (the prior has its lines) */
     }
     return st;
 }

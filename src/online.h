@@ -116,7 +116,7 @@ void polyc__online_backlog_all(polyc_ctx *ctx);
  * accuracy learned again (online.c, "pose corrections") */
 polyc_status polyc__online_apply_corrections(polyc_ctx *ctx);
 /* after a recount, the records' misses of the next kept scans put back,
- * some `beams` of them at least one scan (UINT32_MAX: all) */
+ * until `beams` (> 0) of their beams are done (UINT32_MAX: all) */
 void polyc__online_redo_records(polyc_ctx *ctx, uint32_t beams);
 /* the sum of the view vectors of a cell's endpoints (0, 0: none) */
 void polyc__online_cell_view(const polyc_ctx *ctx, int32_t ix, int32_t iy, float *vx, float *vy);

@@ -573,9 +573,9 @@ static void drop_unoccupied(polyc_ctx *ctx)
  * real logs the final BIC on the batch's data fell on eleven (fhw 1.037 ->
  * 1.021, acapulco 1.020 -> 1.000, infinite-corridor 1.010 -> 0.991,
  * seattle 1.017 -> 1.014) and rose on orebro (0.965 -> 0.973); from
- * 0.012 m it fell on ten. The sweep's online core precision came within 10 % of
- * the batch's on 88 of 120 scenes, against 85 (its worst row, hall seed
- * 12, 1.77 -> 2.08 times). */
+ * 0.012 m it fell on ten. The sweep's online core precision came within
+ * 10 % of the batch's on 88 of 120 scenes, against 85 (its worst row in
+ * those runs, hall seed 12, 1.77 -> 2.08 times). */
 #define FINISH_NOISE_SKIP 2
 
 /* The finishing call: every tile's data made again, what no polyline

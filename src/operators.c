@@ -267,13 +267,12 @@ static int32_t doubled_leg_end(const polyc__opt *o, int32_t v)
     float lu = sqrtf((c->x - a->x) * (c->x - a->x) + (c->y - a->y) * (c->y - a->y));
     float lw = sqrtf((b->x - c->x) * (b->x - c->x) + (b->y - c->y) * (b->y - c->y));
     float tol2 = o->cfg->overlap_m * o->cfg->overlap_m;
-    if (lu <= lw)
-        return lu <= DOUBLED_LEG_M && polyc__seg_dist2(a->x, a->y, c->x, c->y, b->x, b->y) <= tol2
-                   ? c->prev
-                   : POLYC__NONE;
-    return lw <= DOUBLED_LEG_M && polyc__seg_dist2(b->x, b->y, a->x, a->y, c->x, c->y) <= tol2
-               ? c->next
-               : POLYC__NONE;
+    /* the shorter leg's far end, and its distance from the longer leg */
+    int32_t f = lu <= lw ? c->prev : c->next;
+    const polyc__vertex *e = &s->v[f], *l0 = lu <= lw ? c : a, *l1 = lu <= lw ? b : c;
+    int doubled = polyc__minf(lu, lw) <= DOUBLED_LEG_M &&
+                  polyc__seg_dist2(e->x, e->y, l0->x, l0->y, l1->x, l1->y) <= tol2;
+    return doubled ? f : POLYC__NONE;
 }
 
 /* Removing f, the doubled leg's far end, leaves no fold at v (f an end of
@@ -287,7 +286,9 @@ static int unfolds(const polyc__opt *o, int32_t v, int32_t f)
         return 1;
     if (g == (f == c->prev ? c->next : c->prev))
         return 0; /* (a closed triangle) */
-    return f == c->prev ? !is_fold(&s->v[g], c, &s->v[c->next]) : !is_fold(&s->v[c->prev], c, &s->v[g]);
+    if (f == c->prev)
+        return !is_fold(&s->v[g], c, &s->v[c->next]);
+    return !is_fold(&s->v[c->prev], c, &s->v[g]);
 }
 
 int polyc__op_unfold(polyc__opt *o)

@@ -333,9 +333,10 @@ static void compare_counts_in(const polyc_ctx *a_ctx, const polyc_ctx *t_ctx, in
             int idx = polyc__cell_index(ix, iy);
             if (b) {
                 (*cells)++;
+                int capped = a && full_ok && b->misses[idx] >= POLYC__PRE_FULL &&
+                             a->misses[idx] >= POLYC__PRE_FULL;
                 *same += a && a->hits[idx] == b->hits[idx] &&
-                         (a->misses[idx] == b->misses[idx] ||
-                          (full_ok && b->misses[idx] >= POLYC__PRE_FULL && a->misses[idx] >= POLYC__PRE_FULL));
+                         (a->misses[idx] == b->misses[idx] || capped);
             } else if (a) {
                 *stray += a->hits[idx] != 0;
             }
@@ -426,15 +427,16 @@ static void test_corrected_counts(void **state)
  *   first, so it takes its misses out of complete records; the same
  *   counts but in a cell or two whose record reached the cap before the
  *   scan was taken out (a record counts a cell exactly up to
- *   POLYC__PRE_FULL, grid.c; a capped cell keeps its count). Taken out of the records as they waited, it
- *   would take out misses they did not hold yet and then put them in
- *   twice (112 cells off). */
+ *   POLYC__PRE_FULL, grid.c; a capped cell keeps its count). Taken out
+ *   of the records as they waited, it would take out misses they did not
+ *   hold yet and then put them in twice (112 cells off). */
 enum { UPDATE_FIRST, PERSON_FIRST, ONE_MORE };
 
 static void check_records_after_recount(int mode)
 {
     enum { N = 16, LEFT = 3 };
-    static const char *const name[] = {"the update first", "the person first", "one more correction"};
+    static const char *const name[] = {"the update first", "the person first",
+                                       "one more correction"};
     room r = {4.0, 0, 0.0, {0}, {0, 0, 0, 0, 0, 0, 0, 0, 0, NULL}};
     online fixed, truth;
     open_keeping(&fixed, 12.0, 0, N + 2);
