@@ -157,9 +157,27 @@ static int is_head(const polyc__opt *o, int32_t v)
     return o->s->v[v].prev == POLYC__NONE;
 }
 
+/* Whether the polylines of ends e and f leave them within 30 degrees of
+ * one direction: linked, they would make a hairpin. */
+static int would_fold(const polyc__opt *o, int32_t e, int32_t f)
+{
+    const polyc__vertex *V = o->s->v;
+    int32_t en = V[e].prev != POLYC__NONE ? V[e].prev : V[e].next;
+    int32_t fn = V[f].prev != POLYC__NONE ? V[f].prev : V[f].next;
+    float ax = V[en].x - V[e].x, ay = V[en].y - V[e].y;
+    float bx = V[fn].x - V[f].x, by = V[fn].y - V[f].y;
+    float la = sqrtf(ax * ax + ay * ay), lb = sqrtf(bx * bx + by * by);
+    return ax * bx + ay * by > 0.866f * la * lb;
+}
+
 /* Ends closer than merge_dist_m are linked by a segment; the vertex
  * removal operator later fuses the two ends when that lowers the BIC. */
 int polyc__op_merge(polyc__opt *o)
+{
+    return polyc__op_merge_folds(o, 1);
+}
+
+int polyc__op_merge_folds(polyc__opt *o, int folds)
 {
     polyc__store *s = o->s;
     float lim2 = o->cfg->merge_dist_m * o->cfg->merge_dist_m;
@@ -173,7 +191,7 @@ int polyc__op_merge(polyc__opt *o)
             if (!in_region(o, e))
                 continue;
             int32_t f = nearest_end(o, e, lim2);
-            if (f == POLYC__NONE || polyc__link_crosses(o, e, f))
+            if (f == POLYC__NONE || polyc__link_crosses(o, e, f) || (!folds && would_fold(o, e, f)))
                 continue; /* (a link through a wall would be cut again) */
             polyc__chg_begin(o);
             int32_t le = s->v[e].line, lf = s->v[f].line;
@@ -233,19 +251,18 @@ int polyc__op_zigzag(polyc__opt *o)
     return changed;
 }
 
-/* A fold whose shorter leg, of at most DOUBLED_LEG_M, ends within
- * overlap_m of the longer leg draws that stretch of wall twice: its vertex
- * goes whatever the BIC, as crossings and double cover do (acapulco's
- * batch map had a wall run 14 cm past its corner and come back at 0.8
- * degrees; intel's a 13 cm end folded back at 18 degrees). Too short for
- * the zip's runs, such folds escaped band15 and double cover alike. A thin
- * wall's end drawn round has two long legs and stays. Run on the map the
- * search keeps (and after each online round), not in its iterations, whose
- * folds the next moves often undo: removing them there too moved the
- * search's path (the sweep's batch maps on target 62 -> 59 of 120, the
- * summed core precision 910 -> 904 mm). */
-#define DOUBLED_LEG_M 0.3f
-
+/* A fold whose shorter leg ends within overlap_m of the longer leg draws
+ * that stretch of wall twice: it goes whatever the BIC, as crossings and
+ * double cover do (acapulco's batch map had a wall run 14 cm past its
+ * corner and come back at 0.8 degrees; intel's a 13 cm end folded back at
+ * 18 degrees; an online map of freiburg-079 two legs of 37 and 46 cm,
+ * turning through two vertices 3 cm apart). Such folds escaped band15 and
+ * double cover alike when short, and the zigzag's BIC test kept them. A
+ * thin wall's end drawn round has its faces farther apart and stays. Run
+ * on the map the search keeps (and after each online round), not in its
+ * iterations, whose folds the next moves often undo: removing them there
+ * too moved the search's path (the sweep's batch maps on target 62 -> 59
+ * of 120, the summed core precision 910 -> 904 mm). */
 static int is_fold(const polyc__vertex *a, const polyc__vertex *c, const polyc__vertex *b)
 {
     float ux = c->x - a->x, uy = c->y - a->y, wx = b->x - c->x, wy = b->y - c->y;
@@ -270,9 +287,42 @@ static int32_t doubled_leg_end(const polyc__opt *o, int32_t v)
     /* the shorter leg's far end, and its distance from the longer leg */
     int32_t f = lu <= lw ? c->prev : c->next;
     const polyc__vertex *e = &s->v[f], *l0 = lu <= lw ? c : a, *l1 = lu <= lw ? b : c;
-    int doubled = polyc__minf(lu, lw) <= DOUBLED_LEG_M &&
-                  polyc__seg_dist2(e->x, e->y, l0->x, l0->y, l1->x, l1->y) <= tol2;
-    return doubled ? f : POLYC__NONE;
+    return polyc__seg_dist2(e->x, e->y, l0->x, l0->y, l1->x, l1->y) <= tol2 ? f : POLYC__NONE;
+}
+
+/* A fold that turns through two vertices, v and the next, at most
+ * overlap_m apart: the segment before v and the one after its next turn
+ * by over 150 degrees, and the shorter of them ends within overlap_m of
+ * the longer. One of the two vertices goes (the one whose removal costs
+ * less), leaving the fold at the other; returns that one (NONE: no such
+ * fold at v). */
+static int32_t close_cap(polyc__opt *o, int32_t v)
+{
+    const polyc__store *s = o->s;
+    const polyc__vertex *b = &s->v[v];
+    if (b->line == POLYC__NONE || b->prev == POLYC__NONE || b->next == POLYC__NONE)
+        return POLYC__NONE;
+    int32_t w = b->next;
+    const polyc__vertex *a = &s->v[b->prev], *c = &s->v[w];
+    if (c->next == POLYC__NONE || c->next == b->prev)
+        return POLYC__NONE;
+    const polyc__vertex *d = &s->v[c->next];
+    float cap2 = (c->x - b->x) * (c->x - b->x) + (c->y - b->y) * (c->y - b->y);
+    float tol2 = o->cfg->overlap_m * o->cfg->overlap_m;
+    float ux = b->x - a->x, uy = b->y - a->y, wx = d->x - c->x, wy = d->y - c->y;
+    float lu = sqrtf(ux * ux + uy * uy), lw = sqrtf(wx * wx + wy * wy);
+    if (cap2 > tol2 || !(lu * lw > 0.0f) || ux * wx + uy * wy >= -0.866f * lu * lw)
+        return POLYC__NONE;
+    /* the shorter leg's far end against the longer leg */
+    const polyc__vertex *e = lu <= lw ? a : d, *l0 = lu <= lw ? c : a, *l1 = lu <= lw ? d : b;
+    if (polyc__seg_dist2(e->x, e->y, l0->x, l0->y, l1->x, l1->y) > tol2)
+        return POLYC__NONE;
+    double db = polyc__removal_delta_below(o, v, DBL_MAX);
+    double dc = polyc__removal_delta_below(o, w, DBL_MAX);
+    if ((db < dc ? db : dc) >= DBL_MAX)
+        return POLYC__NONE; /* (a single scan's return stays on the map: INFINITY) */
+    polyc__apply_remove(o, db < dc ? v : w);
+    return db < dc ? w : v;
 }
 
 /* Removing f, the doubled leg's far end, leaves no fold at v (f an end of
@@ -295,7 +345,12 @@ int polyc__op_unfold(polyc__opt *o)
 {
     polyc__store *s = o->s;
     int changed = 0;
-    for (int32_t v = 0; v < s->v_high; v++) {
+    for (int32_t u = 0; u < s->v_high; u++) {
+        int32_t v = close_cap(o, u);
+        if (v != POLYC__NONE)
+            changed++;
+        else
+            v = u;
         int32_t f = doubled_leg_end(o, v);
         if (f == POLYC__NONE)
             continue;

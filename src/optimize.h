@@ -351,6 +351,10 @@ void polyc__apply_move(polyc__opt *o, int32_t v, float x, float y);
 /* the operators (paper IV.A-G) */
 int polyc__op_overlaps(polyc__opt *o);
 int polyc__op_merge(polyc__opt *o);
+/* op_merge, with `folds` 0: no link whose two polylines leave it within 30
+ * degrees of one direction (a hairpin, for a pass with no zigzag or zip
+ * after it to judge it) */
+int polyc__op_merge_folds(polyc__opt *o, int folds);
 int polyc__op_split(polyc__opt *o);
 int polyc__op_adjust(polyc__opt *o, int max_rounds, uint32_t since);
 int polyc__op_zigzag(polyc__opt *o);

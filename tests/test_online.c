@@ -321,6 +321,43 @@ static void map_validity(const polyc_ctx *ctx, uint32_t *crossings, uint32_t *ju
     free(lines);
 }
 
+/* Pairs of open ends of two polylines within merge reach (the default
+ * merge_dist_m, 15 cm) that the polylines leave in directions more than 30
+ * degrees apart: ends the merge would link, as it links them in a batch
+ * build's every iteration (a link that would fold back is the zigzag's). */
+#define MERGE_REACH_M 0.15
+static uint32_t linkable_ends(const polyc_ctx *ctx)
+{
+    uint32_t n = polyc_polyline_count(ctx), pairs = 0;
+    double *e = malloc(8u * (n + 1u) * sizeof *e); /* per end: x y, away dx dy */
+    assert_non_null(e);
+    uint32_t k = 0;
+    for (uint32_t i = 0; i < n; i++) {
+        polyc_polyline pl;
+        check_status(polyc_get_polyline(ctx, i, &pl), ctx, "polyc_get_polyline");
+        if (pl.closed || pl.point_count < 2)
+            continue;
+        const float *xy = pl.xy_m;
+        uint32_t last = pl.point_count - 1;
+        double *h = &e[8u * k++];
+        h[0] = xy[0], h[1] = xy[1], h[2] = xy[2] - xy[0], h[3] = xy[3] - xy[1];
+        h[4] = xy[2 * last], h[5] = xy[2 * last + 1];
+        h[6] = xy[2 * last - 2] - xy[2 * last], h[7] = xy[2 * last - 1] - xy[2 * last + 1];
+    }
+    for (uint32_t i = 0; i < k; i++)
+        for (uint32_t j = i + 1; j < k; j++)
+            for (int a = 0; a < 2; a++)
+                for (int b = 0; b < 2; b++) {
+                    const double *p = &e[8u * i + 4u * (uint32_t)a], *q = &e[8u * j + 4u * (uint32_t)b];
+                    double cosang = (p[2] * q[2] + p[3] * q[3]) /
+                                    (hypot(p[2], p[3]) * hypot(q[2], q[3]) + 1e-30);
+                    if (hypot(p[0] - q[0], p[1] - q[1]) < MERGE_REACH_M && cosang < 0.866)
+                        pairs++;
+                }
+    free(e);
+    return pairs;
+}
+
 /* Adds scan i (keep: for corrections), failing the test on an error. */
 static void add(const online *o, const polyc_scan *scan, int keep)
 {
@@ -671,14 +708,14 @@ static void test_changes_since_version(void **state)
     scene_free(&s);
 }
 
-/* With few vertices (128: a ring of 80 removals) the office's removals
+/* With few vertices (128: a ring of 80 removals) the thin walls' removals
  * outrun the ring: a copy too old gets POLYC_ERR_RANGE (and reads the map
  * again), a recent one still rebuilds exactly. */
 static void test_changes_forgotten(void **state)
 {
     (void)state;
     scene s;
-    scene_make(&s, "office", SCENE_SEED);
+    scene_make(&s, "thinwalls", SCENE_SEED);
     online o;
     memset(&o, 0, sizeof o);
     config_of(&o.config);
@@ -696,7 +733,10 @@ static void test_changes_forgotten(void **state)
     uint64_t client_at = 0, prev_at = 0;
     uint32_t refused = 0, applied = 0, a = 0, m = 0, rm = 0, unseen = 0;
     polyc_online_report r;
-    /* two passes: removals enough to go round the ring */
+    /* two passes: removals enough to go round the ring (thin walls: their
+     * faces' pieces come and go while both are seen; the office's walls,
+     * whose pieces the updates link before they are published, made 68
+     * removals in four passes) */
     for (uint32_t i = 0; i < 2 * s.sim.scan_count; i++) {
         add(&o, &s.sim.scans[i % s.sim.scan_count], 0);
         update(&o, POLYC_ONLINE_WORK_DEFAULT, &r);
@@ -721,7 +761,7 @@ static void test_changes_forgotten(void **state)
             applied++;
         }
     }
-    print_message("office, 128 vertices: %u refusals (POLYC_ERR_RANGE) of an old copy, %u "
+    print_message("thinwalls, 128 vertices: %u refusals (POLYC_ERR_RANGE) of an old copy, %u "
                   "applied; %u added, %u modified, %u removed\n",
                   refused, applied, a, m, rm);
     assert_true(refused > 0);
@@ -744,7 +784,7 @@ static void check_valid_replay(const char *name, uint64_t work, uint32_t every)
     online o;
     polyc_online_report r;
     online_open(&o, &s, 0);
-    uint32_t checks = 0, junctions_seen = 0, bad = 0;
+    uint32_t checks = 0, junctions_seen = 0, bad = 0, linkable_sum = 0, linkable_max = 0;
     for (uint32_t i = 0; i < s.sim.scan_count; i++) {
         add(&o, &s.sim.scans[i], 0);
         update(&o, work ? work : i % 3 == 0 ? 500u : POLYC_ONLINE_WORK_DEFAULT, &r);
@@ -753,6 +793,9 @@ static void check_valid_replay(const char *name, uint64_t work, uint32_t every)
         uint32_t crossings, junctions;
         double cover;
         map_validity(o.ctx, &crossings, &junctions, &cover);
+        uint32_t linkable = linkable_ends(o.ctx);
+        linkable_sum += linkable;
+        linkable_max = linkable > linkable_max ? linkable : linkable_max;
         checks++;
         junctions_seen += junctions;
         if (crossings > 0 || cover > 0.0) {
@@ -765,13 +808,21 @@ static void check_valid_replay(const char *name, uint64_t work, uint32_t every)
     uint32_t crossings, junctions;
     double cover;
     map_validity(o.ctx, &crossings, &junctions, &cover);
-    print_message("%s (work %llu%s): %u maps checked, %u junction touches (within %.0f mm of an end); "
-                  "finished: %u crossings, %.3f m doubly covered\n",
+    print_message("%s (work %llu%s): %u maps checked, %u junction touches (within %.0f mm of an end), "
+                  "linkable pairs of ends %u in all, %u at most; finished: %u crossings, %.3f m doubly covered\n",
                   name, (unsigned long long)work, work ? "" : ": 500 and the default in turn",
-                  checks, junctions_seen, 1e3 * JUNCTION_M, crossings, cover);
+                  checks, junctions_seen, 1e3 * JUNCTION_M, linkable_sum, linkable_max, crossings, cover);
     assert_int_equal(crossings, 0);
     assert_true(cover == 0.0);
     assert_int_equal(bad, 0);
+    /* the ends a round's operators leave within merge reach are linked
+     * before the update returns (online_round.c, link_left_ends). Without
+     * that: office 138, 109 and 271 pairs over its three replays (up to 10
+     * in one map), angled 32 and 6, square 7; with it 3, 5, 2, 0, 0, 0 (the
+     * rest: a link that would cross, or ends the zip or the crossing repair
+     * after it made) */
+    assert_true(linkable_max <= 1u);
+    assert_true(linkable_sum <= checks / 10u);
     online_close(&o);
     scene_free(&s);
 }
@@ -847,8 +898,14 @@ static void test_walker_trail(void **state)
 
 /* ---- 4. finish against batch --------------------------------------------- */
 
+static double core_rms(const polyc_ctx *ctx, const scene *s);
+
+/* The scene's scans through an online context, an update after each, then
+ * the finishing call: its map's score (and core RMS, when core is not
+ * NULL; the first noise through the progress callback, when noise is not
+ * NULL). */
 static void online_finished_score(const scene *s, const polyc_scan *scans, gtscore_map_score *out,
-                                  first_noise *noise)
+                                  double *core, first_noise *noise)
 {
     online o;
     polyc_online_report r;
@@ -860,6 +917,8 @@ static void online_finished_score(const scene *s, const polyc_scan *scans, gtsco
     check_status(polyc_online_finish(o.ctx, noise ? note_first_noise : NULL, noise, &r), o.ctx,
                  "polyc_online_finish");
     score_ctx(o.ctx, s, out);
+    if (core)
+        *core = core_rms(o.ctx, s);
     online_close(&o);
 }
 
@@ -910,7 +969,7 @@ static void compare_finish(const char *name)
     gtscore_map_score b, f;
     first_noise bn = {0.0}, fn = {0.0};
     batch_score_n(&s, s.sim.scans, s.sim.scan_count, &b, &bn);
-    online_finished_score(&s, s.sim.scans, &f, &fn);
+    online_finished_score(&s, s.sim.scans, &f, NULL, &fn);
     print_message("%s (first noise: batch %.4f m, finish %.4f m):\n", name, bn.noise_m, fn.noise_m);
     print_score("  batch", &b);
     print_score("  online finished", &f);
@@ -1038,7 +1097,7 @@ static void test_ten_passes(void **state)
     scene s;
     scene_make(&s, "office", SCENE_SEED);
     gtscore_map_score one, ten, batch_ten;
-    online_finished_score(&s, s.sim.scans, &one, NULL);
+    online_finished_score(&s, s.sim.scans, &one, NULL, NULL);
     uint32_t n = s.sim.scan_count;
     polyc_scan *all = malloc(10u * n * sizeof *all);
     assert_non_null(all);
@@ -1117,10 +1176,14 @@ static double core_rms(const polyc_ctx *ctx, const scene *s)
  *   office     4.88 mm, 0.9961, 63 v  55.33 / 54.01 mm, 0.8098 / 0.8114  4.92 mm, 0.9978, 58 v
  * (RMS, completeness, vertices); the backlog drained in 1 and 3 updates. */
 #define CORRECT_DRAIN_UPDATES 20   /* updates the backlog drains in after corrections */
-/* core RMS at most the batch's + this (measured: office +0.04 mm, square
- * -0.78 mm; with the drifted poses' accuracy pairs kept instead of learned
- * again, office +0.52 mm; the sweep's spread of online against batch core
- * precision is in docs/performance.md) */
+/* core RMS at most this above the online map of the true poses (no
+ * drift, no corrections; measured: office -0.37 mm, square +0.20 mm; with
+ * the drifted poses' accuracy pairs kept instead of learned again, office
+ * +0.52 mm against the batch map). Against the batch map the corrected map
+ * is held to the finishing call's tolerance (FINISH_RMS_M): its search
+ * settles in another optimum than the batch's, by up to 0.8 mm on square
+ * whether or not poses were corrected (the sweep's spread of online
+ * against batch core precision is in docs/performance.md). */
 #define CORRECT_RMS_M 0.0005
 
 static void check_correction(const char *name)
@@ -1148,7 +1211,10 @@ static void check_correction(const char *name)
         batch_core = core_rms(ctx, &s);
         free(block);
     }
-    online_finished_score(&s, bad, &drift_fin, NULL);
+    online_finished_score(&s, bad, &drift_fin, NULL, NULL);
+    gtscore_map_score truth_fin;
+    double truth_core;
+    online_finished_score(&s, s.sim.scans, &truth_fin, &truth_core, NULL);
     online o;
     polyc_online_report r;
     online_open(&o, &s, s.sim.scan_count);
@@ -1178,14 +1244,17 @@ static void check_correction(const char *name)
     print_score("  online drifted, updated", &before);
     print_score("  online drifted, finished", &drift_fin);
     print_score("  online corrected", &after);
-    print_message("  core RMS (within 0.5 m of a wall): batch %.2f mm, corrected %.2f mm\n",
-                  1e3 * batch_core, 1e3 * after_core);
+    print_score("  online true poses, finished", &truth_fin);
+    print_message("  core RMS (within 0.5 m of a wall): batch %.2f mm, online true poses %.2f mm, "
+                  "corrected %.2f mm\n",
+                  1e3 * batch_core, 1e3 * truth_core, 1e3 * after_core);
     assert_true(updates <= CORRECT_DRAIN_UPDATES);
     /* like the batch map of the true poses */
     assert_true(after.completeness >= batch.completeness - FINISH_COMPLETENESS);
     assert_true(fabs((double)after.vertices - (double)batch.vertices) <=
                 FINISH_VERTICES * (double)batch.vertices);
-    assert_true(after_core <= batch_core + CORRECT_RMS_M);
+    assert_true(after_core <= truth_core + CORRECT_RMS_M);
+    assert_true(after_core <= batch_core + FINISH_RMS_M);
     /* the whole map too: a 2 cm polyline on a walker's trail, traced before
      * the corrections (its cell 13 hits against 50 misses, m 0.21), went
      * only when the finishing call learned to drop short polylines under

@@ -159,6 +159,37 @@ static void test_merge_closes_polyline(void **state)
     fx_close(&f);
 }
 
+/* Two pieces of a band leaving nearly the same point in nearly one
+ * direction (the online round's case: a link there makes a hairpin that
+ * no zigzag or zip after it judges): op_merge links them, op_merge_folds
+ * without folds does not, and still links a wall's two pieces end to end
+ * or at a corner. */
+static void test_merge_without_folds(void **state)
+{
+    (void)state;
+    static fixture f;
+    fx_open_hand(&f, 0.0f);
+    /* from ends 4 cm apart, 10 degrees between the pieces */
+    const float a[4] = {0.0f, 0.0f, 1.0f, 0.0f}, b[4] = {0.0f, 0.04f, 0.985f, 0.2137f};
+    merge_case(&f, a, b, 2);
+    assert_int_equal(polyc__op_merge_folds(&f.o, 0), 0);
+    assert_int_equal(live_lines(&f.o), 2);
+    assert_int_equal(polyc__op_merge(&f.o), 1);
+    assert_int_equal(live_lines(&f.o), 1);
+    /* end to end */
+    const float c[4] = {-1.0f, 0.0f, -0.05f, 0.0f}, d[4] = {0.05f, 0.0f, 1.0f, 0.0f};
+    merge_case(&f, c, d, 2);
+    assert_int_equal(polyc__op_merge_folds(&f.o, 0), 1);
+    check_books(&f.o, "merge without folds");
+    assert_int_equal(live_lines(&f.o), 1);
+    /* a corner: 90 degrees */
+    const float e[4] = {-1.0f, 0.0f, -0.05f, 0.0f}, g[4] = {0.0f, 0.05f, 0.0f, 1.0f};
+    merge_case(&f, e, g, 2);
+    assert_int_equal(polyc__op_merge_folds(&f.o, 0), 1);
+    assert_int_equal(live_lines(&f.o), 1);
+    fx_close(&f);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -168,6 +199,7 @@ int main(void)
         cmocka_unit_test(test_merge_joins_ends_10cm_apart),
         cmocka_unit_test(test_merge_leaves_ends_30cm_apart),
         cmocka_unit_test(test_merge_closes_polyline),
+        cmocka_unit_test(test_merge_without_folds),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -183,6 +183,28 @@ static void test_unfold_corner_overshoot(void **state)
     fx_close(&f);
 }
 
+/* A band's two faces drawn as one polyline that turns back through two
+ * vertices 3 cm apart (an online map of freiburg-079: legs of 37 and 46 cm
+ * within 5 cm of each other, counted as double cover): op_unfold takes one
+ * of the two vertices and then the fold, whatever the BIC, and leaves no
+ * stretch drawn twice. */
+static void test_unfold_two_vertex_hairpin(void **state)
+{
+    (void)state;
+    static fixture f;
+    static ptlist p;
+    const float walls[8] = {0.0f, 0.0f, 0.46f, 0.0f, 0.46f, 0.03f, 0.09f, 0.03f};
+    const float xy[8] = {0.0f, 0.0f, 0.46f, 0.0f, 0.46f, 0.03f, 0.09f, 0.03f};
+    int32_t l = two_walls_case(&f, &p, walls, xy, 4);
+    assert_int_equal(polyc__op_zigzag(&f.o), 0); /* no single vertex folds */
+    assert_true(polyc__op_unfold(&f.o) >= 2);
+    check_books(&f.o, "unfold two-vertex hairpin");
+    const polyc__store *s = f.o.s;
+    assert_int_equal(s->l[l].count, 2);
+    assert_int_equal(polyc__op_unfold(&f.o), 0);
+    fx_close(&f);
+}
+
 /* A thin wall's end drawn round (two 1 m faces 6 cm apart) folds on two
  * long legs: it is a wall's two faces, not one face twice, and stays. */
 static void test_unfold_keeps_thin_wall_end(void **state)
@@ -401,6 +423,7 @@ int main(void)
         cmocka_unit_test(test_zigzag_removes_hairpin),
         cmocka_unit_test(test_zigzag_keeps_sharp_corner_with_data),
         cmocka_unit_test(test_unfold_corner_overshoot),
+        cmocka_unit_test(test_unfold_two_vertex_hairpin),
         cmocka_unit_test(test_unfold_keeps_thin_wall_end),
         cmocka_unit_test(test_noise_deterministic_and_sized),
         cmocka_unit_test(test_remove_collinear_vertex),
