@@ -360,9 +360,10 @@ static uint32_t stamp_near_ends(polyc__opt *o, uint32_t since)
  * the data; returns how many links. The operators merge first, and their
  * split, climbs and trims leave some ends within reach again; a batch
  * build's next iteration links those, an update's next round does only if
- * its region holds them. Left, they piled up: on edmonton about 200 pairs
- * of ends within 15 cm at a time during the updates, against 8 in the
- * batch map, most of them two-vertex pieces of one wall. */
+ * its region holds them. Left, they piled up: edmonton's maps after 200
+ * and 300 scans had 169 and 194 pairs of ends of two polylines within
+ * 15 cm (most of them two-vertex pieces of one wall), the batch map 8;
+ * with the links 30 and 36. */
 static int link_left_ends(polyc__opt *o)
 {
     if (!o->pol.restructure)
