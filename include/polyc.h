@@ -400,8 +400,11 @@ POLYC_API polyc_status polyc_online_add_scan(polyc_ctx *ctx, const polyc_scan *s
 /* Re-optimises what the scans added or corrected since the last update
  * changed, spending at most about `work` units (POLYC_ONLINE_WORK_DEFAULT;
  * 0 is POLYC_ERR_CONFIG); what does not fit stays in the backlog for the
- * next update. The same scans and budgets give the same map. Before any
- * scan: POLYC_ERR_STATE. out may be NULL. */
+ * next update. Waiting pose corrections count against the budget (a unit
+ * per two beams they cast); an update they spent it in does nothing else
+ * (its report: their units, the version unchanged). The same scans and
+ * budgets give the same map. Before any scan: POLYC_ERR_STATE. out may be
+ * NULL. */
 POLYC_API polyc_status polyc_online_update(polyc_ctx *ctx, uint64_t work,
                                            polyc_online_report *out);
 /* Converges the map as a batch build would: the backlog, then the full

@@ -468,7 +468,7 @@ enum {
     SCAN_RECOUNT   /* in again on cleared counts, as a batch counts it (its
                     * records later: polyc__online_redo_records); the misses
                     * on hit cells, which put a tile in the backlog, are
-                    * not tallied (every tile joins it: relearn) */
+                    * not tallied (every tile joins it: polyc__online_apply_corrections) */
 };
 
 /* The scan's beams into the grid and its endpoints into the sums; a new
@@ -575,10 +575,11 @@ polyc_status polyc_online_add_scan(polyc_ctx *ctx, const polyc_scan *s, int keep
     if (keep && (on->kept_n >= on->lim.keep_scans || s->beam_count > on->lim.keep_beams - on->kept_beams))
         return polyc__fail(ctx, POLYC_ERR_LIMIT, "no room to keep the scan (limits.keep_scans, keep_beams)");
     if (on->moved_n > 0) { /* the waiting corrections go in first */
-        polyc_status cst2 = polyc__online_apply_corrections(ctx);
+        polyc_status cst2 = polyc__online_apply_corrections(ctx, NULL);
         if (cst2 != POLYC_OK)
             return cst2;
     }
+    polyc__online_learn_due(ctx); /* (before this scan's lines join the prior) */
     if (!ctx->have_frame) {
         ctx->frame_x = s->pose_x_m;
         ctx->frame_y = s->pose_y_m;
@@ -775,10 +776,15 @@ static void relabel(polyc_ctx *ctx, int all)
  * Without it the drifted scans' pairs stay, and the weights they give (a
  * band's, where the drift spread a wall) fit the corrected map loosely:
  * intel's drift experiment came out at 1.23 times the batch map's BIC on
- * the true poses' data. */
-static void relearn(polyc_ctx *ctx)
+ * the true poses' data. The learning waits for the next round or scan
+ * (polyc__online_learn_due): nothing reads the two before, and the update
+ * that applies the corrections does nothing else. */
+void polyc__online_learn_due(polyc_ctx *ctx)
 {
     polyc__online *on = ctx->online;
+    if (!on->learn_due)
+        return;
+    on->learn_due = 0;
     polyc__prior_forget(&on->prior);
     polyc__accuracy_forget(&on->acc);
     for (uint32_t k = 0; k < on->kept_n; k++) {
@@ -789,17 +795,26 @@ static void relearn(polyc_ctx *ctx)
         ctx->arena.used = mark;
         on->learn_cache = NULL;
     }
-    polyc__online_backlog_all(ctx);
 }
 
-polyc_status polyc__online_apply_corrections(polyc_ctx *ctx)
+polyc_status polyc__online_apply_corrections(polyc_ctx *ctx, uint64_t *beams_cast)
 {
     polyc__online *on = ctx->online;
+    if (beams_cast)
+        *beams_cast = 0;
     if (on->moved_n == 0)
         return POLYC_OK;
     int all = on->kept_n == on->scans;
     float lx = on->last_x, ly = on->last_y;
     int afresh = all && 2u * on->moved_n >= on->kept_n;
+    uint64_t moved_beams = 0;
+    for (uint32_t k = 0; k < on->kept_n; k++)
+        if (is_moved(on, k))
+            moved_beams += ctx->scans[1 + k].count;
+    /* counted (afresh: every kept scan once; else each moved one out and
+     * in), then their contour cast */
+    if (beams_cast)
+        *beams_cast = (afresh ? on->kept_beams : 2u * moved_beams) + (all ? on->kept_beams : moved_beams);
     if (!afresh) /* (a scan taken out takes its misses out of the records) */
         polyc__online_redo_records(ctx, UINT32_MAX);
     polyc_status st = afresh ? count_afresh(ctx) : move_each(ctx);
@@ -808,8 +823,10 @@ polyc_status polyc__online_apply_corrections(polyc_ctx *ctx)
     relabel(ctx, all);
     memset(on->moved, 0, (on->lim.keep_scans / 32u + 1u) * sizeof *on->moved);
     on->moved_n = 0;
-    if (all)
-        relearn(ctx);
+    if (all) {
+        polyc__online_backlog_all(ctx);
+        on->learn_due = 1;
+    }
     return st;
 }
 

@@ -60,6 +60,9 @@ typedef struct polyc__online {
     /* the kept scans redo_next .. redo_end - 1 still to put their misses
      * back into the records after a recount (grid.c) */
     uint32_t redo_next, redo_end;
+    /* corrections of every kept scan were applied: the prior and the
+     * accuracy are learned again before the next round or scan */
+    uint32_t learn_due;
 
     /* the angle prior and the accuracy, learned scan by scan */
     polyc__prior prior;
@@ -112,9 +115,13 @@ void polyc__online_stage_limits(const polyc_online_limits *ol, polyc_limits *lim
 void polyc__online_backlog_misses(polyc_ctx *ctx);
 void polyc__online_backlog_all(polyc_ctx *ctx);
 /* the corrections given since the last update (or add) into the grid, the
- * sums and the contour; when every scan is kept, the prior and the
- * accuracy learned again (online.c, "pose corrections") */
-polyc_status polyc__online_apply_corrections(polyc_ctx *ctx);
+ * sums and the contour; when every scan is kept, every tile into the
+ * backlog and the prior and the accuracy due to be learned again
+ * (online.c, "pose corrections"); the beams that cast into *beams_cast
+ * (0 when none waited; may be NULL) */
+polyc_status polyc__online_apply_corrections(polyc_ctx *ctx, uint64_t *beams_cast);
+/* the prior and the accuracy learned again from the kept scans, if due */
+void polyc__online_learn_due(polyc_ctx *ctx);
 /* after a recount, the records' misses of the next kept scans put back,
  * until `beams` (> 0) of their beams are done (UINT32_MAX: all) */
 void polyc__online_redo_records(polyc_ctx *ctx, uint32_t beams);

@@ -1230,7 +1230,15 @@ static void check_correction(const char *name)
         check_status(polyc_online_correct(o.ctx, i, t->pose_x_m, t->pose_y_m, t->pose_theta_rad),
                      o.ctx, "polyc_online_correct");
     }
-    uint32_t updates = 0;
+    /* the first update applies the corrections and does nothing else: they
+     * spent its budget (a unit per two beams cast), the map is as it was,
+     * every tile is in the backlog */
+    uint64_t was = polyc_online_version(o.ctx);
+    update(&o, POLYC_ONLINE_WORK_DEFAULT, &r);
+    assert_true(r.work >= POLYC_ONLINE_WORK_DEFAULT);
+    assert_int_equal(r.version, was);
+    assert_true(r.backlog_tiles > 0);
+    uint32_t updates = 1;
     do {
         update(&o, POLYC_ONLINE_WORK_DEFAULT, &r);
         updates++;

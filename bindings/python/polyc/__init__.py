@@ -856,8 +856,10 @@ class OnlineMap(_Block):
     def update(self, work=ONLINE_WORK_DEFAULT):
         """Re-optimises what the scans since the last update changed, within
         about `work` units (0 is PolycError POLYC_ERR_CONFIG); the rest stays
-        in the backlog. Before any scan: PolycError POLYC_ERR_STATE. Returns
-        an OnlineReport."""
+        in the backlog. Waiting corrections count against the budget (a unit
+        per two beams they cast); an update they spent it in does nothing
+        else. Before any scan: PolycError POLYC_ERR_STATE. Returns an
+        OnlineReport."""
         self._enter("update")
         work = _int_field("work", work, _u64)
         r = _OnlineReport()
