@@ -814,7 +814,8 @@ polyc_status polyc__online_apply_corrections(polyc_ctx *ctx, uint64_t *beams_cas
     /* counted (afresh: every kept scan once; else each moved one out and
      * in), then their contour cast */
     if (beams_cast)
-        *beams_cast = (afresh ? on->kept_beams : 2u * moved_beams) + (all ? on->kept_beams : moved_beams);
+        *beams_cast = (afresh ? on->kept_beams : 2u * moved_beams) +
+                      (all ? on->kept_beams : moved_beams);
     if (!afresh) /* (a scan taken out takes its misses out of the records) */
         polyc__online_redo_records(ctx, UINT32_MAX);
     polyc_status st = afresh ? count_afresh(ctx) : move_each(ctx);
