@@ -54,6 +54,8 @@ static const char usage_text[] =
     "  --drift R,X,Y    the pose-correction row's drift at the last scan: a turn\n"
     "                   of R rad about the first pose and a shift of (X, Y) m\n"
     "                   (default 0.02,0.30,-0.20)\n"
+    "  --maps DIR       write each scene's finished online map to DIR (which must\n"
+    "                   exist) as NAME.online.txt, `/` as `-` (carmen-intel...)\n"
     "  -h, --help       this text\n";
 static const char usage_columns[] =
     "Columns: stage times in ms (parse = reading the log, add = polyc_add_scan,\n"
@@ -338,6 +340,8 @@ static int parse_options(int argc, char **argv, options *o)
             o->online_only = 1;
         } else if (strcmp(a, "--rows-log") == 0 && i + 1 < argc) {
             o->rows_log = argv[++i];
+        } else if (strcmp(a, "--maps") == 0 && i + 1 < argc) {
+            o->maps_dir = argv[++i];
         } else if (strcmp(a, "--drift") == 0 && i + 1 < argc) {
             char tail;
             if (sscanf(argv[++i], "%lf,%lf,%lf%c", &o->drift[0], &o->drift[1], &o->drift[2],

@@ -37,6 +37,7 @@ typedef struct options {
     int online;                /* the online section (--no-online: 0) */
     int online_only;           /* only the online section */
     const char *rows_log;      /* the memory and correction rows' real log */
+    const char *maps_dir;      /* --maps: the online maps written there (NULL: not) */
     double drift[3];           /* the correction row's drift at the last scan:
                                   turn (rad), shift x, y (m) */
     const char *data;

@@ -13,6 +13,7 @@
 #include "bench.h"
 #include "fairbic.h"
 #include "gtscore.h"
+#include "mapout.h"
 
 #define CHECK_EVERY 100u  /* a checkpoint every 100 scans... */
 #define CHECK_MAX 10u     /* ...at most 10 a log, evenly spread over those */
@@ -108,6 +109,37 @@ static polyc_polyline *map_lines(const polyc_ctx *ctx, uint32_t *count)
         }
     *count = n;
     return lines;
+}
+
+/* With --maps DIR: ctx's map as DIR/LABEL.online.txt (polyc's text
+ * format, `/` in the label as `-`), to look at or score again
+ * (build-bench/mapscore LOG MAP.txt). A map the tool's `polyc --online`
+ * gives differs: the tool sizes its area from the log another way. */
+static void save_map(const options *o, const polyc_ctx *ctx, const char *label)
+{
+    char path[1200], name[160];
+    uint32_t count, k;
+    polyc_polyline *lines;
+    mapout_map map;
+    FILE *f;
+    if (!o->maps_dir)
+        return;
+    snprintf(name, sizeof name, "%s", label);
+    for (k = 0; name[k]; k++)
+        if (name[k] == '/')
+            name[k] = '-';
+    snprintf(path, sizeof path, "%s/%s.online.txt", o->maps_dir, name);
+    if ((lines = map_lines(ctx, &count)) == NULL || (f = fopen(path, "w")) == NULL) {
+        printf("%-24s --maps: cannot write %s\n", label, path);
+        free(lines);
+        return;
+    }
+    memset(&map, 0, sizeof map);
+    map.lines = lines;
+    map.line_count = count;
+    if (mapout_txt(f, &map) != 0 || fclose(f) != 0)
+        printf("%-24s --maps: error writing %s\n", label, path);
+    free(lines);
 }
 
 /* The figures of ctx's map against d's endpoints (and truth); the times
@@ -593,6 +625,7 @@ static int online_scene(const options *o, const scene *s, const bench_figures *t
                step_p99, step_max, r.total_ms, ratio, r.finish_ms, r.backlog_max, r.checks,
                worst, at, r.cross_max, r.dcov_max_m, tries);
         res->online.lib_ms = r.total_ms;
+        save_map(o, on.ctx, res->label);
         score_map(&d, on.ctx, &res->online);
         fair_score(o, &d, on.ctx, &res->online, res->label);
         res->ok = 1;
