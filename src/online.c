@@ -807,15 +807,16 @@ polyc_status polyc__online_apply_corrections(polyc_ctx *ctx, uint64_t *beams_cas
     int all = on->kept_n == on->scans;
     float lx = on->last_x, ly = on->last_y;
     int afresh = all && 2u * on->moved_n >= on->kept_n;
-    uint64_t moved_beams = 0;
-    for (uint32_t k = 0; k < on->kept_n; k++)
-        if (is_moved(on, k))
-            moved_beams += ctx->scans[1 + k].count;
-    /* counted (afresh: every kept scan once; else each moved one out and
-     * in), then their contour cast */
-    if (beams_cast)
+    if (beams_cast) {
+        uint64_t moved_beams = 0;
+        for (uint32_t k = 0; k < on->kept_n; k++)
+            if (is_moved(on, k))
+                moved_beams += ctx->scans[1 + k].count;
+        /* counted (afresh: every kept scan once; else each moved one out
+         * and in), then their contour cast */
         *beams_cast = (afresh ? on->kept_beams : 2u * moved_beams) +
                       (all ? on->kept_beams : moved_beams);
+    }
     if (!afresh) /* (a scan taken out takes its misses out of the records) */
         polyc__online_redo_records(ctx, UINT32_MAX);
     polyc_status st = afresh ? count_afresh(ctx) : move_each(ctx);

@@ -507,15 +507,16 @@ polyc_status polyc_online_update(polyc_ctx *ctx, uint64_t work, polyc_online_rep
     uint32_t changed = 0;
     if ((st = polyc__online_apply_corrections(ctx, &cast)) != POLYC_OK)
         return st;
-    if (cast / CAST_BEAMS_PER_UNIT >= work) {
+    uint64_t corrections = cast / CAST_BEAMS_PER_UNIT; /* their units */
+    if (corrections >= work) {
         /* the corrections spent the budget: the rounds come in the next
          * updates (intel's 910 at once: some 90 ms; a round and the
          * records' first slice after them took another 16) */
         on->pending = 0;
-        report(ctx, cast / CAST_BEAMS_PER_UNIT, 0, out);
+        report(ctx, corrections, 0, out);
         return POLYC_OK;
     }
-    work -= cast / CAST_BEAMS_PER_UNIT;
+    work -= corrections;
     polyc__online_learn_due(ctx);
     polyc__online_redo_records(ctx, REDO_BEAMS);
     polyc__online_backlog_misses(ctx);
@@ -531,7 +532,7 @@ polyc_status polyc_online_update(polyc_ctx *ctx, uint64_t work, polyc_online_rep
             st = pst;
     }
     on->pending = 0;
-    report(ctx, spent + cast / CAST_BEAMS_PER_UNIT, changed, out);
+    report(ctx, spent + corrections, changed, out);
     return st;
 }
 
