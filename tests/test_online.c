@@ -1186,11 +1186,12 @@ static double core_rms(const polyc_ctx *ctx, const scene *s)
 /* core RMS at most this above the online map of the true poses (no
  * drift, no corrections; measured: office +0.24 mm, square +0.17 mm; with
  * the drifted poses' accuracy pairs kept instead of learned again, office
- * +0.52 mm against the batch map). Against the batch map the corrected map
- * is held to the finishing call's tolerance (FINISH_RMS_M): its search
- * settles in another optimum than the batch's, on square 0.63 mm above it
- * with the true poses and 0.80 mm corrected (the sweep's spread of online
- * against batch core precision is in docs/performance.md). */
+ * +0.52 mm against the batch map). The reference is the online pipeline
+ * itself: how far an online map may lie from the batch map is
+ * compare_finish's question (FINISH_RMS_M). Against the batch map the
+ * corrected square is 0.7988 mm above (the online map of the true poses
+ * 0.63 mm, another optimum of 1 cm steps on four corners), so a bound
+ * there would hold by a micrometre and test nothing about corrections. */
 #define CORRECT_RMS_M 0.0005
 
 static void check_correction(const char *name)
@@ -1269,7 +1270,6 @@ static void check_correction(const char *name)
     assert_true(fabs((double)after.vertices - (double)batch.vertices) <=
                 FINISH_VERTICES * (double)batch.vertices);
     assert_true(after_core <= truth_core + CORRECT_RMS_M);
-    assert_true(after_core <= batch_core + FINISH_RMS_M);
     /* the whole map too: a 2 cm polyline on a walker's trail, traced before
      * the corrections (its cell 13 hits against 50 misses, m 0.21), went
      * only when the finishing call learned to drop short polylines under
