@@ -2,6 +2,7 @@
  * seeds, scored against each scene's own ground truth.
  *
  *   sweep [--seeds A-B] [--kinds a,b,...] [--save DIR] [--svg DIR] [--occupancy | --online]
+ *         [--map-seed N]
  *
  * Takes nothing from disk: every scene is simulated (tools/eval/scansim.h), its
  * ground truth written to memory and read back by tools/eval/gtscore.h, its scans
@@ -93,6 +94,10 @@ static const char usage_text[] =
     "                   kind and over all on how many scenes core/b <= 1.10 and\n"
     "                   the worst core/b and verts/b, and lists the five scenes\n"
     "                   of the worst core/b. Not with --occupancy\n"
+    "  --map-seed N     the optimiser's seed (polyc_config.seed) of every map,\n"
+    "                   batch and online; default the library's. Two runs that\n"
+    "                   differ only in it show how far a figure moves with the\n"
+    "                   search's random path alone\n"
     "  -h, --help       this text\n"
     "Columns: scans, beams (all scans), ms (the pipeline from polyc_init to the\n"
     "optimised map), verts (map vertices), ideal, ratio (verts / ideal), rms\n"
@@ -125,6 +130,8 @@ typedef struct options {
     const char *svg_dir;       /* NULL: none */
     int occupancy;             /* --occupancy */
     int online;                /* --online */
+    int map_seed_set;          /* --map-seed given */
+    uint64_t map_seed;         /* --map-seed: polyc_config.seed of every map */
 } options;
 
 /* ---- the figures ----------------------------------------------------------- */
@@ -436,16 +443,14 @@ static double ratio_of(double a, double b)
  * map's figures (the row `batch`) beside it. *lines and *count become the
  * online map's (the caller frees them). */
 static int online_scene(const scansim_scene *sc, const gtscore_truth *truth, const row *batch,
-                        pipeline *q, polyc_polyline **lines, uint32_t *count, row *r,
-                        const char *label)
+                        const polyc_config *config, pipeline *q, polyc_polyline **lines,
+                        uint32_t *count, row *r, const char *label)
 {
-    polyc_config config;
     double ms;
-    polyc_config_default(&config);
     free(*lines);
     *lines = NULL;
     *count = 0;
-    if (pipeline_run_online(q, &config, sc->scans, sc->scan_count, &ms) != 0 ||
+    if (pipeline_run_online(q, config, sc->scans, sc->scan_count, &ms) != 0 ||
         (*lines = pipeline_lines(q, count)) == NULL) {
         printf("%s error in %s (online): %s (%s)\n", label,
                q->failed_at ? q->failed_at : "pipeline_lines", polyc_status_str(q->status),
@@ -503,6 +508,8 @@ static int sweep_scene(const options *o, const char *kind, uint64_t seed, row *r
         goto done;
     }
     polyc_config_default(&config);
+    if (o->map_seed_set)
+        config.seed = o->map_seed;
     if (o->occupancy) {
         occmap_config oc;
         occmap_config_default(&oc);
@@ -536,7 +543,7 @@ static int sweep_scene(const options *o, const char *kind, uint64_t seed, row *r
         printf("%s error: scoring ran out of memory\n", label);
         goto done;
     }
-    if (o->online && online_scene(&sc, &truth, &batch, &q, &lines, &count, r, label) != 0)
+    if (o->online && online_scene(&sc, &truth, &batch, &config, &q, &lines, &count, r, label) != 0)
         goto done;
     r->ok = 1;
     printf("%s", label);
@@ -746,6 +753,13 @@ static int parse_options(int argc, char **argv, options *o)
             o->online = 1;
         } else if (strcmp(a, "--svg") == 0 && i + 1 < argc) {
             o->svg_dir = argv[++i];
+        } else if (strcmp(a, "--map-seed") == 0 && i + 1 < argc) {
+            char *end;
+            errno = 0;
+            o->map_seed = strtoull(argv[++i], &end, 10);
+            if (errno || end == argv[i] || *end)
+                return -1;
+            o->map_seed_set = 1;
         } else
             return -1;
     }
