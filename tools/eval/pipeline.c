@@ -167,6 +167,12 @@ static uint32_t twice(uint32_t a, double cap)
 int pipeline_run_online(pipeline *p, const polyc_config *config, const polyc_scan *scans,
                         uint32_t n, double *ms)
 {
+    return pipeline_run_online_wider(p, config, scans, n, 0.0, ms);
+}
+
+int pipeline_run_online_wider(pipeline *p, const polyc_config *config, const polyc_scan *scans,
+                              uint32_t n, double wider_m, double *ms)
+{
     polyc_box box = {HUGE_VAL, HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
     double x0, y0, reach, tiles;
     uint32_t i, beams = 0;
@@ -185,7 +191,7 @@ int pipeline_run_online(pipeline *p, const polyc_config *config, const polyc_sca
     }
     reach = fmax(fmax(x0 - box.min_x_m, box.max_x_m - x0),
                  fmax(y0 - box.min_y_m, box.max_y_m - y0));
-    if (step(p, polyc_online_limits_for_area(&p->config, 2.0 * (reach + PIPELINE_ONLINE_MARGIN_M),
+    if (step(p, polyc_online_limits_for_area(&p->config, 2.0 * (reach + PIPELINE_ONLINE_MARGIN_M) + wider_m,
                                              beams, &p->online_limits),
              "polyc_online_limits_for_area"))
         return -1;

@@ -65,6 +65,12 @@ int pipeline_run_grid(pipeline *p, const polyc_config *config, const polyc_occup
 #define PIPELINE_ONLINE_DOUBLINGS 4u
 int pipeline_run_online(pipeline *p, const polyc_config *config, const polyc_scan *scans,
                         uint32_t n, double *ms);
+/* The same with the square's side `wider_m` longer: its grid's cells lie
+ * wider_m / 2 further out (the online grid is laid out from the corner of
+ * the square), so a wider_m that is no multiple of two cells aligns them
+ * another way. */
+int pipeline_run_online_wider(pipeline *p, const polyc_config *config, const polyc_scan *scans,
+                              uint32_t n, double wider_m, double *ms);
 /* The current map as an array of polylines (malloc'ed; NULL on failure). */
 polyc_polyline *pipeline_lines(pipeline *p, uint32_t *count);
 
