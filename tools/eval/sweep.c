@@ -841,6 +841,8 @@ static int parse_options(int argc, char **argv, options *o)
         } else
             return -1;
     }
+    if (!o->online && (o->batch_seeds > 1 || o->online_wider_m > 0.0))
+        return -1; /* (options of --online) */
     return o->online && o->occupancy ? -1 : 0;
 }
 
