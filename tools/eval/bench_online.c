@@ -137,7 +137,8 @@ static void save_map(const options *o, const polyc_ctx *ctx, const char *label)
     memset(&map, 0, sizeof map);
     map.lines = lines;
     map.line_count = count;
-    if (mapout_txt(f, &map) != 0 || fclose(f) != 0)
+    int bad = mapout_txt(f, &map) != 0;
+    if (fclose(f) != 0 || bad) /* (closed either way) */
         printf("%-24s --maps: error writing %s\n", label, path);
     free(lines);
 }

@@ -604,7 +604,8 @@ static int sweep_scene(const options *o, const char *kind, uint64_t seed, row *r
     if (o->online && batch_core_high(&sc, &truth, &config, o->batch_seeds - 1u,
                                      batch.fig[FIG_CORE], &batch.fig[FIG_BCORE_HI], label) != 0)
         goto done;
-    if (o->online && online_scene(&sc, &truth, &batch, &config, o->online_wider_m, &q, &lines, &count, r, label) != 0)
+    if (o->online && online_scene(&sc, &truth, &batch, &config, o->online_wider_m, &q, &lines,
+                                  &count, r, label) != 0)
         goto done;
     r->ok = 1;
     printf("%s", label);
@@ -748,21 +749,24 @@ static void summarise(const options *o, const row *rows, size_t n, const char *k
 
 /* ---- main ------------------------------------------------------------------- */
 
+/* A decimal unsigned number at the start of text, no sign; *end after it.
+ * -1 when there is none or it does not fit. */
+static int parse_unsigned(const char *text, char **end, unsigned long long *out)
+{
+    errno = 0;
+    *out = strtoull(text, end, 10);
+    return errno || *end == text || text[0] == '-' ? -1 : 0;
+}
+
 static int parse_seeds(const char *text, options *o)
 {
     char *end;
     unsigned long long a, b;
-    errno = 0;
-    a = strtoull(text, &end, 10);
-    if (errno || end == text || text[0] == '-')
+    if (parse_unsigned(text, &end, &a))
         return -1;
     b = a;
-    if (*end == '-') {
-        const char *second = end + 1;
-        b = strtoull(second, &end, 10);
-        if (errno || end == second || second[0] == '-')
-            return -1;
-    }
+    if (*end == '-' && parse_unsigned(end + 1, &end, &b))
+        return -1;
     if (*end || b < a || b - a > 100000u)
         return -1;
     o->seed_first = a;
@@ -827,16 +831,16 @@ static int parse_options(int argc, char **argv, options *o)
             o->online_wider_m = v;
         } else if (strcmp(a, "--batch-seeds") == 0 && i + 1 < argc) {
             char *end;
-            unsigned long v = strtoul(argv[++i], &end, 10);
-            if (end == argv[i] || *end || v < 1 || v > 16)
+            unsigned long long v;
+            if (parse_unsigned(argv[++i], &end, &v) || *end || v < 1 || v > 16)
                 return -1;
             o->batch_seeds = (unsigned)v;
         } else if (strcmp(a, "--map-seed") == 0 && i + 1 < argc) {
             char *end;
-            errno = 0;
-            o->map_seed = strtoull(argv[++i], &end, 10);
-            if (errno || end == argv[i] || *end)
+            unsigned long long v;
+            if (parse_unsigned(argv[++i], &end, &v) || *end)
                 return -1;
+            o->map_seed = v;
             o->map_seed_set = 1;
         } else
             return -1;
