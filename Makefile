@@ -199,7 +199,7 @@ $(BUILD)/footprint8: examples/footprint.c $(EMB_OBJ)
 # the quick bad-input tests again in build-asan/ under ASan and UBSan.
 # test-valgrind: the tool over a sample log (batch and --online), its grid as
 # a ROS map and a bad log, no error or leak.
-FUZZ_TARGETS = scanlog library mapyaml pgm
+FUZZ_TARGETS = scanlog library mapyaml pgm png
 FUZZ_REPLAY  = $(FUZZ_TARGETS:%=$(BUILD)/tests/fuzz_replay_%)
 $(BUILD)/tests/fuzz_replay_%: tests/fuzz_%.c tests/fuzz_replay.c $(TOOL_OBJ) $(BUILD)/libpolyc.a
 	@mkdir -p $(dir $@)
@@ -249,10 +249,12 @@ build-fuzz/fuzz_scanlog: tests/fuzz_scanlog.c tools/scanlog.c tools/scanlog_nore
 build-fuzz/fuzz_library: tests/fuzz_library.c $(LIB_SRC)
 build-fuzz/fuzz_mapyaml: tests/fuzz_mapyaml.c tools/mapfile.c tools/mapfile_pgm.c tools/textesc.c
 build-fuzz/fuzz_pgm: tests/fuzz_pgm.c tools/mapfile.c tools/mapfile_pgm.c tools/textesc.c
+build-fuzz/fuzz_png: tests/fuzz_png.c tools/mapfile.c tools/mapfile_pgm.c tools/mapfile_png.c \
+    tools/inflate.c tools/textesc.c
 # the optimiser's float compares drown the run in comparison tracing: off
 build-fuzz/fuzz_library: FUZZ_CFLAGS += -fno-sanitize-coverage=trace-cmp
 $(FUZZ_BIN): include/polyc.h $(wildcard src/*.h) tools/scanlog.h tools/scanlog_noreturn.h \
-             tools/mapfile.h tools/textesc.h
+             tools/mapfile.h tools/textesc.h tools/inflate.h
 	@mkdir -p $(dir $@)
 	$(FUZZ_CC) $(FUZZ_CFLAGS) $(filter %.c,$^) -o $@ -lm
 fuzz: $(FUZZ_BIN)

@@ -1,6 +1,6 @@
 #!/bin/sh
 # cli_bad_input.sh - every bad input of issue 6 through the polyc tool, and
-# bad ROS maps (a map YAML and its PGM) and `polyc grid`.
+# bad ROS maps (a map YAML and its PGM or PNG) and `polyc grid`.
 #   tests/cli_bad_input.sh [--quick] POLYC
 # Each input must give either a map (exit 0, what was skipped counted in
 # --stats) or one line `polyc: FILE:LINE: reason` on stderr with a non-zero
@@ -302,6 +302,23 @@ for f in sub/dir/m.yaml abs.yaml; do
     run --format txt "$f"
     [ $rc -eq 0 ] && cmp -s out.txt p2.txt || bad "exit $rc, or the P5 map differs from the P2 one"
 done
+# the same room as PNG: 8-bit gray, and 8-bit RGBA in scale mode with the
+# unknown cells transparent (what nav2's map_saver writes in scale mode):
+# the same cells, so the same map
+printf '\211\120\116\107\015\012\032\012\000\000\000\015\111\110\104\122\000\000\000\024\000\000\000\020\010\000\000\000\000\063\163\000\307\000\000\000\040\111\104\101\124\170\332\143\070\213\005\060\340\020\144\100\003\020\301\177\050\140\120\010\142\163\047\361\336\244\104\020\000\035\300\356\055\117\046\130\374\000\000\000\000\111\105\116\104\256\102\140\202' > room_g.png
+printf '\211\120\116\107\015\012\032\012\000\000\000\015\111\110\104\122\000\000\000\024\000\000\000\020\010\006\000\000\000\026\030\137\033\000\000\000\055\111\104\101\124\170\332\143\070\173\366\054\003\065\061\003\315\014\004\202\377\224\140\254\006\376\373\367\217\054\074\152\340\210\066\220\252\351\160\360\147\275\221\143\040\000\034\301\132\042\323\172\235\046\000\000\000\000\111\105\116\104\256\102\140\202' > room_c.png
+printf 'image: room_g.png\nresolution: 0.05\n%s\n' "$REST" > png_g.yaml
+printf 'image: room_c.png\nmode: scale\nresolution: 0.05\n%s\n' "$REST" > png_c.yaml
+for f in png_g.yaml png_c.yaml; do
+    name="map-png-$f"
+    run --format txt "$f"
+    [ $rc -eq 0 ] && cmp -s out.txt p2.txt || bad "exit $rc, or the PNG map differs from the PGM one"
+done
+name=map-png-stats
+run --stats -o map.svg png_c.yaml
+[ $rc -eq 0 ] && grep -qE '^map +20 x 16 cells of 0.05 m, room_c.png \(PNG, 8-bit RGBA\), mode scale$' err.txt \
+    || bad "exit $rc, or --stats lacks the PNG's map line"
+rm -f map.svg
 
 # refused: the YAML's line, or the image's byte
 cat > nonegate.yaml <<YAML
@@ -332,7 +349,7 @@ printf 'image: adir\nresolution: 0.05\n%s\n' "$REST" > dirimg.yaml
 refused map-image-directory dirimg.yaml 1 'image adir: Is a directory$'
 for dev in /dev/zero /dev/urandom; do
     printf 'image: %s\nresolution: 0.05\n%s\n' $dev "$REST" > dev.yaml
-    refused "map-image-$dev" dev.yaml 1 "image $dev: not a regular file \(a device or a FIFO\): give a PGM file$"
+    refused "map-image-$dev" dev.yaml 1 "image $dev: not a regular file \(a device or a FIFO\): give a PGM or PNG file$"
 done
 mkfifo fifo.pgm
 printf 'image: fifo.pgm\nresolution: 0.05\n%s\n' "$REST" > fifo.yaml
@@ -346,7 +363,7 @@ if LC_ALL=C grep -q '[^ -~]' err.txt; then bad "--stats prints raw bytes"; fi
 rm -f map.svg "$(printf '\033[2J.pgm')"
 printf '\211PNG\r\n\032\n\000\000\000\rIHDR' > png.pgm
 printf 'image: png.pgm\nresolution: 0.05\n%s\n' "$REST" > png.yaml
-refused_as map-png png.yaml 'polyc: png.pgm: byte 0: ' 'a PNG image: polyc reads PGM \(P5 or P2\) only; save the map as PGM'
+refused_as map-png-truncated png.yaml 'polyc: png.pgm: byte 8: ' 'the file ends before its IEND chunk \(truncated\)$'
 img() { printf 'image: %s\nresolution: 0.05\n%s\n' "$1" "$REST" > "$1.yaml"; }
 printf 'P5\n4 2\n255\n\000\000\000' > cut.pgm; img cut.pgm
 refused_as map-truncated cut.pgm.yaml 'polyc: cut.pgm: byte 14: ' 'truncated: 3 bytes of pixel data, 4 x 2 at 1 bytes a pixel need 8$'

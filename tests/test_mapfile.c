@@ -383,8 +383,7 @@ static void test_pgm_errors(void **state)
 {
     (void)state;
     EXPECT_PGM_ERROR("\x89PNG\r\n\x1a\n\0\0\0\rIHDR",
-                     "m.pgm: byte 0: a PNG image: polyc reads PGM (P5 or P2) only; save the map as"
-                     " PGM (e.g. map_saver -f NAME --fmt pgm, or convert it)");
+                     "m.pgm: byte 0: a PNG image, not a PGM (mapfile_png_read reads it)");
     EXPECT_PGM_ERROR("P6 1 1 255\n\0\0\0",
                      "m.pgm: byte 0: not a PGM image (P5 or P2): it starts with 'P6 1'; save the"
                      " map as PGM");

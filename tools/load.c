@@ -83,26 +83,40 @@ int load_map(const options *o, map_input *m)
                                 shown, MAPFILE_MAX_PGM_BYTES)
                  : err == READFILE_NOT_FILE
                      ? complain(EXIT_INPUT, "%s:%u: image %s: not a regular file (a device or a"
-                                            " FIFO): give a PGM file", o->input, line, shown)
+                                            " FIFO): give a PGM or PNG file", o->input, line, shown)
                      : complain(EXIT_INPUT, "%s:%u: image %s: %s", o->input, line, shown,
                                 strerror(err));
         free(shown);
         return rc;
     }
-    bad = mapfile_pgm_parse(&m->pgm, (const uint8_t *)text, len, shown);
-    free(text);
-    free(shown);
-    if (bad)
-        return complain(EXIT_INPUT, "%s", m->pgm.error);
-    size_t cells = (size_t)m->pgm.width * m->pgm.height;
-    if (!(m->cells = malloc(cells)))
-        return complain(EXIT_MEMORY, "memory budget too small: need %zu bytes for the map's cells",
-                        cells);
-    mapfile_to_cells(&m->pgm, &m->yaml, m->cells);
-    mapfile_pgm_free(&m->pgm);            /* the samples are not needed any more */
+    if ((m->is_png = mapfile_is_png((const uint8_t *)text, len)) != 0) {
+        /* (read and converted in one go: its pixels are not kept) */
+        bad = mapfile_png_read(&m->png, (const uint8_t *)text, len, shown, &m->yaml, &m->cells);
+        free(text);
+        free(shown);
+        if (bad)
+            return complain(EXIT_INPUT, "%s", m->png.error);
+        m->width = m->png.width;
+        m->height = m->png.height;
+    } else {
+        bad = mapfile_pgm_parse(&m->pgm, (const uint8_t *)text, len, shown);
+        free(text);
+        free(shown);
+        if (bad)
+            return complain(EXIT_INPUT, "%s", m->pgm.error);
+        m->width = m->pgm.width;
+        m->height = m->pgm.height;
+        size_t n = (size_t)m->width * m->height;
+        if (!(m->cells = malloc(n)))
+            return complain(EXIT_MEMORY,
+                            "memory budget too small: need %zu bytes for the map's cells", n);
+        mapfile_to_cells(&m->pgm, &m->yaml, m->cells);
+        mapfile_pgm_free(&m->pgm);            /* the samples are not needed any more */
+    }
+    size_t cells = (size_t)m->width * m->height;
     polyc_occupancy_grid *g = &m->grid;
-    g->width = m->pgm.width;
-    g->height = m->pgm.height;
+    g->width = m->width;
+    g->height = m->height;
     g->resolution_m = (float)m->yaml.resolution_m;
     g->reserved = 0;
     g->origin_x_m = m->yaml.origin_x_m;
@@ -160,9 +174,18 @@ void print_map_stats(const map_input *m)
     static const char *const modes[] = {"trinary", "scale", "raw"};
     FILE *e = stderr;
     char *shown = textesc_dup(m->image_path);   /* no raw bytes on the terminal */
-    fprintf(e, "map            %u x %u cells of %g m, %s (%s, maxval %u), mode %s%s\n",
-            (unsigned)m->pgm.width, (unsigned)m->pgm.height, m->yaml.resolution_m,
-            shown ? shown : "?", m->pgm.plain ? "P2" : "P5", (unsigned)m->pgm.maxval,
+    char kind[64];
+    if (m->is_png)
+        snprintf(kind, sizeof kind, "PNG, %u-bit %s%s%s", m->png.bit_depth,
+                 mapfile_png_color_name(m->png.color_type),
+                 m->png.alpha && m->png.color_type != 4 && m->png.color_type != 6 ? " with tRNS"
+                                                                                  : "",
+                 m->png.interlaced ? ", interlaced" : "");
+    else
+        snprintf(kind, sizeof kind, "%s, maxval %u", m->pgm.plain ? "P2" : "P5",
+                 (unsigned)m->pgm.maxval);
+    fprintf(e, "map            %u x %u cells of %g m, %s (%s), mode %s%s\n", (unsigned)m->width,
+            (unsigned)m->height, m->yaml.resolution_m, shown ? shown : "?", kind,
             modes[m->yaml.mode], m->yaml.negate ? ", negate" : "");
     free(shown);
     fprintf(e, "origin         %.6f %.6f m, yaw %.6f rad\n", m->yaml.origin_x_m,

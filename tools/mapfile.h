@@ -1,10 +1,11 @@
-/* mapfile.h - ROS map_server maps: the map YAML and its PGM image in,
+/* mapfile.h - ROS map_server maps: the map YAML and its image (PGM, PNG) in,
  * nav_msgs/OccupancyGrid cell values out (converted as nav2's map_server
  * does), and a hit/miss grid out as map_saver writes a map.
  * Rules: docs/formats.md ("ROS maps"). All memory is owned by the structs. */
 #ifndef POLYC_MAPFILE_H
 #define POLYC_MAPFILE_H
 
+#include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -77,8 +78,39 @@ int mapfile_pgm_parse(mapfile_pgm *p, const uint8_t *data, size_t len, const cha
 void mapfile_pgm_free(mapfile_pgm *p);
 
 /* One pixel's OccupancyGrid value (-1 unknown, 0..100) under the YAML's
- * mode, negate and thresholds: nav2 map_server's rule (docs/formats.md). */
+ * mode, negate and thresholds: nav2 map_server's rule (docs/formats.md),
+ * from a gray sample, or from the pixel's shade (0 black .. 1 white) and
+ * whether it is opaque (a pixel with any transparency is -1 in `scale`). */
 int8_t mapfile_cell_value(uint32_t sample, uint32_t maxval, const mapfile_yaml *y);
+int8_t mapfile_shade_value(double shade, int opaque, const mapfile_yaml *y);
+
+/* "NAME: byte N: " and the message, into error[cap]: the image readers'
+ * failures (mapfile_pgm.c). */
+void mapfile_byte_error(char *error, size_t cap, const char *name, size_t at, const char *fmt,
+                        va_list ap);
+
+/* A PNG image's header (mapfile_png.c). */
+typedef struct mapfile_png {
+    uint32_t width, height;
+    unsigned bit_depth;        /* 1, 2, 4, 8 or 16 */
+    unsigned color_type;       /* 0 gray, 2 RGB, 3 palette, 4 gray+alpha, 6 RGBA */
+    int interlaced;            /* 1: Adam7 */
+    int alpha;                 /* an alpha channel or a tRNS chunk (map_server's "matte") */
+    char error[512];           /* "NAME: byte N: what is wrong" after a failure */
+} mapfile_png;
+
+/* Whether the bytes start with PNG's signature; a colour type's name
+ * ("gray", "RGB", "palette", "gray+alpha", "RGBA"). */
+int mapfile_is_png(const uint8_t *data, size_t len);
+const char *mapfile_png_color_name(unsigned type);
+
+/* Reads a whole PNG file of len bytes and converts every pixel under the
+ * YAML (docs/formats.md, "The image: PNG"): *cells, malloc'd, width *
+ * height values in the order of mapfile_to_cells. Returns 0, or -1 with
+ * p->error set (byte N a 0-based offset into the file; out of memory
+ * too) and *cells NULL. */
+int mapfile_png_read(mapfile_png *p, const uint8_t *data, size_t len, const char *name,
+                     const mapfile_yaml *y, int8_t **cells);
 
 /* Every pixel converted: cells[(height - 1 - row) * width + column], i.e.
  * OccupancyGrid order with row 0 at the bottom. cells: width * height. */

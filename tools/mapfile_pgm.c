@@ -23,15 +23,20 @@ typedef struct pgm_reader {
     size_t pos;
 } pgm_reader;
 
-static int pfail(pgm_reader *r, size_t at, const char *fmt, ...)
+void mapfile_byte_error(char *error, size_t cap, const char *name, size_t at, const char *fmt,
+                        va_list ap)
 {
     char msg[400];
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    snprintf(error, cap, "%s: byte %llu: %s", name, (unsigned long long)at, msg);
+}
+
+static int pfail(pgm_reader *r, size_t at, const char *fmt, ...)
+{
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
+    mapfile_byte_error(r->p->error, sizeof r->p->error, r->name, at, fmt, ap);
     va_end(ap);
-    snprintf(r->p->error, sizeof r->p->error, "%s: byte %llu: %s", r->name,
-             (unsigned long long)at, msg);
     return -1;
 }
 
@@ -91,8 +96,7 @@ int mapfile_pgm_parse(mapfile_pgm *p, const uint8_t *data, size_t len, const cha
     textesc_excerpt e;
     memset(p, 0, sizeof *p);
     if (len >= 8 && memcmp(data, "\x89PNG\r\n\x1a\n", 8) == 0)
-        return pfail(&r, 0, "a PNG image: polyc reads PGM (P5 or P2) only; save the map as"
-                            " PGM (e.g. map_saver -f NAME --fmt pgm, or convert it)");
+        return pfail(&r, 0, "a PNG image, not a PGM (mapfile_png_read reads it)");
     if (len < 2 || data[0] != 'P' || (data[1] != '5' && data[1] != '2') ||
         (len > 2 && !pgm_space(data[2]) && data[2] != '#'))
         return pfail(&r, 0, "not a PGM image (P5 or P2): it starts with '%s'; save the map"
@@ -185,7 +189,11 @@ void mapfile_pgm_free(mapfile_pgm *p)
 
 int8_t mapfile_cell_value(uint32_t sample, uint32_t maxval, const mapfile_yaml *y)
 {
-    double shade = (double)sample / (double)maxval;     /* 0 black .. 1 white */
+    return mapfile_shade_value((double)sample / (double)maxval, 1, y); /* (PGM has no alpha) */
+}
+
+int8_t mapfile_shade_value(double shade, int opaque, const mapfile_yaml *y)
+{
     if (y->mode == MAPFILE_RAW) {
         double v = round(shade * 255.0);
         if (v >= 0.0 && v <= 100.0)
@@ -193,6 +201,8 @@ int8_t mapfile_cell_value(uint32_t sample, uint32_t maxval, const mapfile_yaml *
         return -1;
     }
     double occ = y->negate ? shade : 1.0 - shade;
+    if (y->mode == MAPFILE_SCALE && !opaque)
+        return -1;
     if (y->occupied_thresh < occ)
         return 100;
     if (occ < y->free_thresh)
