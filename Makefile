@@ -145,9 +145,11 @@ $(BUILD)/tests/cxx_header: tests/cxx_header.cpp include/polyc.h $(BUILD)/libpoly
 test-install: all
 	tests/install_test.sh "$(MAKE)" "$(BUILD)"
 # The Python package's library: libpolyc with the tool's readers
-# (scanlog, mapfile, gridimage) and the binding's glue (polyc_io.c), as
-# `pip install ./bindings/python` builds it (bindings/python/setup.py).
+# (scanlog, mapfile and its image readers, gridimage) and the binding's glue
+# (polyc_io.c), as `pip install ./bindings/python` builds it
+# (bindings/python/setup.py).
 PY_MOD = tools/scanlog.c tools/scanlog_noreturn.c tools/mapfile.c tools/mapfile_pgm.c \
+         tools/mapfile_png.c tools/mapfile_image.c tools/inflate.c \
          tools/gridimage.c tools/readfile.c tools/textesc.c bindings/python/polyc_io.c
 PY_OBJ = $(PY_MOD:%.c=$(BUILD)/pyobj/%.o)
 $(BUILD)/pyobj/%.o: %.c include/polyc.h $(wildcard tools/*.h)

@@ -66,10 +66,7 @@ typedef struct membuf {
 /* A map read from a map YAML and its image. */
 typedef struct map_input {
     mapfile_yaml yaml;
-    mapfile_pgm pgm;           /* the image, when a PGM */
-    mapfile_png png;           /* when a PNG (is_png) */
-    int is_png;
-    uint32_t width, height;    /* the image's pixels */
+    mapfile_image image;       /* its size and kind (its cells are `cells`) */
     char *image_path;          /* as opened */
     int8_t *cells;             /* OccupancyGrid values, row 0 at the bottom */
     polyc_occupancy_grid grid;

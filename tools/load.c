@@ -89,34 +89,16 @@ int load_map(const options *o, map_input *m)
         free(shown);
         return rc;
     }
-    if ((m->is_png = mapfile_is_png((const uint8_t *)text, len)) != 0) {
-        /* (read and converted in one go: its pixels are not kept) */
-        bad = mapfile_png_read(&m->png, (const uint8_t *)text, len, shown, &m->yaml, &m->cells);
-        free(text);
-        free(shown);
-        if (bad)
-            return complain(EXIT_INPUT, "%s", m->png.error);
-        m->width = m->png.width;
-        m->height = m->png.height;
-    } else {
-        bad = mapfile_pgm_parse(&m->pgm, (const uint8_t *)text, len, shown);
-        free(text);
-        free(shown);
-        if (bad)
-            return complain(EXIT_INPUT, "%s", m->pgm.error);
-        m->width = m->pgm.width;
-        m->height = m->pgm.height;
-        size_t n = (size_t)m->width * m->height;
-        if (!(m->cells = malloc(n)))
-            return complain(EXIT_MEMORY,
-                            "memory budget too small: need %zu bytes for the map's cells", n);
-        mapfile_to_cells(&m->pgm, &m->yaml, m->cells);
-        mapfile_pgm_free(&m->pgm);            /* the samples are not needed any more */
-    }
-    size_t cells = (size_t)m->width * m->height;
+    bad = mapfile_image_read(&m->image, (const uint8_t *)text, len, shown, &m->yaml);
+    free(text);
+    free(shown);
+    if (bad)
+        return complain(m->image.no_memory ? EXIT_MEMORY : EXIT_INPUT, "%s", m->image.error);
+    m->cells = m->image.cells;
+    size_t cells = (size_t)m->image.width * m->image.height;
     polyc_occupancy_grid *g = &m->grid;
-    g->width = m->width;
-    g->height = m->height;
+    g->width = m->image.width;
+    g->height = m->image.height;
     g->resolution_m = (float)m->yaml.resolution_m;
     g->reserved = 0;
     g->origin_x_m = m->yaml.origin_x_m;
@@ -174,18 +156,9 @@ void print_map_stats(const map_input *m)
     static const char *const modes[] = {"trinary", "scale", "raw"};
     FILE *e = stderr;
     char *shown = textesc_dup(m->image_path);   /* no raw bytes on the terminal */
-    char kind[64];
-    if (m->is_png)
-        snprintf(kind, sizeof kind, "PNG, %u-bit %s%s%s", m->png.bit_depth,
-                 mapfile_png_color_name(m->png.color_type),
-                 m->png.alpha && m->png.color_type != 4 && m->png.color_type != 6 ? " with tRNS"
-                                                                                  : "",
-                 m->png.interlaced ? ", interlaced" : "");
-    else
-        snprintf(kind, sizeof kind, "%s, maxval %u", m->pgm.plain ? "P2" : "P5",
-                 (unsigned)m->pgm.maxval);
-    fprintf(e, "map            %u x %u cells of %g m, %s (%s), mode %s%s\n", (unsigned)m->width,
-            (unsigned)m->height, m->yaml.resolution_m, shown ? shown : "?", kind,
+    fprintf(e, "map            %u x %u cells of %g m, %s (%s), mode %s%s\n",
+            (unsigned)m->image.width, (unsigned)m->image.height, m->yaml.resolution_m,
+            shown ? shown : "?", m->image.kind,
             modes[m->yaml.mode], m->yaml.negate ? ", negate" : "");
     free(shown);
     fprintf(e, "origin         %.6f %.6f m, yaw %.6f rad\n", m->yaml.origin_x_m,

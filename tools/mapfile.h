@@ -96,6 +96,7 @@ typedef struct mapfile_png {
     unsigned color_type;       /* 0 gray, 2 RGB, 3 palette, 4 gray+alpha, 6 RGBA */
     int interlaced;            /* 1: Adam7 */
     int alpha;                 /* an alpha channel or a tRNS chunk (map_server's "matte") */
+    int no_memory;             /* the failure was an allocation's */
     char error[512];           /* "NAME: byte N: what is wrong" after a failure */
 } mapfile_png;
 
@@ -111,6 +112,20 @@ const char *mapfile_png_color_name(unsigned type);
  * too) and *cells NULL. */
 int mapfile_png_read(mapfile_png *p, const uint8_t *data, size_t len, const char *name,
                      const mapfile_yaml *y, int8_t **cells);
+
+/* The image, PGM or PNG (told by its first bytes), converted under the
+ * YAML (mapfile_image.c): cells malloc'd (the caller frees them), its size
+ * and a description for --stats ("P5, maxval 255", "PNG, 8-bit RGBA").
+ * Returns 0, or -1 with error set ("NAME: byte N: ...") and cells NULL. */
+typedef struct mapfile_image {
+    uint32_t width, height;
+    int8_t *cells;
+    char kind[64];
+    int no_memory;             /* the failure was an allocation's */
+    char error[512];
+} mapfile_image;
+int mapfile_image_read(mapfile_image *m, const uint8_t *data, size_t len, const char *name,
+                       const mapfile_yaml *y);
 
 /* Every pixel converted: cells[(height - 1 - row) * width + column], i.e.
  * OccupancyGrid order with row 0 at the bottom. cells: width * height. */

@@ -368,6 +368,7 @@ int mapfile_png_read(mapfile_png *p, const uint8_t *data, size_t len, const char
     int8_t *out = malloc((size_t)p->width * p->height);
     int rc = 0;
     if (!z || !raw || !out) {
+        p->no_memory = 1;
         rc = pfail(&r, 0, "out of memory: %zu bytes for the image", r.idat_bytes + raw_n +
                                                                         (size_t)p->width * p->height);
         goto done;

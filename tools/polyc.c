@@ -95,7 +95,6 @@ int main(int argc, char **argv)
     gridimage_free(&r.image);
     scanlog_free(&r.log);
     mapfile_yaml_free(&map.yaml);
-    mapfile_pgm_free(&map.pgm);
     free(map.image_path);
     free(map.cells);
     return rc;

@@ -1,6 +1,6 @@
 /* polyc_io.c - the polyc tool's readers for the Python binding: a laser log
  * (tools/scanlog.c) into polyc_scan records, a map_server map YAML and its
- * PGM (tools/mapfile.c) into a polyc_occupancy_grid, read as `polyc` reads
+ * PGM or PNG (tools/mapfile*.c) into a polyc_occupancy_grid, read as `polyc` reads
  * them; and a context's hit/miss grid as the image `polyc grid` writes
  * (tools/gridimage.c). Built into the binding's libpolyc.so with the
  * library; the library itself (src/) stays without allocation and I/O.
@@ -41,7 +41,7 @@ POLYC_IO_API void polyc_io_log_free(scanlog *log);
 
 typedef struct polyc_io_map {
     polyc_occupancy_grid grid;     /* cells owned by the handle */
-    char *image_path;              /* the PGM as opened */
+    char *image_path;              /* the image (PGM or PNG) as opened */
     double occupied_thresh;        /* the YAML's, as it converted the pixels */
     double free_thresh;
     int mode;                      /* enum mapfile_mode */
@@ -173,21 +173,18 @@ int polyc_io_read_map(const char *path, polyc_io_map **out, char *error, size_t 
         polyc_io_map_free(m);
         return -1;
     }
-    mapfile_pgm pgm;
-    memset(&pgm, 0, sizeof pgm);
-    bad = mapfile_pgm_parse(&pgm, (const uint8_t *)text, len, image);
+    mapfile_image img;
+    bad = mapfile_image_read(&img, (const uint8_t *)text, len, image, &yaml);
     free(text);
-    int8_t *cells = bad ? NULL : malloc((size_t)pgm.width * pgm.height);
-    if (bad || !cells) {
-        fail(error, error_size, "%s%s", bad ? pgm.error : "out of memory", "");
-        mapfile_pgm_free(&pgm);
+    if (bad) {
+        fail(error, error_size, "%s%s", img.error, "");
         mapfile_yaml_free(&yaml);
         polyc_io_map_free(m);
         return -1;
     }
-    mapfile_to_cells(&pgm, &yaml, cells);
-    m->grid.width = pgm.width;
-    m->grid.height = pgm.height;
+    int8_t *cells = img.cells;
+    m->grid.width = img.width;
+    m->grid.height = img.height;
     m->grid.resolution_m = (float)yaml.resolution_m;
     m->grid.origin_x_m = yaml.origin_x_m;
     m->grid.origin_y_m = yaml.origin_y_m;
@@ -197,7 +194,6 @@ int polyc_io_read_map(const char *path, polyc_io_map **out, char *error, size_t 
     m->free_thresh = yaml.free_thresh;
     m->mode = yaml.mode;
     m->negate = yaml.negate;
-    mapfile_pgm_free(&pgm);
     mapfile_yaml_free(&yaml);
     *out = m;
     return 0;

@@ -3,6 +3,7 @@
 libpolyc.so is a plain shared library (loaded with ctypes, not a CPython
 extension module): the library (src/*.c), the polyc tool's readers
 (tools/scanlog.c, tools/scanlog_noreturn.c, tools/mapfile.c, tools/mapfile_pgm.c,
+tools/mapfile_png.c, tools/mapfile_image.c, tools/inflate.c,
 tools/gridimage.c, tools/readfile.c, tools/textesc.c) and the binding's glue
 (polyc_io.c), compiled with the compiler Python was built with. The C
 sources are the repository's own (../../src from here): pip builds a local
@@ -39,7 +40,8 @@ def _version():
 REPO_SOURCES = (sorted(glob.glob(os.path.join(REPO, "src", "*.c"))) +
                 [os.path.join(REPO, "tools", n)
                  for n in ("scanlog.c", "scanlog_noreturn.c", "mapfile.c", "mapfile_pgm.c",
-                           "gridimage.c", "readfile.c", "textesc.c")])
+                           "mapfile_png.c", "mapfile_image.c", "inflate.c", "gridimage.c",
+                           "readfile.c", "textesc.c")])
 REPO_HEADERS = [HEADER] + sorted(glob.glob(os.path.join(REPO, "src", "*.h")) +
                                  glob.glob(os.path.join(REPO, "tools", "*.h")))
 

@@ -31,6 +31,7 @@ import tempfile
 import threading
 import time
 import unittest
+import zlib
 from array import array
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -598,6 +599,49 @@ class Files(unittest.TestCase):
             with self.assertRaises(ValueError) as e:
                 polyc.read_map(prefix + ".yaml")
             self.assertIn("image", str(e.exception))
+
+    def test_map_from_png(self):
+        """The grid's image as an RGBA PNG in scale mode (the unknown cells
+        transparent, as nav2's map_saver writes it): the same cells as the
+        PGM, and the tool's map; a damaged PNG gives the tool's message."""
+        with tempfile.TemporaryDirectory() as tmp:
+            prefix = os.path.join(tmp, "office")
+            subprocess.run([TOOL, "grid", "-o", prefix, self.LOG], check=True,
+                           capture_output=True)
+            pgm = polyc.read_map(prefix + ".yaml")
+            image = polyc.grid_image(polyc.read_log(self.LOG))
+            rows = b"".join(b"\0" + bytes(c for v in image.pixels[r * image.width:
+                                                                   (r + 1) * image.width]
+                                           for c in (v, v, v, 0 if v == 205 else 255))
+                            for r in range(image.height))
+
+            def chunk(kind, data):
+                return (struct.pack(">I", len(data)) + kind + data +
+                        struct.pack(">I", zlib.crc32(kind + data)))
+            png = (b"\x89PNG\r\n\x1a\n" +
+                   chunk(b"IHDR", struct.pack(">IIBBBBB", image.width, image.height, 8, 6,
+                                              0, 0, 0)) +
+                   chunk(b"IDAT", zlib.compress(rows)) + chunk(b"IEND", b""))
+            with open(prefix + ".png", "wb") as f:
+                f.write(png)
+            with open(prefix + ".yaml") as f:
+                text = f.read().replace("office.pgm", "office.png")
+            with open(prefix + "_png.yaml", "w") as f:
+                f.write("mode: scale\n" + text)
+            grid = polyc.read_map(prefix + "_png.yaml")
+            self.assertEqual(grid.image_path, prefix + ".png")
+            self.assertEqual((grid.width, grid.height), (pgm.width, pgm.height))
+            self.assertEqual(bytes(grid.cells), bytes(pgm.cells))
+            result = polyc.build_map_from_grid(grid.cells, grid.width, grid.height,
+                                               grid.resolution, origin=grid.origin)
+            same_as_tool(self, result, tool_json(prefix + "_png.yaml"))
+            with open(prefix + ".png", "wb") as f:
+                f.write(png[:-4] + b"\0" * 4)               # IEND's CRC damaged
+            with self.assertRaises(ValueError) as e:
+                polyc.read_map(prefix + "_png.yaml")
+            tool = subprocess.run([TOOL, prefix + "_png.yaml"], capture_output=True, text=True)
+            self.assertEqual("polyc: " + str(e.exception), tool.stderr.strip())
+            self.assertIn("byte", str(e.exception))
 
 
 class Calls(unittest.TestCase):

@@ -11,7 +11,7 @@
     print(result.stats["memory_used_bytes"])
 
     scans = polyc.read_log("office.log")              # as the polyc tool reads it
-    grid = polyc.read_map("map.yaml")                 # map_server YAML + PGM
+    grid = polyc.read_map("map.yaml")                 # map_server YAML + PGM or PNG
     result = polyc.build_map_from_grid(grid.cells, grid.width, grid.height,
                                        grid.resolution, origin=grid.origin)
 
@@ -1066,8 +1066,8 @@ def read_log(path, max_range_m=None):
 
 
 def read_map(path):
-    """A ROS map_server map: the YAML at path and its image (PGM, next to
-    it), converted to OccupancyGrid values as `polyc map.yaml` does (nav2's
+    """A ROS map_server map: the YAML at path and its image (PGM or PNG,
+    next to it), converted to OccupancyGrid values as `polyc map.yaml` does (nav2's
     rules: mode, negate, the YAML's thresholds). A Map; a bad map raises
     ValueError with the tool's message (FILE:LINE or FILE: byte N)."""
     _need_io("read_map")
