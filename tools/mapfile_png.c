@@ -42,19 +42,20 @@ static uint32_t be32(const uint8_t *b)
     return (uint32_t)b[0] << 24 | (uint32_t)b[1] << 16 | (uint32_t)b[2] << 8 | b[3];
 }
 
-static uint32_t crc32_of(const uint8_t *b, size_t n)
+/* The CRC-32 table, made per file (no shared state: the Python binding
+ * may read maps from several threads). */
+static void crc32_table(uint32_t table[256])
 {
-    static uint32_t table[256];
-    static int made;
-    if (!made) {
-        for (uint32_t i = 0; i < 256; i++) {
-            uint32_t c = i;
-            for (int k = 0; k < 8; k++)
-                c = c & 1u ? 0xedb88320u ^ (c >> 1) : c >> 1;
-            table[i] = c;
-        }
-        made = 1;
+    for (uint32_t i = 0; i < 256; i++) {
+        uint32_t c = i;
+        for (int k = 0; k < 8; k++)
+            c = c & 1u ? 0xedb88320u ^ (c >> 1) : c >> 1;
+        table[i] = c;
     }
+}
+
+static uint32_t crc32_of(const uint32_t table[256], const uint8_t *b, size_t n)
+{
     uint32_t c = 0xffffffffu;
     for (size_t i = 0; i < n; i++)
         c = table[(c ^ b[i]) & 0xffu] ^ (c >> 8);
@@ -163,6 +164,8 @@ static int read_chunks(png_reader *r)
 {
     size_t pos = 8;
     int seen_ihdr = 0, in_idat = 0, after_idat = 0;
+    uint32_t crc_table[256];
+    crc32_table(crc_table);
     for (;;) {
         if (r->len - pos < 12)
             return pfail(r, pos, "the file ends before its IEND chunk (truncated)");
@@ -179,7 +182,7 @@ static int read_chunks(png_reader *r)
             return pfail(r, pos, "chunk '%s' of %u bytes runs past the end of the file (truncated)",
                          tname, (unsigned)n);
         const uint8_t *c = type + 4;
-        if (crc32_of(type, (size_t)n + 4) != be32(c + n))
+        if (crc32_of(crc_table, type, (size_t)n + 4) != be32(c + n))
             return pfail(r, pos + 8 + n, "chunk '%s': its CRC does not match (a damaged file)",
                          tname);
         if (!seen_ihdr && memcmp(type, "IHDR", 4) != 0)
