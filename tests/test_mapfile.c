@@ -385,13 +385,13 @@ static void test_pgm_errors(void **state)
     EXPECT_PGM_ERROR("\x89PNG\r\n\x1a\n\0\0\0\rIHDR",
                      "m.pgm: byte 0: a PNG image, not a PGM (mapfile_png_read reads it)");
     EXPECT_PGM_ERROR("P6 1 1 255\n\0\0\0",
-                     "m.pgm: byte 0: not a PGM image (P5 or P2): it starts with 'P6 1'; save the"
-                     " map as PGM");
-    EXPECT_PGM_ERROR("", "m.pgm: byte 0: not a PGM image (P5 or P2): it starts with ''; save the"
-                         " map as PGM");
+                     "m.pgm: byte 0: not a PGM (P5 or P2) or PNG image: it starts with 'P6 1';"
+                     " save the map as PGM or PNG");
+    EXPECT_PGM_ERROR("", "m.pgm: byte 0: not a PGM (P5 or P2) or PNG image: it starts with '';"
+                         " save the map as PGM or PNG");
     EXPECT_PGM_ERROR("P55 1 1 255\n\0",
-                     "m.pgm: byte 0: not a PGM image (P5 or P2): it starts with 'P55 '; save the"
-                     " map as PGM");
+                     "m.pgm: byte 0: not a PGM (P5 or P2) or PNG image: it starts with 'P55 ';"
+                     " save the map as PGM or PNG");
     EXPECT_PGM_ERROR("P5\n3 2\n255\n\0\0\0\0\0",
                      "m.pgm: byte 16: truncated: 5 bytes of pixel data, 3 x 2 at 1 bytes a pixel"
                      " need 6");

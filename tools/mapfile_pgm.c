@@ -99,8 +99,9 @@ int mapfile_pgm_parse(mapfile_pgm *p, const uint8_t *data, size_t len, const cha
         return pfail(&r, 0, "a PNG image, not a PGM (mapfile_png_read reads it)");
     if (len < 2 || data[0] != 'P' || (data[1] != '5' && data[1] != '2') ||
         (len > 2 && !pgm_space(data[2]) && data[2] != '#'))
-        return pfail(&r, 0, "not a PGM image (P5 or P2): it starts with '%s'; save the map"
-                            " as PGM", textesc_quote(&e, (const char *)data, len < 4 ? len : 4));
+        return pfail(&r, 0, "not a PGM (P5 or P2) or PNG image: it starts with '%s'; save the"
+                            " map as PGM or PNG",
+                     textesc_quote(&e, (const char *)data, len < 4 ? len : 4));
     p->plain = data[1] == '2';
     r.pos = 2;
     uint64_t w, h, maxval;
