@@ -94,7 +94,7 @@ unit: $(TEST_BIN) $(BUILD)/polyc
 # CHECK_STEPS, each into build-check/STEP.log: one line per step (the log's
 # tail if it failed), and last a line `N passed, N failed` alone (CI reads it).
 CHECK_STEPS = unit test-checks test-cli test-fuzz-replay test-asan test-cxx test-install \
-              test-python test-embedded test-opt-O3 test-opt-Os test-golden test-valgrind cross
+              test-python test-embedded test-opt-O3 test-opt-Os test-golden test-valgrind cross target
 check: deps
 	@mkdir -p build-check; pass=0; fail=0; \
 	for s in $(CHECK_STEPS); do \
@@ -311,6 +311,50 @@ $(EMB_EXAMPLES:%=$(XBUILD)/%.o): $(XBUILD)/%.o: examples/%.c examples/embedded_r
 	$(CROSS)gcc $(XFLAGS) -D$(XTARGET) -c $< -o $@
 $(XELF): %.elf: %.o $(XBUILD)/libpolyc.a
 	$(CROSS)gcc $(XFLAGS) -specs=nosys.specs -Wl,--gc-sections $^ -lm -o $@
+
+# The embedded examples on an emulated Cortex-M4F (`make target`; needs
+# qemu-system-arm and newlib's rdimon, which make deps installs): each example
+# with the harness of tools/target/ (its own vector table, start-up and linker
+# script, an instruction counter, stdio over semihosting) against
+# $(XBUILD)/libpolyc.a, run on qemu's mps2-an386 (-icount shift=0: one
+# instruction a nanosecond); tools/target/check.py checks each map against
+# the room's walls and the host's map and prints the instructions of each
+# library call. `make target-profile`: the same runs with a PC sample every
+# 4,000 instructions, the top functions and the share of software double.
+TBUILD ?= build-target
+QEMU   ?= qemu-system-arm
+QEMU_RUN = timeout 600 $(QEMU) -M mps2-an386 -nographic -monitor none -serial none \
+           -icount shift=0 -semihosting-config enable=on,target=native -kernel
+T_LINK = -nostartfiles -T tools/target/mps2_an386.ld -specs=rdimon.specs -Wl,--gc-sections
+T_CFLAGS = $(filter-out -Werror -fcallgraph-info=su -fstack-usage,$(XFLAGS)) -DTARGET_STDIO \
+           -include tools/target/target.h
+.PHONY: target target-profile
+$(TBUILD)/startup.o: tools/target/startup.c tools/target/target.h
+	@mkdir -p $(dir $@)
+	$(CROSS)gcc $(T_CFLAGS) -Werror -c $< -o $@
+$(TBUILD)/startup_profile.o: tools/target/startup.c tools/target/target.h
+	@mkdir -p $(dir $@)
+	$(CROSS)gcc $(T_CFLAGS) -Werror -DTARGET_PROFILE -c $< -o $@
+$(EMB_EXAMPLES:%=$(TBUILD)/%.o): $(TBUILD)/%.o: examples/%.c examples/embedded_room.h include/polyc.h \
+                                  tools/target/target.h
+	@mkdir -p $(dir $@)
+	$(CROSS)gcc $(T_CFLAGS) -c $< -o $@
+$(TBUILD)/%.elf: $(TBUILD)/startup.o $(TBUILD)/%.o $(XBUILD)/libpolyc.a tools/target/mps2_an386.ld
+	$(CROSS)gcc $(T_CFLAGS) $(T_LINK) $(filter %.o %.a,$^) -lm -o $@
+$(TBUILD)/%.profile.elf: $(TBUILD)/startup_profile.o $(TBUILD)/%.o $(XBUILD)/libpolyc.a \
+                         tools/target/mps2_an386.ld
+	$(CROSS)gcc $(T_CFLAGS) $(T_LINK) $(filter %.o %.a,$^) -lm -o $@
+target: $(EMB_EXAMPLES:%=$(TBUILD)/%.elf) $(EMB_EXAMPLES:%=$(BUILD)/%)
+	@set -e; for x in $(EMB_EXAMPLES); do \
+	  $(QEMU_RUN) $(TBUILD)/$$x.elf > $(TBUILD)/$$x.out 2>&1; \
+	  $(BUILD)/$$x > $(TBUILD)/$$x.host; \
+	  python3 tools/target/check.py --room examples/embedded_room.h --name $$x \
+	    $(TBUILD)/$$x.out $(TBUILD)/$$x.host; done
+target-profile: $(EMB_EXAMPLES:%=$(TBUILD)/%.profile.elf)
+	@set -e; for x in $(EMB_EXAMPLES); do \
+	  (cd $(TBUILD) && $(QEMU_RUN) $$x.profile.elf > $$x.profile.out 2>&1 && mv target-pcs.bin $$x.pcs); \
+	  python3 tools/target/profile.py --nm $(CROSS)nm --elf $(TBUILD)/$$x.profile.elf \
+	    --name $$x $(TBUILD)/$$x.pcs; done
 
 # Benchmark on the shared data (not in the repo): an optimised build in
 # build-bench/, then one table. `make bench DATA=dir BENCH_ARGS='--only intel'`

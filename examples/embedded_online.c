@@ -69,17 +69,26 @@ static polyc_status run(polyc_ctx **out, size_t *need)
     *need = polyc_online_memory_size(&cfg, &lim);
     if (*need == 0 || *need > sizeof block)
         return POLYC_ERR_NOMEM;
-    if ((st = polyc_online_init(block, sizeof block, &cfg, &lim, out)) != POLYC_OK)
+    st = polyc_online_init(block, sizeof block, &cfg, &lim, out);
+    EMBEDDED_MARK("init", 0);
+    if (st != POLYC_OK)
         return st;
     uint32_t seed = 12345u;
     for (unsigned i = 0; i < POSES; i++) {
         make_scan(&scan, ranges, path[i][0], path[i][1], path[i][2], &seed);
-        if ((st = polyc_online_add_scan(*out, &scan, 0, NULL)) != POLYC_OK)
+        EMBEDDED_MARK("scan", i); /* the simulated laser, not the library */
+        st = polyc_online_add_scan(*out, &scan, 0, NULL);
+        EMBEDDED_MARK("add", i);
+        if (st != POLYC_OK)
             return st;
-        if ((st = polyc_online_update(*out, POLYC_ONLINE_WORK_DEFAULT, NULL)) != POLYC_OK)
+        st = polyc_online_update(*out, POLYC_ONLINE_WORK_DEFAULT, NULL);
+        EMBEDDED_MARK("update", i);
+        if (st != POLYC_OK)
             return st;
     }
-    return polyc_online_finish(*out, NULL, NULL, NULL);
+    st = polyc_online_finish(*out, NULL, NULL, NULL);
+    EMBEDDED_MARK("finish", 0);
+    return st;
 }
 
 #ifdef EMBEDDED_ONLINE_TARGET

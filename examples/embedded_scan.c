@@ -50,6 +50,7 @@ static polyc_status run(polyc_ctx **out, size_t *need)
 
     uint32_t seed = 12345u;
     make_scan(&scan, ranges, POSE_X, POSE_Y, 0.0f, &seed);
+    EMBEDDED_MARK("scan", 0); /* the simulated laser, not the library */
     polyc_config_default(&cfg);
     cfg.cell_m = CELL_M;
     cfg.free_range_m = RANGE_CAP_M;
@@ -59,11 +60,17 @@ static polyc_status run(polyc_ctx **out, size_t *need)
     *need = polyc_memory_size(&cfg, &lim);
     if (*need == 0 || *need > sizeof block)
         return POLYC_ERR_NOMEM;
-    if ((st = polyc_init(block, sizeof block, &cfg, &lim, out)) != POLYC_OK)
+    st = polyc_init(block, sizeof block, &cfg, &lim, out);
+    EMBEDDED_MARK("init", 0);
+    if (st != POLYC_OK)
         return st;
-    if ((st = polyc_add_scan(*out, &scan)) != POLYC_OK)
+    st = polyc_add_scan(*out, &scan);
+    EMBEDDED_MARK("add", 0);
+    if (st != POLYC_OK)
         return st;
-    return polyc_build(*out, NULL, NULL);
+    st = polyc_build(*out, NULL, NULL);
+    EMBEDDED_MARK("build", 0);
+    return st;
 }
 
 #ifdef EMBEDDED_SCAN_TARGET

@@ -1,0 +1,71 @@
+#!/usr/bin/env python3
+"""profile.py - where an emulated Cortex-M4F run spends its instructions,
+from the PC samples of the harness (startup.c built with -DTARGET_PROFILE:
+a sample every 4,000 instructions).
+
+usage: profile.py --elf FILE.elf [--nm arm-none-eabi-nm] [--top 15] --name NAME PCS.bin
+
+Prints the share of the samples of the top functions, and the share in
+software double-precision routines (libgcc's __aeabi_d*, __*df3, __*df2,
+conversions to and from double) and in double libm (sin, cos, sqrt, atan2 ...
+and their __ieee754_ / __kernel_ helpers).
+"""
+import argparse
+import bisect
+import collections
+import re
+import struct
+import subprocess
+import sys
+
+SOFT_DOUBLE = re.compile(r"^__(aeabi_(d|[fil]2d|d2|ui2d|ul2d)\w*|\w+df[23]|extendsfdf2|truncdfsf2|"
+                         r"fix\w*df\w*|float\w*df|(eq|ne|lt|le|gt|ge|un|cmp)df2|"
+                         r"aeabi_cdc\w+|aeabi_cdrc\w+|clzdi2|muldi3|udivmoddi4|aeabi_[lu]?ldivmod)$")
+DOUBLE_LIBM = re.compile(r"^(__ieee754_\w+|__kernel_\w+|sin|cos|tan|atan2?|asin|acos|exp|log|log10|pow|sqrt|"
+                         r"hypot|floor|ceil|fabs|fmod|round|lround|copysign|scalbn|frexp|ldexp|modf|"
+                         r"rint|nearbyint|trunc)$")
+
+
+def symbols(nm, elf):
+    out = subprocess.run([nm, "-n", "--defined-only", elf], check=True,
+                         capture_output=True, text=True).stdout
+    addrs, names = [], []
+    for line in out.splitlines():
+        w = line.split()
+        if len(w) == 3 and w[1] in "tTwW":
+            addrs.append(int(w[0], 16) & ~1)
+            names.append(w[2])
+    return addrs, names
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--elf", required=True)
+    ap.add_argument("--nm", default="arm-none-eabi-nm")
+    ap.add_argument("--top", type=int, default=15)
+    ap.add_argument("--name", default="")
+    ap.add_argument("pcs")
+    a = ap.parse_args()
+    data = open(a.pcs, "rb").read()
+    pcs = struct.unpack("<%dI" % (len(data) // 4), data)
+    if not pcs:
+        sys.exit("profile.py: no samples in " + a.pcs)
+    addrs, names = symbols(a.nm, a.elf)
+    hist = collections.Counter()
+    for pc in pcs:
+        i = bisect.bisect_right(addrs, pc & ~1) - 1
+        hist[names[i] if i >= 0 else "?"] += 1
+    n = len(pcs)
+    soft = sum(c for f, c in hist.items() if SOFT_DOUBLE.match(f))
+    libm = sum(c for f, c in hist.items() if DOUBLE_LIBM.match(f))
+    print("profile %s: %d samples (about %d M instructions)" % (a.name, n, n * 4000 // 1000000))
+    print("profile %s: software double arithmetic %.1f %%, double libm %.1f %%"
+          % (a.name, 100.0 * soft / n, 100.0 * libm / n))
+    for f, c in hist.most_common(a.top):
+        kind = " (soft double)" if SOFT_DOUBLE.match(f) else " (double libm)" if DOUBLE_LIBM.match(f) else ""
+        print("profile %s: %6.2f %%  %s%s" % (a.name, 100.0 * c / n, f, kind))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
