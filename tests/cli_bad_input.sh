@@ -193,14 +193,33 @@ run -o map.svg text.log
 name=old-output-kept
 [ $rc -eq 1 ] && [ "$(cat map.svg)" = old ] || bad "a failed run changed an existing map.svg"
 rm -f map.svg
+# a missing folder: refused before any work (exit 2), the folder named
 name=missing-dir
 run -o nodir/map.svg lf.log
-[ $rc -eq 1 ] && grep -q '^polyc: nodir/map.svg: cannot create a temporary file' err.txt \
-    || bad "exit $rc for an unwritable output"
+[ $rc -eq 2 ] && grep -q "^polyc: -o 'nodir/map.svg' is in a folder that does not exist$" err.txt \
+    || bad "exit $rc for an output in a missing folder"
 name=trace-unwritable
 run --iterations 2 --trace nodir/trace.txt -o map.svg lf.log
-[ $rc -eq 1 ] && [ ! -e map.svg ] && grep -q '^polyc: nodir/trace.txt: cannot create' err.txt \
-    || bad "exit $rc, or the map written although --trace failed"
+[ $rc -eq 2 ] && [ ! -e map.svg ] \
+    && grep -q "^polyc: --trace 'nodir/trace.txt' is in a folder that does not exist$" err.txt \
+    || bad "exit $rc, or the map written although --trace cannot be"
+name=dangling-link-missing-dir
+ln -s nodir/map.svg dangling.svg
+run -o dangling.svg lf.log
+[ $rc -eq 2 ] && grep -q "^polyc: -o 'dangling.svg' is in a folder that does not exist$" err.txt \
+    || bad "exit $rc for a link into a missing folder"
+rm -f dangling.svg
+# file names from the command line are escaped in messages, as input bytes are
+name=escaped-names
+esc=$(printf '\033')
+run "$(printf 'evil\033[31m.log')"
+[ $rc -eq 1 ] && grep -q '^polyc: evil\\x1b\[31m\.log: No such file or directory$' err.txt \
+    && ! grep -q "$esc" err.txt || bad "exit $rc, or an ESC byte on stderr"
+run -o "$(printf 'out\033]0;x\007.png')" lf.log
+[ $rc -eq 2 ] && ! grep -q "$esc" err.txt || bad "exit $rc, or an ESC byte on stderr"
+run -o "$(printf 'nodir\033[2J/m.svg')" lf.log
+[ $rc -eq 2 ] && grep -q "^polyc: -o 'nodir\\\\x1b\[2J/m.svg' is in a folder" err.txt \
+    && ! grep -q "$esc" err.txt || bad "exit $rc, or an ESC byte on stderr"
 name=both-outputs
 run --iterations 2 --trace trace.txt -o map.svg lf.log
 [ $rc -eq 0 ] && [ -s map.svg ] && [ -s trace.txt ] || bad "exit $rc, map and trace not both written"
@@ -442,8 +461,9 @@ run grid -o g text.log
 [ ! -e g.pgm ] && [ ! -e g.yaml ] || bad "a failed run left g.pgm or g.yaml"
 name=grid-unwritable
 run grid -o nodir/g lf.log
-[ $rc -eq 1 ] && [ ! -e nodir ] && grep -q '^polyc: nodir/g.pgm: cannot create a temporary file' err.txt \
-    || bad "exit $rc for an unwritable prefix"
+[ $rc -eq 2 ] && [ ! -e nodir ] \
+    && grep -q "^polyc: -o PREFIX 'nodir/g' is in a folder that does not exist" err.txt \
+    || bad "exit $rc for a prefix in a missing folder"
 
 # ---- round trip: office.log -> polyc grid -> polyc PREFIX.yaml ----
 # The map from the grid must lie on the map from the log, and cover it: the

@@ -2,8 +2,11 @@
 # cli_output.sh - where polyc writes (docs/formats.md, "Writing"): a file
 # replaced atomically with its mode and owner kept, a symlink's target
 # replaced, a device, a FIFO and stdout written in place, names refused
-# before any work, the format from -o's extension, and no temporary file
-# left after an error, a closed pipe or SIGINT, SIGTERM, SIGHUP.
+# before any work (an output that is an input, a symlink refused by the
+# fs.protected_symlinks rule, a missing folder, an extension polyc does not
+# write), the format from -o's extension, and no temporary file left after
+# an error, a closed pipe, `ulimit -f` or a signal (SIGKILL too, where the
+# system has O_TMPFILE).
 #   tests/cli_output.sh POLYC [LOG]
 # LOG defaults to examples/office.log. Run as root, it runs again as user
 # 65534 (setpriv, or su) where the machine allows it.
@@ -156,6 +159,141 @@ refused same-inode -o hard.svg --trace target.svg "$LOG"
 refused both-stdout --trace - "$LOG"
 pattern="--format svg contradicts -o clash.json"; refused format-clash --format svg -o clash.json "$LOG"
 
+# ---- an output that is an input: refused before any work, the input kept ----
+# every output (-o, convert -o, --trace, grid's PREFIX.pgm and PREFIX.yaml,
+# --frames' frames, stdout) against every input (the log by name, through a
+# link, a hard link or stdin; a map YAML and its image)
+cp "$LOG" in.log
+cp in.log in.keep
+ln -s in.log in-link.log
+ln in.log in-hard.log
+cp in.log gl.pgm
+cp in.log gl.yaml
+mkdir frl frn
+ln -s ../in.log frl/frame-00050.svg
+cp in.log frn/frame-00100.svg
+run grid -o mp in.log
+cp mp.pgm mp.keep
+cp mp.yaml mpy.keep
+ln -s mp.pgm mp-link.svg
+kept() { cmp -s in.log in.keep && cmp -s mp.pgm mp.keep && cmp -s mp.yaml mpy.keep; }
+# is_input NAME ARGS...: exit 2, 'the same file', no input changed
+is_input() {
+    name=input-$1
+    shift
+    run "$@"
+    [ $rc -eq 2 ] && grep -q '(the same file' err.txt || bad "exit $rc, expected 2 and 'the same file'"
+    kept || { bad "an input was changed"; cp in.keep in.log; cp mp.keep mp.pgm; cp mpy.keep mp.yaml; }
+}
+is_input o-name -o in.log in.log
+is_input o-link -o in-link.log in.log
+is_input o-hard -o in-hard.log in.log
+is_input o-via-input-link -o in.log in-link.log
+is_input o-json --format json -o in.log in.log
+is_input convert convert -o in.log in.log
+is_input convert-hard convert -o in-hard.log in-link.log
+is_input trace --iterations 2 --trace in.log -o t.svg in.log
+is_input trace-link --iterations 2 --trace in-link.log -o t.svg in.log
+is_input online-o --online -o in.log in.log
+is_input grid-pgm grid -o gl gl.pgm
+is_input grid-yaml grid -o gl.yaml gl.yaml
+is_input frames-link --online --frames frl -o t.svg in.log
+is_input frames-file --online --frames frn frn/frame-00100.svg
+is_input map-yaml -o mp.yaml mp.yaml
+is_input map-image --format svg -o mp.pgm mp.yaml
+is_input map-image-link -o mp-link.svg mp.yaml
+is_input map-image-trace --iterations 2 --trace mp.pgm -o t.svg mp.yaml
+name=input-stdin
+count=$((count + 1))
+"$POLYC" -o in.log - < in.log > out.txt 2> err.txt
+rc=$?
+[ $rc -eq 2 ] && grep -q "is the input 'stdin'" err.txt && kept || bad "exit $rc for -o the file on stdin"
+name=input-stdout
+count=$((count + 1))
+"$POLYC" in.log >> in.log 2> err.txt
+rc=$?
+[ $rc -eq 2 ] && grep -q "^polyc: stdout is the input 'in.log'" err.txt && kept \
+    || bad "exit $rc for stdout appended to the input"
+cp in.keep in.log
+name=input-not-a-copy
+run --iterations 2 -o in.keep.svg --trace frn.txt in.log
+[ $rc -eq 0 ] && is_svg in.keep.svg || bad "exit $rc: a copy of the input is not the input"
+name=input-frames-other
+run --online --frames frl --every 7 --format txt -o t.txt in.log
+[ $rc -eq 0 ] && [ -L frl/frame-00050.svg ] && [ -s frl/frame-00007.svg ] \
+    || bad "exit $rc: frames that are not the input refused"
+rm -rf frl frn in-link.log in-hard.log gl.pgm gl.yaml mp-link.svg t.svg t.txt
+
+# ---- a folder that is missing, or one the user may not write ----
+pattern="-o 'nodir/x.svg' is in a folder that does not exist"
+refused missing-folder -o nodir/x.svg "$LOG"
+ln -s nodir/x.svg dangle.svg
+pattern="-o 'dangle.svg' is in a folder that does not exist"
+refused dangling-link-folder -o dangle.svg "$LOG"
+pattern="-o PREFIX 'nodir/g' is in a folder that does not exist"
+refused grid-missing-folder grid -o nodir/g "$LOG"
+[ -e nodir ] && bad "nodir made"
+if [ "$uid" != 0 ]; then
+    mkdir rodir
+    chmod 555 rodir
+    pattern="-o 'rodir/x.svg' is in a folder that you may not write"
+    refused unwritable-folder -o rodir/x.svg "$LOG"
+    pattern="--trace 'rodir/t.txt' is in a folder that you may not write"
+    refused unwritable-trace --trace rodir/t.txt -o t.svg "$LOG"
+    [ -e t.svg ] && bad "t.svg written"
+    rm -f t.svg
+fi
+
+# ---- symlinks in a sticky, world-writable folder: the kernel's
+# fs.protected_symlinks rule (followed only if the caller or the folder's
+# owner owns the link), whatever the system's setting ----
+mkdir shared
+chmod 1777 shared
+name=sticky-own-link
+ln -s ../own.svg shared/own.svg
+run -o shared/own.svg "$LOG"
+[ $rc -eq 0 ] && [ -L shared/own.svg ] && is_svg own.svg || bad "exit $rc: the caller's own link not followed"
+if [ "$uid" = 0 ]; then
+    mkdir private
+    echo secret > private/secret
+    chmod 600 private/secret
+    ln -s ../private/secret shared/evil.svg
+    chown -h 65534:65534 shared/evil.svg
+    for args in "-o shared/evil.svg" "--trace shared/evil.svg -o t.svg" "convert -o shared/evil.svg"; do
+        name="sticky-other-link ($args)"
+        # shellcheck disable=SC2086
+        run $args "$LOG"
+        [ $rc -eq 2 ] && grep -q "fs.protected_symlinks" err.txt && [ "$(cat private/secret)" = secret ] \
+            && [ "$(mode_of private/secret)" = 600 ] && [ ! -e t.svg ] \
+            || bad "exit $rc, or the link's target was replaced"
+    done
+    name=sticky-grid-link
+    ln -s ../private/secret shared/g.yaml
+    chown -h 65534:65534 shared/g.yaml
+    run grid -o shared/g "$LOG"
+    [ $rc -eq 2 ] && grep -q "fs.protected_symlinks" err.txt && [ "$(cat private/secret)" = secret ] \
+        && [ ! -e shared/g.pgm ] || bad "exit $rc, or a grid file written through the link"
+    name=sticky-link-in-chain
+    ln -s shared/evil.svg chain.svg
+    run -o chain.svg "$LOG"
+    [ $rc -eq 2 ] && [ "$(cat private/secret)" = secret ] || bad "exit $rc, a chain through the link followed"
+    name=sticky-folder-owner-link
+    mkdir owned
+    chown 65534:65534 owned
+    chmod 1777 owned
+    ln -s ../by-owner.svg owned/l.svg
+    chown -h 65534:65534 owned/l.svg
+    run -o owned/l.svg "$LOG"
+    [ $rc -eq 0 ] && [ -L owned/l.svg ] && is_svg by-owner.svg || bad "exit $rc: the folder owner's link not followed"
+    name=not-sticky-other-link
+    mkdir open
+    chmod 777 open
+    ln -s ../by-other.svg open/l.svg
+    chown -h 65534:65534 open/l.svg
+    run -o open/l.svg "$LOG"
+    [ $rc -eq 0 ] && is_svg by-other.svg || bad "exit $rc: a link in a folder without the sticky bit not followed"
+fi
+
 # ---- the format follows -o's extension ----
 name=format-json
 run -o m.json "$LOG"
@@ -163,11 +301,30 @@ run -o m.json "$LOG"
 name=format-txt
 run -o m.TXT "$LOG"
 [ $rc -eq 0 ] && grep -qE '^(open|closed) [0-9]+ ' m.TXT || bad "exit $rc, m.TXT is not TXT"
+name=format-none
+run -o m "$LOG"
+[ $rc -eq 0 ] && is_svg m || bad "exit $rc, m (no extension) is not the default SVG"
 name=format-other
-run -o m.map "$LOG"
-[ $rc -eq 0 ] && is_svg m.map || bad "exit $rc, m.map is not the default SVG"
 run --format json -o m2.map "$LOG"
 [ $rc -eq 0 ] && head -c 1 m2.map | grep -q '{' || bad "exit $rc, --format json not followed"
+pattern="-o 'clash.png': polyc writes .svg, .json or .txt, not .png"
+refused format-png -o clash.png "$LOG"
+[ -e clash.png ] && bad "clash.png written"
+pattern="-o 'clash.map': polyc writes .svg, .json or .txt, not .map"
+refused format-unknown -o clash.map "$LOG"
+[ -e clash.map ] && bad "clash.map written"
+pattern="polyc grid writes PREFIX.pgm and PREFIX.yaml .*not a .png file"
+refused grid-png grid -o clash.png "$LOG"
+[ -e clash.png.pgm ] && bad "clash.png.pgm written"
+
+# ---- polyc grid: -o office, office.pgm or office.yaml give the same pair ----
+for prefix in gp.pgm gy.yaml; do
+    name=grid-ext-$prefix
+    run grid -o $prefix "$LOG"
+    base=${prefix%.*}
+    [ $rc -eq 0 ] && [ -s $base.pgm ] && grep -q "^image: $base.pgm\$" $base.yaml \
+        && [ ! -e $prefix.pgm ] && [ ! -e $prefix.yaml ] || bad "exit $rc, or not $base.pgm + $base.yaml"
+done
 
 # ---- a closed pipe: an error, no temporary file ----
 name=closed-pipe
@@ -179,20 +336,29 @@ rc=$(cat rc.txt)
 no_temps
 
 # ---- signals: the temporary files go, the process dies of the signal ----
-# wait_temp: until a temporary file exists (the run is blocked after it)
+# wait_temp PID: until the run has written a file it has not named yet: an
+# unnamed one (O_TMPFILE, open in /proc/PID/fd as '... (deleted)') or a
+# temporary .polyc-XXXXXX (named is set to 1 then); the run is blocked after it
 wait_temp() {
     i=0
-    while [ $i -lt 200 ] && ! ls -A | grep -q '^\.polyc-'; do sleep 0.05; i=$((i + 1)); done
+    named=0
+    while [ $i -lt 200 ]; do
+        ls -A | grep -q '^\.polyc-' && { named=1; return; }
+        ls -l "/proc/$1/fd" 2> /dev/null | grep -q '(deleted)' && return
+        sleep 0.05
+        i=$((i + 1))
+    done
+    bad "no prepared output seen in 10 s"
 }
-# a background job of a script ignores SIGINT, and so would polyc (it keeps
-# a signal ignored, as nohup wants): env --default-signal gives it back
-if env --default-signal=INT true 2> /dev/null; then
-    bg="env --default-signal=INT"
-    sigs="INT TERM HUP"
+# a background job of a script ignores SIGINT and SIGQUIT, and so would polyc
+# (it keeps a signal ignored, as nohup wants): env --default-signal gives them back
+if env --default-signal=INT,QUIT true 2> /dev/null; then
+    bg="env --default-signal=INT,QUIT"
+    sigs="INT QUIT TERM HUP USR1 USR2 ALRM VTALRM XCPU"
 else
     bg=
-    sigs="TERM HUP"
-    echo "cli_output: SIGINT not tested (env --default-signal is missing)"
+    sigs="TERM HUP USR1 USR2 ALRM VTALRM XCPU"
+    echo "cli_output: SIGINT and SIGQUIT not tested (env --default-signal is missing)"
 fi
 # stop SIG PID: sends SIG, then SIGKILL if the run outlives it by 5 s; rc
 stop() {
@@ -204,16 +370,39 @@ stop() {
     rc=$?
 }
 mkfifo blocked
+echo old > t4old.txt
 for sig in $sigs; do
-    # the map waits for a reader of the FIFO, the trace's temporary file is written
+    # the map waits for a reader of the FIFO, the traces are written, unnamed
     name=signal-$sig-fifo
     count=$((count + 1))
     $bg "$POLYC" --iterations 2 --trace t4.txt -o blocked "$LOG" 2> err.txt &
     pid=$!
-    wait_temp
+    wait_temp $pid
     stop $sig $pid
     [ $rc -gt 128 ] && [ ! -e t4.txt ] || bad "exit $rc after SIG$sig"
     no_temps
+done
+# SIGKILL: no handler runs; an unnamed file goes with the process (where
+# the folder's file system has O_TMPFILE: asked of python3 if there is one)
+tmpfile=unknown
+if command -v python3 > /dev/null 2>&1; then
+    python3 -c 'import os; os.close(os.open(".", os.O_TMPFILE | os.O_WRONLY, 0o600))' 2> /dev/null \
+        && tmpfile=yes || tmpfile=no
+fi
+for trace in t4.txt t4old.txt; do
+    name=signal-KILL-$trace
+    count=$((count + 1))
+    "$POLYC" --iterations 2 --trace $trace -o blocked "$LOG" 2> err.txt &
+    pid=$!
+    wait_temp $pid
+    stop KILL $pid
+    [ $rc -gt 128 ] && [ ! -e t4.txt ] && [ "$(cat t4old.txt)" = old ] || bad "exit $rc, or $trace changed"
+    if [ $tmpfile = no ] || { [ $tmpfile = unknown ] && [ $named = 1 ]; }; then
+        echo "cli_output: SIGKILL leaves a temporary file here (no O_TMPFILE in $T)"
+        rm -f .polyc-*
+    else
+        no_temps
+    fi
 done
 sig=${sigs%% *}
 name=signal-$sig-full-pipe
@@ -223,7 +412,7 @@ sleep 30 < slow &
 sleeper=$!
 $bg "$POLYC" --points --iterations 2 --trace t5.txt "$LOG" > slow 2> err.txt &
 pid=$!
-wait_temp
+wait_temp $pid
 sleep 0.2
 stop $sig $pid
 kill $sleeper 2> /dev/null
@@ -235,9 +424,25 @@ count=$((count + 1))
 mkfifo g.yaml
 $bg "$POLYC" grid -o g "$LOG" 2> err.txt &
 pid=$!
-wait_temp
+wait_temp $pid
 stop $sig $pid
 [ $rc -gt 128 ] && [ ! -e g.pgm ] || bad "exit $rc, or g.pgm written after SIG$sig"
+no_temps
+
+# ---- past ulimit -f (SIGXFSZ is ignored: the write fails, reported) ----
+name=ulimit-f-new
+count=$((count + 1))
+(ulimit -f 2 && exec "$POLYC" -o big.svg "$LOG") > out.txt 2> err.txt
+rc=$?
+[ $rc -eq 1 ] && [ ! -e big.svg ] && grep -q '^polyc: big.svg: File too large$' err.txt \
+    || bad "exit $rc, or big.svg written past ulimit -f"
+no_temps
+name=ulimit-f-old
+echo old > big.svg
+count=$((count + 1))
+(ulimit -f 2 && exec "$POLYC" --iterations 2 --trace bt.txt -o big.svg "$LOG") > out.txt 2> err.txt
+rc=$?
+[ $rc -eq 1 ] && [ "$(cat big.svg)" = old ] && [ ! -e bt.txt ] || bad "exit $rc, or big.svg changed"
 no_temps
 
 echo "cli_output ($who): $count runs, $failed failures"

@@ -10,6 +10,7 @@
 
 #include "cli.h"
 #include "outfile.h"
+#include "textesc.h"
 
 double now_ms(void)
 {
@@ -94,15 +95,27 @@ void progress_stage(const char *stage)
     progress_show(NULL);
 }
 
+/* The message is escaped whole (textesc.h): a file name from the command
+ * line cannot send terminal escapes either; input bytes quoted in it are
+ * already escaped, and a backslash stays as it is. */
 int complain(int code, const char *fmt, ...)
 {
-    va_list ap;
+    va_list ap, again;
     progress_clear();
-    fputs("polyc: ", stderr);
     va_start(ap, fmt);
-    vfprintf(stderr, fmt, ap);
+    va_copy(again, ap);
+    int n = vsnprintf(NULL, 0, fmt, ap);
+    char *msg = n >= 0 ? malloc((size_t)n + 1) : NULL;
+    char *shown = NULL;
+    if (msg) {
+        vsnprintf(msg, (size_t)n + 1, fmt, again);
+        shown = textesc_dup(msg);
+    }
+    va_end(again);
     va_end(ap);
-    fputc('\n', stderr);
+    fprintf(stderr, "polyc: %s\n", shown ? shown : "out of memory (for a message)");
+    free(shown);
+    free(msg);
     if (code == EXIT_USAGE)
         fputs("try 'polyc --help'\n", stderr);
     return code;
@@ -148,7 +161,7 @@ int write_outputs(const char *const *paths, const membuf *const *bufs, size_t n)
         for (size_t j = 0; j < made; j++)
             outfile_abort(&of[j]);
         const char *p = paths[made - 1];
-        return what ? complain(EXIT_INPUT, "%s: %s: %s", p, what, strerror(err))
+        return what ? complain(EXIT_INPUT, "%s: %s (%s)", p, what, strerror(err))
                     : complain(EXIT_INPUT, "%s: %s", p, strerror(err));
     }
     progress_clear();                     /* before stdout, which may be the terminal */

@@ -114,6 +114,9 @@ int write_outputs(const char *const *paths, const membuf *const *bufs, size_t n)
 int parse_args(int argc, char **argv, options *o);
 /* Refuses (usage) the options given that are not in `allowed`. */
 int refuse_options(const options *o, unsigned allowed, const char *why);
+/* polyc grid's PREFIX: the length of -o's value without a .pgm or .yaml
+ * extension (-o office.yaml writes office.pgm and office.yaml). */
+size_t grid_prefix_len(const char *output);
 
 /* ---- load.c ---- */
 

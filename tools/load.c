@@ -9,6 +9,7 @@
 #include <sys/stat.h>
 
 #include "cli.h"
+#include "outfile.h"
 #include "readfile.h"
 #include "textesc.h"
 
@@ -75,6 +76,17 @@ int load_map(const options *o, map_input *m)
     char *shown = textesc_dup(m->image_path);
     if (!shown)
         return complain(EXIT_INPUT, "out of memory");
+    const char *const outs[] = {o->output, o->trace};   /* before the image is read */
+    const char *const opts[] = {"-o", "--trace"};
+    for (int i = 0; i < 2; i++)
+        if ((i == 0 || o->trace) && outfile_is_input(outs[i], m->image_path)) {
+            int rc = complain(EXIT_USAGE, "%s '%s' is the map's image %s (the same file, named at"
+                                          " %s:%u): it would be replaced; give another name",
+                              opts[i], outs[i] ? outs[i] : "-", shown, o->input,
+                              (unsigned)m->yaml.image_line);
+            free(shown);
+            return rc;
+        }
     err = readfile(m->image_path, MAPFILE_MAX_PGM_BYTES, &text, &len);
     if (err) {
         unsigned line = (unsigned)m->yaml.image_line;

@@ -3,6 +3,7 @@
  * sized for the log's area, each scan added and the map updated within
  * --work, --frames' SVGs, the finished map written as run.c writes a batch
  * map, and --stats' latencies of an add and of an add and its update. */
+#include <dirent.h>
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -12,6 +13,8 @@
 
 #include "cli.h"
 #include "ctxblock.h"
+#include "outfile.h"
+#include "textesc.h"
 
 #define ONLINE_ATTEMPTS 3          /* the usual limits, then 4 and 16 times them */
 #define ONLINE_EDGE_M 1.0          /* the library refuses data this near the area's
@@ -74,6 +77,48 @@ static int make_frames_dir(const char *dir)
     return complain(EXIT_INPUT, "--frames %s: %s", dir, strerror(errno == EEXIST ? ENOTDIR : errno));
 }
 
+/* The width of the frames' numbers: as the last one needs, at least 5. */
+static int frame_digits(uint32_t count)
+{
+    int digits = snprintf(NULL, 0, "%u", (unsigned)count);
+    return digits > 5 ? digits : 5;
+}
+
+/* Refuses (usage) a --frames DIR in which a frame this run writes is the
+ * input (DIR/frame-00050.svg a link to it, or the log itself), before the
+ * replay: DIR's entries named as those frames are looked at. */
+static int frames_clash(const options *o, uint32_t count)
+{
+    DIR *d = opendir(o->frames);
+    if (!d)
+        return 0;                      /* made new: nothing in it */
+    int width = frame_digits(count), rc = 0;
+    size_t n = strlen(o->frames) + 300;
+    char *path = malloc(n);
+    struct dirent *e;
+    while (path && !rc && (e = readdir(d)) != NULL) {
+        char *end, want[48];
+        if (strncmp(e->d_name, "frame-", 6) != 0 || e->d_name[6] < '0' || e->d_name[6] > '9')
+            continue;
+        unsigned long k = strtoul(e->d_name + 6, &end, 10);
+        if (k == 0 || k > count || k % o->every != 0)
+            continue;
+        snprintf(want, sizeof want, "frame-%0*lu.svg", width, k);
+        if (strcmp(want, e->d_name) != 0)
+            continue;
+        snprintf(path, n, "%s/%s", o->frames, want);
+        if (outfile_is_input(path, o->input))
+            rc = complain(EXIT_USAGE, "--frames %s: %s is the input '%s' (the same file): it"
+                                      " would be replaced; give another folder", o->frames,
+                          want, strcmp(o->input, "-") == 0 ? "stdin" : o->input);
+    }
+    closedir(d);
+    if (!path)
+        return complain(EXIT_INPUT, "out of memory");
+    free(path);
+    return rc;
+}
+
 /* The map after `scans` scans as DIR/frame-NNNNN.svg (as wide as the last
  * frame's number needs, at least 5 digits), written as -o is (outfile.h). */
 static int write_frame(const options *o, run *r, const polyc_config *cfg, polyc_ctx *ctx,
@@ -92,12 +137,11 @@ static int write_frame(const options *o, run *r, const polyc_config *cfg, polyc_
     map.path = r->log.scans;
     map.path_count = scans;
     map.view_m = view;             /* one view for every frame */
-    int digits = snprintf(NULL, 0, "%u", (unsigned)r->log.count);
     size_t n = strlen(o->frames) + 32;
     char *path = malloc(n);
     if (!path)
         return complain(EXIT_INPUT, "out of memory");
-    snprintf(path, n, "%s/frame-%0*u.svg", o->frames, digits > 5 ? digits : 5, (unsigned)scans);
+    snprintf(path, n, "%s/frame-%0*u.svg", o->frames, frame_digits(r->log.count), (unsigned)scans);
     membuf m = {NULL, 0, NULL};
     rc = render_map(&m, FORMAT_SVG, &map);
     if (!rc) {
@@ -203,9 +247,12 @@ static void print_online_stats(const options *o, const run *r, replay *rp, size_
     fprintf(stderr, "online ms      adds and updates %.1f in all, finish %.1f\n", total,
             rp->finish_ms);
     fprintf(stderr, "backlog        at most %u tiles\n", (unsigned)rp->max_backlog);
-    if (o->frames)
-        fprintf(stderr, "frames         %u in %s, %.1f ms\n", (unsigned)rp->frames, o->frames,
-                rp->frames_ms);
+    if (o->frames) {
+        char *shown = textesc_dup(o->frames);   /* no raw bytes on the terminal */
+        fprintf(stderr, "frames         %u in %s, %.1f ms\n", (unsigned)rp->frames,
+                shown ? shown : "?", rp->frames_ms);
+        free(shown);
+    }
 }
 
 int online_map(const options *o, run *r, double t_start, mapout_times *t)
@@ -216,6 +263,7 @@ int online_map(const options *o, run *r, double t_start, mapout_times *t)
     replay rp;
     memset(&rp, 0, sizeof rp);
     uint32_t max_beams;
+    int rc;
     rp.area_m = log_area(&cfg, &r->log, &rp.box, &max_beams);
     polyc_status st = polyc_online_limits_for_area(&cfg, rp.area_m, max_beams, &lim);
     if (st == POLYC_ERR_EXTENT)
@@ -224,6 +272,8 @@ int online_map(const options *o, run *r, double t_start, mapout_times *t)
                         input_name(o), rp.area_m / 2, rp.area_m, (double)cfg.max_extent_m);
     if (st != POLYC_OK)
         return library_fail("sizing", st, NULL, 0);
+    if (o->frames && (rc = frames_clash(o, r->log.count)) != 0)
+        return rc;
     if (o->frames && make_frames_dir(o->frames))
         return EXIT_INPUT;
     rp.add_ms = malloc(2 * (size_t)r->log.count * sizeof *rp.add_ms);
@@ -231,7 +281,6 @@ int online_map(const options *o, run *r, double t_start, mapout_times *t)
         return complain(EXIT_INPUT, "out of memory");
     rp.step_ms = rp.add_ms + r->log.count;
     size_t size = 0;
-    int rc;
     for (;;) {
         rp.attempts++;
         int retry = rp.attempts < ONLINE_ATTEMPTS;

@@ -208,52 +208,135 @@ static int takes_value(const char *name)
     return 0;
 }
 
-/* The format -o's extension names (.svg, .json, .txt), or -1. */
+/* The extension of path's last component (after its last '.', not a
+ * leading one), or NULL. */
+static const char *extension(const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    const char *base = slash ? slash + 1 : path;
+    const char *dot = strrchr(base, '.');
+    return dot && dot != base && dot[1] ? dot + 1 : NULL;
+}
+
+/* 1 if path ends with ext, in any case. */
+static int ends_with(const char *path, const char *ext)
+{
+    size_t n = strlen(path), e = strlen(ext);
+    if (n < e)
+        return 0;
+    for (size_t i = 0; i < e; i++)
+        if (tolower((unsigned char)path[n - e + i]) != ext[i])
+            return 0;
+    return 1;
+}
+
+/* The format -o's extension names (.svg, .json, .txt, in any case), or -1. */
 static int format_of_name(const char *path)
 {
     static const char *const ext[] = {".svg", ".json", ".txt"};
-    const char *slash = strrchr(path, '/');
-    const char *dot = strrchr(slash ? slash + 1 : path, '.');
-    for (int f = 0; dot && f < 3; f++) {
-        size_t i = 0;
-        while (dot[i] && ext[f][i] && tolower((unsigned char)dot[i]) == ext[f][i])
-            i++;
-        if (!dot[i] && !ext[f][i])
+    const char *x = extension(path);
+    for (int f = 0; x && f < 3; f++)
+        if (ends_with(path, ext[f]) && strlen(x) + 1 == strlen(ext[f]))
             return f;
-    }
     return -1;
 }
 
+/* 1 if path has an extension that names a format of its own, which polyc
+ * does not write: letters and digits after the dot, at least one a letter
+ * (map.png, map.pdf; not run.2 nor a name such as /dev/null). A device,
+ * FIFO or descriptor name is never refused. */
+static int other_extension(const char *path)
+{
+    const char *x = extension(path);
+    struct stat st;
+    int letter = 0;
+    if (!x || format_of_name(path) >= 0 || strlen(x) > 8 ||
+        (stat(path, &st) == 0 && !S_ISREG(st.st_mode)) || strncmp(path, "/dev/", 5) == 0 ||
+        strncmp(path, "/proc/", 6) == 0)
+        return 0;
+    for (; *x; x++) {
+        if (!isalnum((unsigned char)*x))
+            return 0;
+        letter |= isalpha((unsigned char)*x) != 0;
+    }
+    return letter;
+}
+
+size_t grid_prefix_len(const char *output)
+{
+    static const char *const ext[] = {".pgm", ".yaml"};
+    size_t n = strlen(output);
+    for (int k = 0; k < 2; k++) {
+        size_t e = strlen(ext[k]);
+        if (n > e && output[n - e - 1] != '/' && ends_with(output, ext[k]))
+            return n - e;
+    }
+    return n;
+}
+
+/* Refuses (usage) an output that is an input, before any work: the same
+ * regular file (device and inode, through links; stdout and stdin too). */
+static int check_not_input(const char *what, const char *path, const char *input)
+{
+    if (!outfile_is_input(path, input))
+        return 0;
+    const char *in = strcmp(input, "-") == 0 ? "stdin" : input;
+    return path && strcmp(path, "-") != 0
+               ? complain(EXIT_USAGE, "%s '%s' is the input '%s' (the same file): it would be"
+                                      " replaced; give another name", what, path, in)
+               : complain(EXIT_USAGE, "stdout is the input '%s' (the same file): give -o another"
+                                      " name", in);
+}
+
 /* Refuses (usage) outputs that cannot be written as asked, before any work:
- * an empty or directory name, -o and --trace naming the same file, a
- * --format that -o's extension contradicts; else takes the format from it. */
+ * an empty or directory name, a name in a missing or unwritable folder, a
+ * symlink not to follow, -o and --trace naming the same file, an output
+ * that is the input, an extension polyc does not write, a --format that
+ * -o's extension contradicts; else takes the format from it. */
 static int check_outputs(options *o)
 {
     const char *why;
+    int rc;
     if (o->command == CMD_GRID) {
-        size_t n = strlen(o->output);
+        size_t n = grid_prefix_len(o->output);
         char *p = malloc(n + 6);
         if (!p)
             return complain(EXIT_INPUT, "out of memory");
-        why = outfile_check(o->output);
-        for (int i = 0; i < 2 && !why; i++) {
-            snprintf(p, n + 6, "%s%s", o->output, i ? ".yaml" : ".pgm");
-            why = outfile_check(p);
+        snprintf(p, n + 6, "%.*s", (int)n, o->output);
+        rc = 0;
+        why = n == 0 ? "is empty" : outfile_check(o->output);
+        if (!why && (format_of_name(p) >= 0 || other_extension(p)))
+            rc = complain(EXIT_USAGE, "-o PREFIX '%s': polyc grid writes PREFIX.pgm and"
+                                      " PREFIX.yaml (-o office, office.pgm or office.yaml), not"
+                                      " a .%s file", o->output, extension(p));
+        for (int i = 0; i < 2 && !why && !rc; i++) {
+            snprintf(p, n + 6, "%.*s%s", (int)n, o->output, i ? ".yaml" : ".pgm");
+            if (!(why = outfile_check(p)))
+                rc = check_not_input("-o", p, o->input);
         }
         free(p);
         return why ? complain(EXIT_USAGE, "-o PREFIX '%s' %s (polyc grid writes PREFIX.pgm and"
                                           " PREFIX.yaml)", o->output, why)
-                   : 0;
+                   : rc;
     }
     if ((why = outfile_check(o->output)))
-        return complain(EXIT_USAGE, "-o '%s' %s: give a file name", o->output, why);
+        return complain(EXIT_USAGE, "-o '%s' %s", o->output, why);
     if ((why = outfile_check(o->trace)))
-        return complain(EXIT_USAGE, "--trace '%s' %s: give a file name", o->trace, why);
+        return complain(EXIT_USAGE, "--trace '%s' %s", o->trace, why);
     if (o->trace && outfile_same(o->output, o->trace))
         return complain(EXIT_USAGE, "-o and --trace name the same file ('%s', '%s')",
                         o->output ? o->output : "-", o->trace);
-    int f = o->output && o->command == CMD_MAP ? format_of_name(o->output) : -1;
+    if ((rc = check_not_input("-o", o->output, o->input)) != 0 ||
+        (o->trace && (rc = check_not_input("--trace", o->trace, o->input)) != 0))
+        return rc;
+    if (o->command != CMD_MAP || !o->output)
+        return 0;
+    int f = format_of_name(o->output);
     static const char *const names[] = {"svg", "json", "txt"};
+    if (f < 0 && !(o->given & OPT_FORMAT) && other_extension(o->output))
+        return complain(EXIT_USAGE, "-o '%s': polyc writes .svg, .json or .txt, not .%s (or"
+                                    " give --format to write that name)", o->output,
+                        extension(o->output));
     if (f >= 0 && (o->given & OPT_FORMAT) && (int)o->format != f)
         return complain(EXIT_USAGE, "--format %s contradicts -o %s (a .%s name)",
                         names[o->format], o->output, names[f]);

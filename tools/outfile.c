@@ -2,7 +2,7 @@
  * Takes: a path and bytes rendered in memory.
  * Gives: the bytes in the file (atomically for a regular file), stdout or a
  * device; temporary files listed for the signal handlers to remove. */
-#define _XOPEN_SOURCE 700       /* realpath */
+#define _GNU_SOURCE             /* O_TMPFILE, O_PATH, AT_EMPTY_PATH; realpath */
 #include "outfile.h"
 
 #include <errno.h>
@@ -13,26 +13,64 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 #define OUTFILE_MAX_TEMPS 8
 #define OUTFILE_MAX_LINKS 40           /* as the kernel's ELOOP limit */
-#define OUTFILE_TEMP_NAME ".polyc-XXXXXX"
+#define OUTFILE_TEMP_NAME ".polyc-"    /* and 6 letters or digits */
+#define OUTFILE_REFUSED (-1)           /* locate: a symlink not to follow */
+#define OUTFILE_RULE "is a symlink in a sticky, world-writable folder that neither you nor the" \
+                     " folder's owner owns: not followed (the kernel's fs.protected_symlinks rule)"
+#ifdef O_PATH
+#define OUTFILE_DIR_FLAGS (O_PATH | O_DIRECTORY | O_CLOEXEC)
+#else
+#define OUTFILE_DIR_FLAGS (O_RDONLY | O_DIRECTORY | O_CLOEXEC)
+#endif
 
 /* ---- the temporary files, for the signal handlers ---- */
 
+/* A named temporary file: its name in its folder's descriptor. */
 static char *volatile temps[OUTFILE_MAX_TEMPS];
-static const int caught[] = {SIGINT, SIGTERM, SIGHUP};
+static volatile sig_atomic_t temp_dirs[OUTFILE_MAX_TEMPS];
+static sigset_t caught;                /* the signals on_signal handles */
 
 static void on_signal(int sig)
 {
     for (int i = 0; i < OUTFILE_MAX_TEMPS; i++) {
         char *p = temps[i];
         if (p)
-            unlink(p);                 /* async-signal-safe */
+            unlinkat((int)temp_dirs[i], p, 0);   /* async-signal-safe */
     }
     signal(sig, SIG_DFL);
     raise(sig);                        /* delivered when the handler returns */
+}
+
+/* Every signal whose default action ends the process, but SIGKILL and
+ * SIGSTOP's kind (not catchable) and SIGPIPE and SIGXFSZ (ignored). */
+static int ends_process(int sig)
+{
+    static const int term[] = {
+        SIGHUP, SIGINT, SIGQUIT, SIGILL, SIGTRAP, SIGABRT, SIGBUS, SIGFPE, SIGUSR1, SIGSEGV,
+        SIGUSR2, SIGALRM, SIGTERM, SIGXCPU, SIGVTALRM, SIGPROF, SIGSYS,
+#ifdef SIGSTKFLT
+        SIGSTKFLT,
+#endif
+#ifdef SIGPOLL
+        SIGPOLL,
+#endif
+#ifdef SIGPWR
+        SIGPWR,
+#endif
+    };
+    for (size_t i = 0; i < sizeof term / sizeof term[0]; i++)
+        if (term[i] == sig)
+            return 1;
+#ifdef SIGRTMIN
+    if (sig >= SIGRTMIN && sig <= SIGRTMAX)
+        return 1;
+#endif
+    return 0;
 }
 
 void outfile_signals(void)
@@ -40,27 +78,33 @@ void outfile_signals(void)
     struct sigaction sa, old;
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = on_signal;
-    sigemptyset(&sa.sa_mask);
-    for (size_t i = 0; i < sizeof caught / sizeof caught[0]; i++)
-        sigaddset(&sa.sa_mask, caught[i]);
-    for (size_t i = 0; i < sizeof caught / sizeof caught[0]; i++)
-        if (sigaction(caught[i], NULL, &old) == 0 && old.sa_handler != SIG_IGN)
-            sigaction(caught[i], &sa, NULL);   /* (nohup's SIGHUP stays ignored) */
+    sigemptyset(&caught);
+    for (int sig = 1; sig < 65; sig++)
+        if (ends_process(sig))
+            sigaddset(&caught, sig);
+    sa.sa_mask = caught;
+    for (int sig = 1; sig < 65; sig++) {
+        if (!ends_process(sig))
+            continue;
+        /* one ignored (nohup's SIGHUP) or handled (a sanitizer's SIGSEGV)
+         * when polyc started stays so */
+        if (sigaction(sig, NULL, &old) == 0 && !(old.sa_flags & SA_SIGINFO) &&
+            old.sa_handler == SIG_DFL)
+            sigaction(sig, &sa, NULL);
+        else
+            sigdelset(&caught, sig);
+    }
     signal(SIGPIPE, SIG_IGN);          /* a closed pipe: EPIPE, reported */
+    signal(SIGXFSZ, SIG_IGN);          /* past ulimit -f: EFBIG, reported */
 }
 
 /* The caught signals held back while the list changes. */
 static void hold(int on, sigset_t *saved)
 {
-    if (on) {
-        sigset_t set;
-        sigemptyset(&set);
-        for (size_t i = 0; i < sizeof caught / sizeof caught[0]; i++)
-            sigaddset(&set, caught[i]);
-        sigprocmask(SIG_BLOCK, &set, saved);
-    } else {
+    if (on)
+        sigprocmask(SIG_BLOCK, &caught, saved);
+    else
         sigprocmask(SIG_SETMASK, saved, NULL);
-    }
 }
 
 static void forget(outfile *o)
@@ -72,6 +116,69 @@ static void forget(outfile *o)
         hold(0, &saved);
         o->slot = -1;
     }
+}
+
+/* Makes a name .polyc-XXXXXX in o->dir with make(o), which returns 0, or
+ * an errno value (EEXIST: try another name); lists it for the handlers.
+ * 0 or an errno value. */
+static int new_temp(outfile *o, int (*make)(outfile *o, int *fd), int *fd)
+{
+    static const char letters[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789";
+    static unsigned long seq;
+    unsigned long x = (unsigned long)getpid() * 2654435761ul ^ (unsigned long)time(NULL);
+    sigset_t saved;
+    int err = EMFILE, slot = -1;
+    hold(1, &saved);                   /* listed before a signal can see it */
+    for (int i = 0; i < OUTFILE_MAX_TEMPS && slot < 0; i++)
+        if (!temps[i])
+            slot = i;
+    for (int tries = 0; slot >= 0 && tries < 100; tries++) {
+        unsigned long v = x + 7919ul * ++seq;
+        memcpy(o->tmp, OUTFILE_TEMP_NAME, sizeof OUTFILE_TEMP_NAME - 1);
+        for (size_t k = 0; k < 6; k++, v /= 62)
+            o->tmp[sizeof OUTFILE_TEMP_NAME - 1 + k] = letters[v % 62];
+        o->tmp[sizeof OUTFILE_TEMP_NAME + 5] = '\0';
+        if ((err = make(o, fd)) != EEXIST)
+            break;
+    }
+    if (!err) {
+        temp_dirs[slot] = o->dir;
+        temps[slot] = o->tmp;
+        o->slot = slot;
+    } else {
+        o->tmp[0] = '\0';
+    }
+    hold(0, &saved);
+    return err;
+}
+
+/* new_temp's makers: an empty file, and the unnamed file's link. */
+static int create_temp(outfile *o, int *fd)
+{
+    *fd = openat(o->dir, o->tmp, O_CREAT | O_EXCL | O_WRONLY | O_NOFOLLOW | O_CLOEXEC, 0600);
+    return *fd < 0 ? errno : 0;
+}
+
+/* Gives the unnamed file o->tmpfd the name `name` in o->dir; 0 or an
+ * errno value (EEXIST: the name is taken). */
+static int link_unnamed(const outfile *o, const char *name)
+{
+    char proc[48];
+    snprintf(proc, sizeof proc, "/proc/self/fd/%d", o->tmpfd);
+    if (linkat(AT_FDCWD, proc, o->dir, name, AT_SYMLINK_FOLLOW) == 0)
+        return 0;
+    int err = errno;
+#ifdef AT_EMPTY_PATH
+    if (err == ENOENT && linkat(o->tmpfd, "", o->dir, name, AT_EMPTY_PATH) == 0)
+        return 0;                      /* no /proc: allowed with CAP_DAC_READ_SEARCH */
+#endif
+    return err;
+}
+
+static int link_temp(outfile *o, int *fd)
+{
+    (void)fd;
+    return link_unnamed(o, o->tmp);
 }
 
 /* ---- names ---- */
@@ -150,16 +257,113 @@ static char *resolve(const char *path, int *err)
     return NULL;
 }
 
+static const char *base_of(const char *p)
+{
+    const char *slash = strrchr(p, '/');
+    return slash ? slash + 1 : p;
+}
+
+/* Follows path's last component through its symlinks, each looked at and
+ * read in its folder opened as a descriptor, by the kernel's
+ * fs.protected_symlinks rule: in a sticky, world-writable folder, a link is
+ * followed only if the caller or the folder's owner owns it (the folders on
+ * the way are the kernel's to follow). *target: the name at the end
+ * (malloc'd); *dir: its folder, open, or -1 for a name the kernel makes up
+ * (is_magic). 0, OUTFILE_REFUSED or an errno value (*folder set if it is
+ * the folder's: it could not be opened). */
+static int locate(const char *path, char **target, int *dir, int *folder)
+{
+    *target = NULL;
+    *dir = -1;
+    *folder = 0;
+    char *cur = in_dir_of("", path);
+    if (!cur)
+        return ENOMEM;
+    for (int hop = 0; hop <= OUTFILE_MAX_LINKS; hop++) {
+        if (is_magic(cur)) {
+            *target = cur;
+            return 0;
+        }
+        char *d = in_dir_of(cur, ".");
+        int fd = d ? open(d, OUTFILE_DIR_FLAGS) : -1;
+        int err = !d ? ENOMEM : fd < 0 ? errno : 0;
+        free(d);
+        if (err) {
+            *folder = err != ENOMEM;
+            free(cur);
+            return err;
+        }
+        const char *base = base_of(cur);
+        struct stat ls, ds;
+        if (fstatat(fd, base, &ls, AT_SYMLINK_NOFOLLOW) != 0 || !S_ISLNK(ls.st_mode)) {
+            *target = cur;
+            *dir = fd;
+            return 0;
+        }
+        char link[PATH_MAX];
+        ssize_t n = -1;
+        if (fstat(fd, &ds) != 0)
+            err = errno;
+        else if ((ds.st_mode & S_ISVTX) && (ds.st_mode & S_IWOTH) && ls.st_uid != geteuid() &&
+                 ls.st_uid != ds.st_uid)
+            err = OUTFILE_REFUSED;
+        else if ((n = readlinkat(fd, base, link, sizeof link - 1)) < 0)
+            err = errno;
+        close(fd);
+        char *next = NULL;
+        if (!err) {
+            link[n] = '\0';
+            next = link[0] == '/' ? in_dir_of("", link) : in_dir_of(cur, link);
+            err = next ? 0 : ENOMEM;
+        }
+        free(cur);
+        if (err)
+            return err;
+        cur = next;
+    }
+    free(cur);
+    return ELOOP;
+}
+
 const char *outfile_check(const char *path)
 {
-    struct stat st;
     if (!path || strcmp(path, "-") == 0)
         return NULL;
     if (!*path)
         return "is empty";
-    if (path[strlen(path) - 1] == '/' || (stat(path, &st) == 0 && S_ISDIR(st.st_mode)))
+    if (path[strlen(path) - 1] == '/')
         return "names a directory";
-    return NULL;
+    char *t;
+    int dir, folder;
+    int err = locate(path, &t, &dir, &folder);
+    const char *why = NULL;
+    struct stat st;
+    if (err == OUTFILE_REFUSED)
+        why = OUTFILE_RULE;
+    else if (err == ENOMEM)
+        why = "cannot be checked (out of memory)";
+    else if (err == ELOOP)
+        why = "is a loop or a chain of too many symlinks";
+    else if (err && folder)
+        why = err == ENOENT    ? "is in a folder that does not exist"
+              : err == ENOTDIR ? "is in a folder that is not a folder"
+              : err == EACCES  ? "is in a folder that you may not enter"
+                               : "is in a folder that cannot be opened";
+    else if (err)
+        why = "is a symlink that cannot be read";
+    else if (dir >= 0) {
+        int exists = fstatat(dir, base_of(t), &st, AT_SYMLINK_NOFOLLOW) == 0;
+        if (exists && S_ISDIR(st.st_mode))
+            why = "names a directory";
+        else if ((!exists || S_ISREG(st.st_mode)) &&
+                 faccessat(dir, ".", W_OK | X_OK, AT_EACCESS) != 0)
+            why = errno == EROFS ? "is on a read-only file system"
+                                 : "is in a folder that you may not write";
+    }
+    if (dir >= 0)
+        close(dir);
+    free(t);
+    return why;
 }
 
 /* The target's folder made absolute, and its name: one spelling per file. */
@@ -199,6 +403,16 @@ int outfile_same(const char *a, const char *b)
     return same;
 }
 
+int outfile_is_input(const char *out, const char *in)
+{
+    struct stat x, y;
+    int so = !out || strcmp(out, "-") == 0, si = !in || strcmp(in, "-") == 0;
+    if ((so ? fstat(STDOUT_FILENO, &x) : stat(out, &x)) != 0 ||
+        (si ? fstat(STDIN_FILENO, &y) : stat(in, &y)) != 0)
+        return 0;
+    return S_ISREG(x.st_mode) && x.st_dev == y.st_dev && x.st_ino == y.st_ino;
+}
+
 /* ---- writing ---- */
 
 static int write_all(int fd, const char *data, size_t len)
@@ -221,46 +435,46 @@ int outfile_prepare(outfile *o, const char *path, const char *data, size_t len, 
     o->len = len;
     o->slot = -1;
     o->fd = -1;
+    o->dir = -1;
+    o->tmpfd = -1;
     *what = NULL;
     if (!path || strcmp(path, "-") == 0) {
         o->kind = OUTFILE_STDOUT;
         return 0;
     }
-    int err = 0;
-    if (!(o->target = resolve(path, &err)))
+    int folder, err = locate(path, &o->target, &o->dir, &folder);
+    if (err == OUTFILE_REFUSED) {
+        *what = OUTFILE_RULE;
+        return EACCES;
+    }
+    if (err) {
+        *what = folder ? "cannot open its folder" : NULL;
         return err;
-    struct stat st;
-    int exists = stat(o->target, &st) == 0;
-    if (exists && S_ISDIR(st.st_mode))
-        return EISDIR;
-    if (is_magic(o->target) || (exists && !S_ISREG(st.st_mode))) {
+    }
+    o->base = base_of(o->target);
+    if (o->dir < 0) {                  /* /dev/stdout, /proc/self/fd/N, ... */
         o->kind = OUTFILE_IN_PLACE;
         o->fd = own_fd(o->target);     /* written as is: a shell's >> stays an append */
         return 0;
     }
-    o->kind = OUTFILE_REPLACE;
-    if (!(o->tmp = in_dir_of(o->target, OUTFILE_TEMP_NAME)))
-        return ENOMEM;
-    sigset_t saved;
-    hold(1, &saved);                   /* listed before a signal can see it */
-    int fd = mkstemp(o->tmp);
-    err = fd < 0 ? errno : 0;
-    for (int i = 0; fd >= 0 && i < OUTFILE_MAX_TEMPS && o->slot < 0; i++)
-        if (!temps[i]) {
-            temps[i] = o->tmp;
-            o->slot = i;
-        }
-    if (fd >= 0 && o->slot < 0) {
-        unlink(o->tmp);
-        close(fd);
-        fd = -1;
-        err = EMFILE;
+    struct stat st;
+    int exists = fstatat(o->dir, o->base, &st, AT_SYMLINK_NOFOLLOW) == 0;
+    if (exists && S_ISDIR(st.st_mode))
+        return EISDIR;
+    if (exists && !S_ISREG(st.st_mode)) {
+        o->kind = OUTFILE_IN_PLACE;
+        return 0;
     }
-    hold(0, &saved);
-    if (fd < 0) {
-        free(o->tmp);
-        o->tmp = NULL;
-        *what = "cannot create a temporary file";
+    o->kind = OUTFILE_REPLACE;
+    o->fresh = !exists;
+    int fd = -1;
+#ifdef O_TMPFILE
+    fd = openat(o->dir, ".", O_TMPFILE | O_WRONLY | O_CLOEXEC, 0666);   /* less the umask */
+    o->tmpfd = fd;
+#endif
+    if (fd < 0 && (err = new_temp(o, create_temp, &fd)) != 0) {
+        *what = "cannot create a file in its folder";
+        outfile_abort(o);
         return err;
     }
     if (exists) {                      /* the file's owner and mode, as far as allowed */
@@ -268,8 +482,8 @@ int outfile_prepare(outfile *o, const char *path, const char *data, size_t len, 
             /* not ours to give away: the new file is the writer's */
         }
         err = fchmod(fd, st.st_mode & 07777) ? errno : 0;
-    } else {
-        mode_t mask = umask(0);        /* mkstemp makes 0600; give the usual mode */
+    } else if (o->tmpfd < 0) {
+        mode_t mask = umask(0);        /* made 0600; give the usual mode */
         umask(mask);
         err = fchmod(fd, 0666 & ~mask) ? errno : 0;
     }
@@ -277,11 +491,27 @@ int outfile_prepare(outfile *o, const char *path, const char *data, size_t len, 
         err = write_all(fd, data, len);
     if (!err && fsync(fd) != 0)
         err = errno;
-    if (close(fd) != 0 && !err)
+    if (o->tmpfd < 0 && close(fd) != 0 && !err)
         err = errno;
     if (err)
         outfile_abort(o);
     return err;
+}
+
+/* The written file under the target's name: an unnamed file linked in
+ * (a new name) or linked to a temporary name first, then renamed over it. */
+static int give_name(outfile *o)
+{
+    int err = 0, unused;
+    if (o->tmpfd >= 0 && o->fresh && (err = link_unnamed(o, o->base)) != EEXIST)
+        return err;                    /* (EEXIST: made meanwhile, so replaced) */
+    if (o->tmpfd >= 0 && (err = new_temp(o, link_temp, &unused)) != 0)
+        return err;
+    if (renameat(o->dir, o->tmp, o->dir, o->base) != 0)
+        return errno;
+    forget(o);
+    o->tmp[0] = '\0';
+    return 0;
 }
 
 int outfile_commit(outfile *o)
@@ -298,20 +528,23 @@ int outfile_commit(outfile *o)
             err = write_all(o->fd, o->data, o->len);
     } else if (o->kind == OUTFILE_IN_PLACE) {
         struct stat st;
-        int trunc = stat(o->target, &st) == 0 && S_ISREG(st.st_mode) ? O_TRUNC : 0;
-        int fd = open(o->target, O_WRONLY | O_NOCTTY | trunc);
+        int flags = O_WRONLY | O_NOCTTY | O_CLOEXEC, fd;
+        if (o->dir >= 0) {             /* the file looked at, not a link put there since */
+            if (fstatat(o->dir, o->base, &st, AT_SYMLINK_NOFOLLOW) == 0 && S_ISREG(st.st_mode))
+                flags |= O_TRUNC;
+            fd = openat(o->dir, o->base, flags | O_NOFOLLOW);
+        } else {
+            if (stat(o->target, &st) == 0 && S_ISREG(st.st_mode))
+                flags |= O_TRUNC;
+            fd = open(o->target, flags);
+        }
         if (fd < 0)
             return errno;
         err = write_all(fd, o->data, o->len);
         if (close(fd) != 0 && !err)
             err = errno;
-    } else if (o->tmp) {
-        err = rename(o->tmp, o->target) != 0 ? errno : 0;
-        if (!err) {
-            forget(o);
-            free(o->tmp);
-            o->tmp = NULL;
-        }
+    } else if (o->tmpfd >= 0 || o->tmp[0]) {
+        err = give_name(o);
     }
     outfile_abort(o);
     return err;
@@ -319,12 +552,17 @@ int outfile_commit(outfile *o)
 
 void outfile_abort(outfile *o)
 {
-    if (o->tmp) {
-        unlink(o->tmp);
+    if (o->tmp[0]) {
+        unlinkat(o->dir, o->tmp, 0);
         forget(o);
-        free(o->tmp);
-        o->tmp = NULL;
+        o->tmp[0] = '\0';
     }
+    if (o->tmpfd >= 0)
+        close(o->tmpfd);               /* an unnamed file goes with its last descriptor */
+    o->tmpfd = -1;
+    if (o->dir >= 0)
+        close(o->dir);
+    o->dir = -1;
     free(o->target);
     o->target = NULL;
 }

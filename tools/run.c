@@ -400,14 +400,14 @@ int make_map(const options *o, run *r, double t_start, mapout_times *t)
  * image by its base name. 0 or an exit code. */
 static int write_grid_files(const options *o, run *r, const gridimage *img)
 {
-    size_t plen = strlen(o->output);
+    size_t plen = grid_prefix_len(o->output);
     char *pgm_path = malloc(plen + 6), *yaml_path = malloc(plen + 6);
     int rc = 0;
     if (!pgm_path || !yaml_path) {
         rc = complain(EXIT_INPUT, "out of memory");
     } else {
-        snprintf(pgm_path, plen + 6, "%s.pgm", o->output);
-        snprintf(yaml_path, plen + 6, "%s.yaml", o->output);
+        snprintf(pgm_path, plen + 6, "%.*s.pgm", (int)plen, o->output);
+        snprintf(yaml_path, plen + 6, "%.*s.yaml", (int)plen, o->output);
         const char *slash = strrchr(pgm_path, '/');
         const char *image = slash ? slash + 1 : pgm_path;
         for (const char *q = image; *q && !rc; q++)
