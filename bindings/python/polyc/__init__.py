@@ -39,7 +39,11 @@ POLYC_ERR_RANGE: ResyncError, a PolycError); bad arguments raise TypeError or
 ValueError before the library sees them; an exception raised in a progress
 callback (KeyboardInterrupt too) stops the optimiser and is raised again by
 the call that ran it.
+Threads: each Context and OnlineMap holds a lock around every call into its
+block; a call from another thread waits for the running one, a call from
+inside the object's own progress callback raises PolycError POLYC_ERR_BUSY.
 """
+import contextlib
 import ctypes
 import math
 import numbers
@@ -640,16 +644,25 @@ class _Progress:
 
 
 class _Block:
-    """What a context in a block of its own does, batch or online: refuse
-    calls from its own progress callback, raise the library's errors, run
-    the optimiser with a progress callback, copy the map out."""
+    """What a context in a block of its own does, batch or online: one
+    thread at a time (a lock around every call into the block; another
+    thread waits), refuse calls from its own progress callback, raise the
+    library's errors, run the optimiser with a progress callback, copy the
+    map out."""
     _busy = False
     _ctx = None
 
-    def _enter(self, what):
-        if self._busy:
-            raise PolycError(ERR_BUSY, what, "a context's methods may not be called from "
-                             "inside its own progress callback")
+    @contextlib.contextmanager
+    def _use(self, what):
+        """The block to this thread for the calls of `what`: another thread
+        waits until it is free. A call from inside the object's own
+        progress callback (the thread that holds the lock, reentrant) is
+        POLYC_ERR_BUSY at once, as the library would say."""
+        with self._lock:
+            if self._busy:
+                raise PolycError(ERR_BUSY, what, "a context's methods may not be called from "
+                                 "inside its own progress callback")
+            yield
 
     def _check(self, status, what):
         if status != OK:
@@ -659,16 +672,16 @@ class _Block:
     def _run(self, fn, progress, what):
         """fn(ctx, callback, None) with progress; the callback's exception
         first, then the status."""
-        self._enter(what)
         interrupts = _Interrupts()
         cb = _Progress(progress, self, interrupts)
-        with interrupts:
-            status = fn(self._ctx, cb.c, None)
-        interrupts.deliver()
-        if cb.error is not None:
-            error, cb.error = cb.error, None
-            raise error
-        self._check(status, what)
+        with self._use(what):
+            with interrupts:
+                status = fn(self._ctx, cb.c, None)
+            interrupts.deliver()
+            if cb.error is not None:
+                error, cb.error = cb.error, None
+                raise error
+            self._check(status, what)
 
     def _copy_polylines(self):
         out = []
@@ -692,10 +705,12 @@ class Context(_Block):
     limits: dict or (max_scans, max_beams, max_grid_cells, max_vertices[, max_points]);
     memory_bytes: block size (default: polyc_memory_size); other keywords
     override polyc_config fields (cell_m=0.05, max_iterations=0, seed=3, ...).
-    Its methods may not be called from inside its own progress callback
-    (PolycError POLYC_ERR_BUSY)."""
+    One thread at a time: a call from another thread waits until the
+    running one returns. Its methods may not be called from inside its own
+    progress callback (PolycError POLYC_ERR_BUSY)."""
 
     def __init__(self, limits, memory_bytes=None, **config):
+        self._lock = threading.RLock()
         self._busy = False
         self._ctx = ctypes.c_void_p()
         self._cfg = _config(config)
@@ -715,17 +730,17 @@ class Context(_Block):
     def add_scan(self, pose, start_angle_rad, angle_step_rad, min_range_m, max_range_m,
                  ranges_m):
         """Copies one scan in (see Scan for the fields)."""
-        self._enter("add scan")
         s, _buf = _scan((pose, start_angle_rad, angle_step_rad, min_range_m, max_range_m,
                          ranges_m))
-        self._check(_lib.polyc_add_scan(self._ctx, ctypes.byref(s)), "add scan")
+        with self._use("add scan"):
+            self._check(_lib.polyc_add_scan(self._ctx, ctypes.byref(s)), "add scan")
 
     def add_grid(self, cells, width, height, resolution, origin=(0.0, 0.0, 0.0)):
         """Takes an occupancy grid (see build_map_from_grid for the arguments);
         a context holds one grid or scans, not both."""
-        self._enter("add grid")
         g, _buf = _grid(cells, width, height, resolution, origin)
-        self._check(_lib.polyc_add_grid(self._ctx, ctypes.byref(g)), "add grid")
+        with self._use("add grid"):
+            self._check(_lib.polyc_add_grid(self._ctx, ctypes.byref(g)), "add grid")
 
     def build(self, progress=None):
         """Grid, contour, trace and (if max_iterations > 0) the optimiser.
@@ -735,16 +750,16 @@ class Context(_Block):
         self._run(_lib.polyc_build, progress, "build")
 
     def build_grid(self):
-        self._enter("build grid")
-        self._check(_lib.polyc_build_grid(self._ctx), "build grid")
+        with self._use("build grid"):
+            self._check(_lib.polyc_build_grid(self._ctx), "build grid")
 
     def extract_contour(self):
-        self._enter("extract contour")
-        self._check(_lib.polyc_extract_contour(self._ctx), "extract contour")
+        with self._use("extract contour"):
+            self._check(_lib.polyc_extract_contour(self._ctx), "extract contour")
 
     def trace(self):
-        self._enter("trace")
-        self._check(_lib.polyc_trace(self._ctx), "trace")
+        with self._use("trace"):
+            self._check(_lib.polyc_trace(self._ctx), "trace")
 
     def optimize(self, progress=None):
         """The optimiser; progress as for build."""
@@ -752,42 +767,43 @@ class Context(_Block):
 
     def score(self):
         """(bic, error_sq_m2) of the current polylines."""
-        self._enter("score")
         bic, err = _f64(), _f64()
-        self._check(_lib.polyc_score(self._ctx, ctypes.byref(bic), ctypes.byref(err)), "score")
+        with self._use("score"):
+            self._check(_lib.polyc_score(self._ctx, ctypes.byref(bic), ctypes.byref(err)),
+                        "score")
         return bic.value, err.value
 
     def polylines(self):
         """The current map, copied out: a list of Polyline."""
-        self._enter("polylines")
-        return self._copy_polylines()
+        with self._use("polylines"):
+            return self._copy_polylines()
 
     def grid_image(self):
         """The hit/miss grid (run build_grid first) as the image `polyc grid`
         writes: a GridImage."""
-        self._enter("grid image")
         _need_io("grid_image")
         img = ctypes.POINTER(_GridImage)()
         status = ctypes.c_int(OK)
-        made = _lib.polyc_io_grid_image(self._ctx, ctypes.byref(img), ctypes.byref(status))
-        try:
-            if made == -1:
-                self._check(status.value, "grid image")
-            if made == -2:
+        with self._use("grid image"):
+            made = _lib.polyc_io_grid_image(self._ctx, ctypes.byref(img), ctypes.byref(status))
+            try:
+                if made == -1:
+                    self._check(status.value, "grid image")
+                if made == -2:
+                    g = img.contents
+                    raise PolycError(ERR_EXTENT, "grid image", "the grid is %d x %d cells: "
+                                     "empty, or more than a map may have" % (g.width, g.height))
+                if made != 0:
+                    raise MemoryError("grid image")
                 g = img.contents
-                raise PolycError(ERR_EXTENT, "grid image", "the grid is %d x %d cells: empty, or "
-                                 "more than a map may have" % (g.width, g.height))
-            if made != 0:
-                raise MemoryError("grid image")
-            g = img.contents
-            return GridImage(ctypes.string_at(g.pixels, g.width * g.height), g.width, g.height,
-                             _shortest(g.cell_m), (g.origin_x_m, g.origin_y_m, 0.0))
-        finally:
-            _lib.polyc_io_grid_image_free(img)
+                return GridImage(ctypes.string_at(g.pixels, g.width * g.height), g.width,
+                                 g.height, _shortest(g.cell_m), (g.origin_x_m, g.origin_y_m, 0.0))
+            finally:
+                _lib.polyc_io_grid_image_free(img)
 
     def stats(self):
-        self._enter("stats")
-        return self._get_stats()
+        with self._use("stats"):
+            return self._get_stats()
 
 
 class OnlineMap(_Block):
@@ -800,11 +816,13 @@ class OnlineMap(_Block):
     how many scans (and their beams in all) add_scan(..., keep=True) may
     keep for correct(). The other limits (max_grid_cells, max_vertices,
     max_points) come from polyc_online_limits_for_area; keywords override
-    them. Its methods may not be called from inside finish's progress
-    callback (PolycError POLYC_ERR_BUSY)."""
+    them. One thread at a time: a call from another thread waits until the
+    running one returns. Its methods may not be called from inside finish's
+    progress callback (PolycError POLYC_ERR_BUSY)."""
 
     def __init__(self, area_m, max_scan_beams, config=None, keep_scans=0, keep_beams=0,
                  **limits):
+        self._lock = threading.RLock()
         self._ctx = ctypes.c_void_p()
         self._cfg = _config(dict(config or {}))
         area_m = _real_field("area_m", area_m)
@@ -841,12 +859,13 @@ class OnlineMap(_Block):
         s goes in as add_scan(*s)); keep=True keeps it for correct().
         Returns its scan id (0 for the first). The map changes at the next
         update."""
-        self._enter("add scan")
         s, _buf = _scan((pose, start_angle_rad, angle_step_rad, min_range_m, max_range_m,
                          ranges_m))
         scan_id = _u32()
-        self._check(_lib.polyc_online_add_scan(self._ctx, ctypes.byref(s), 1 if keep else 0,
-                                               ctypes.byref(scan_id)), "add scan")
+        with self._use("add scan"):
+            self._check(_lib.polyc_online_add_scan(self._ctx, ctypes.byref(s),
+                                                   1 if keep else 0, ctypes.byref(scan_id)),
+                        "add scan")
         return scan_id.value
 
     @staticmethod
@@ -860,10 +879,10 @@ class OnlineMap(_Block):
         per two beams they cast); an update they spent it in does nothing
         else. Before any scan: PolycError POLYC_ERR_STATE. Returns an
         OnlineReport."""
-        self._enter("update")
         work = _int_field("work", work, _u64)
         r = _OnlineReport()
-        self._check(_lib.polyc_online_update(self._ctx, work, ctypes.byref(r)), "update")
+        with self._use("update"):
+            self._check(_lib.polyc_online_update(self._ctx, work, ctypes.byref(r)), "update")
         return self._report(r)
 
     def finish(self, progress=None):
@@ -884,30 +903,31 @@ class OnlineMap(_Block):
         add_scan() applies every waiting correction, and the updates
         re-optimise what changed. A scan not kept (or unknown): PolycError
         POLYC_ERR_RANGE."""
-        self._enter("correct")
         scan_id = _int_field("scan_id", scan_id, _u32)
         x, y, theta = (_real_field("pose", v) for v in pose)
-        self._check(_lib.polyc_online_correct(self._ctx, scan_id, x, y, theta), "correct")
+        with self._use("correct"):
+            self._check(_lib.polyc_online_correct(self._ctx, scan_id, x, y, theta), "correct")
 
     def changes_since(self, version):
         """The polylines added, modified or removed by the versions after
         `version`, one Change (id, kind, version) per polyline, its latest,
         ids ascending. ResyncError (a PolycError, POLYC_ERR_RANGE) when
         removals that old are forgotten: read the whole map again."""
-        self._enter("changes since")
         since = _int_field("version", version, _u64)
         count = _u32()
         cap, out = 0, None
-        while True:
-            status = _lib.polyc_online_changes(self._ctx, since, out, cap, ctypes.byref(count))
-            if status == ERR_RANGE:
-                raise ResyncError(status, "changes since %d" % since,
-                                  _lib.polyc_last_error(self._ctx).decode())
-            self._check(status, "changes since %d" % since)
-            if count.value <= cap:
-                break
-            cap = count.value
-            out = (_Change * cap)()
+        with self._use("changes since"):
+            while True:
+                status = _lib.polyc_online_changes(self._ctx, since, out, cap,
+                                                   ctypes.byref(count))
+                if status == ERR_RANGE:
+                    raise ResyncError(status, "changes since %d" % since,
+                                      _lib.polyc_last_error(self._ctx).decode())
+                self._check(status, "changes since %d" % since)
+                if count.value <= cap:
+                    break
+                cap = count.value
+                out = (_Change * cap)()
         return [Change(c.id, CHANGE_KINDS.get(c.kind, "kind %d" % c.kind), c.version)
                 for c in (out[:count.value] if count.value else ())]
 
@@ -915,33 +935,34 @@ class OnlineMap(_Block):
     def version(self):
         """The map's version: 0 before the first update, one more for every
         update or finish that changed the map."""
-        self._enter("version")
-        return _lib.polyc_online_version(self._ctx)
+        with self._use("version"):
+            return _lib.polyc_online_version(self._ctx)
 
     @property
     def polylines(self):
         """The map as the last update or finish left it, copied out: a list
         of Polyline, as in a batch Result."""
-        self._enter("polylines")
-        return self._copy_polylines()
+        with self._use("polylines"):
+            return self._copy_polylines()
 
     @property
     def polyline_ids(self):
         """The ids of the polylines, in the order of polylines: an id stays
         the same while its polyline lives; ids start at 1, never reused."""
-        self._enter("polyline ids")
         ids = []
         one = _u32()
-        for i in range(_lib.polyc_polyline_count(self._ctx)):
-            self._check(_lib.polyc_polyline_id(self._ctx, i, ctypes.byref(one)), "polyline id")
-            ids.append(one.value)
+        with self._use("polyline ids"):
+            for i in range(_lib.polyc_polyline_count(self._ctx)):
+                self._check(_lib.polyc_polyline_id(self._ctx, i, ctypes.byref(one)),
+                            "polyline id")
+                ids.append(one.value)
         return ids
 
     @property
     def stats(self):
         """The fields of polyc_stats for the current map (a dict)."""
-        self._enter("stats")
-        return self._get_stats()
+        with self._use("stats"):
+            return self._get_stats()
 
 
 def _scans_and_limits(cfg, scans):
