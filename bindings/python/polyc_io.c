@@ -7,7 +7,9 @@
  *
  * Memory: each reader mallocs a handle that owns everything it points to;
  * the matching *_free releases it. Errors: -1 with the reader's message
- * ("NAME:LINE: what is wrong", as the tool prints it) in error[error_size].
+ * ("NAME:LINE: what is wrong", as the tool prints it) in error[error_size];
+ * the file named not opened (missing, not allowed, a directory): its errno
+ * value (> 0), and the message too.
  *
  * SPDX-License-Identifier: MIT
  */
@@ -15,6 +17,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "gridimage.h"
 #include "mapfile.h"
@@ -29,7 +32,7 @@
 #endif
 
 /* Bumped when a function below changes; the binding checks it. */
-#define POLYC_IO_VERSION 1
+#define POLYC_IO_VERSION 2
 
 POLYC_IO_API int polyc_io_version(void);
 POLYC_IO_API size_t polyc_io_struct_size(const char *name);
@@ -81,7 +84,8 @@ static int fail(char *error, size_t error_size, const char *fmt, const char *a, 
 /* ---- logs ---- */
 
 /* Reads the log at path as `polyc LOG` does (`--max-range` is max_range_m;
- * 0: none). 0 and *out, or -1 and the message. */
+ * 0: none). 0 and *out; -1 and the message; the errno value if path is not
+ * opened (EISDIR for a directory). */
 int polyc_io_read_log(const char *path, double max_range_m, scanlog **out, char *error,
                       size_t error_size)
 {
@@ -91,10 +95,20 @@ int polyc_io_read_log(const char *path, double max_range_m, scanlog **out, char 
     scanlog *log = calloc(1, sizeof *log);
     if (!log)
         return fail(error, error_size, "%s%s", "out of memory", "");
+    errno = 0;
     FILE *f = fopen(path, "rb");
-    if (!f) {
+    struct stat st;
+    int err = 0;
+    if (!f || fstat(fileno(f), &st) != 0)
+        err = errno ? errno : EIO;
+    else if (S_ISDIR(st.st_mode))
+        err = EISDIR;
+    if (err) {
+        if (f)
+            fclose(f);
         free(log);
-        return fail(error, error_size, "%s: %s", path, strerror(errno));
+        fail(error, error_size, "%s: %s", path, strerror(err));
+        return err;
     }
     scanlog_opts opts = {max_range_m};
     int bad = scanlog_read(log, f, path, &opts);
@@ -129,7 +143,9 @@ void polyc_io_log_free(scanlog *log)
 /* ---- maps ---- */
 
 /* Reads a map YAML, its image (map_server's rule for where it is) and
- * converts its pixels as `polyc map.yaml` does. 0 and *out, or -1. */
+ * converts its pixels as `polyc map.yaml` does. 0 and *out; -1 and the
+ * message; the errno value if the YAML is not opened (its image not
+ * opened is -1: a bad map). */
 int polyc_io_read_map(const char *path, polyc_io_map **out, char *error, size_t error_size)
 {
     if (!path || !out)
@@ -142,8 +158,10 @@ int polyc_io_read_map(const char *path, polyc_io_map **out, char *error, size_t 
         return fail(error, error_size, "%s: %s", path, "too large to be a map YAML");
     if (err == READFILE_NOT_FILE)
         return fail(error, error_size, "%s: %s", path, "not a regular file");
-    if (err)
-        return fail(error, error_size, "%s: %s", path, strerror(err));
+    if (err) {
+        fail(error, error_size, "%s: %s", path, strerror(err));
+        return err;
+    }
     mapfile_yaml yaml;
     memset(&yaml, 0, sizeof yaml);
     int bad = mapfile_yaml_parse(&yaml, text, len, path);

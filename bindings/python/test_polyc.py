@@ -17,6 +17,8 @@ POLYC_WHEELS, a folder with setuptools and wheel wheels for an offline pip
 install (else pip goes online). numpy is optional: its tests skip without it.
 """
 import ctypes
+import errno
+import inspect
 import json
 import math
 import os
@@ -103,6 +105,49 @@ class Binding(unittest.TestCase):
         for name, cls in polyc._STRUCTS.items():
             self.assertEqual(polyc._lib.polyc_struct_size(name.encode()), ctypes.sizeof(cls), name)
         self.assertEqual(polyc._lib.polyc_struct_size(b"no_such_struct"), 0)
+
+    def test_version(self):
+        with open(os.path.join(REPO, "include", "polyc.h")) as f:
+            header = f.read()
+        want = ".".join(re.search(r"#define POLYC_VERSION_%s (\d+)" % part, header).group(1)
+                        for part in ("MAJOR", "MINOR", "PATCH"))
+        self.assertEqual(polyc.__version__, want)
+        self.assertEqual(polyc.__version__, "%d.%d.%d" % polyc.version())
+
+    def test_every_public_call_has_a_docstring(self):
+        names = [n for n in polyc.__all__ if callable(getattr(polyc, n))]
+        for cls in (polyc.Context, polyc.OnlineMap):
+            names += ["%s.%s" % (cls.__name__, n) for n in vars(cls) if not n.startswith("_")]
+        self.assertIn("Context.build_grid", names)
+        for name in names:
+            obj = polyc
+            for part in name.split("."):
+                obj = getattr(obj, part)
+            doc = inspect.getdoc(obj.fget if isinstance(obj, property) else obj)
+            self.assertTrue(doc and doc.strip(), "%s has no docstring" % name)
+
+    def test_the_readme_gives_the_real_signatures(self):
+        with open(os.path.join(HERE, "README.md")) as f:
+            text = f.read()
+        calls = {"build_map": polyc.build_map, "build_map_from_grid": polyc.build_map_from_grid,
+                 "grid_image": polyc.grid_image, "read_log": polyc.read_log,
+                 "read_map": polyc.read_map, "Context": polyc.Context,
+                 "OnlineMap": polyc.OnlineMap, "add_scan": polyc.OnlineMap.add_scan,
+                 "update": polyc.OnlineMap.update, "finish": polyc.OnlineMap.finish,
+                 "changes_since": polyc.OnlineMap.changes_since}
+        for name, fn in calls.items():
+            found = re.search(r"`%s\(([^`]+)\)`" % name, text)   # not a call `f()`
+            self.assertIsNotNone(found, "README: no `%s(...)`" % name)
+            documented = [p.split("=")[0] for p in re.split(r",\s*(?![^()]*\))",
+                                                             " ".join(found.group(1).split()))]
+            real = [("**" if p.kind == p.VAR_KEYWORD else "") + p.name
+                    for p in inspect.signature(fn).parameters.values() if p.name != "self"]
+            self.assertEqual(documented, real, "README's %s" % name)
+            for part in re.split(r",\s*(?![^()]*\))", " ".join(found.group(1).split())):
+                if "=" in part:
+                    key, value = part.split("=", 1)
+                    want = inspect.signature(fn).parameters[key].default
+                    self.assertEqual(eval(value, vars(polyc)), want, "README's %s" % part)
 
     def test_defaults_in_field_order(self):
         c = polyc.default_config()   # a field out of order would show a wrong value here
@@ -541,9 +586,42 @@ class Files(unittest.TestCase):
             self.assertEqual(tool.returncode, 1)
             self.assertEqual("polyc: " + str(e.exception), tool.stderr.strip())
             self.assertIn(path + ":2:", str(e.exception))
-            with self.assertRaises(ValueError) as e:
-                polyc.read_log(os.path.join(tmp, "missing.log"))
-            self.assertIn("No such file", str(e.exception))
+
+    def test_a_file_not_opened_is_an_os_error(self):
+        # as open() raises it: the same class, errno, text and filename
+        with tempfile.TemporaryDirectory() as tmp:
+            missing = os.path.join(tmp, "missing.log")
+            for read in (polyc.read_log, polyc.read_map):
+                for path in (missing, tmp, os.fsencode(missing)):
+                    with self.assertRaises(OSError) as want:
+                        open(path, "rb")
+                    with self.assertRaises(OSError) as e:
+                        read(path)
+                    self.assertIs(type(e.exception), type(want.exception))
+                    self.assertEqual(str(e.exception), str(want.exception))
+                    self.assertEqual(e.exception.filename, path)
+                with self.assertRaises(IsADirectoryError):
+                    read(tmp)
+            with self.assertRaises(FileNotFoundError) as e:
+                polyc.read_log("/nonexistent.log")
+            self.assertEqual(e.exception.errno, errno.ENOENT)
+
+    def test_a_path_with_a_nul_is_a_value_error(self):
+        # as open() refuses it, not the file before the NUL
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "room.scans")
+            write_plain(path, scene())
+            subprocess.run([TOOL, "grid", "-o", os.path.join(tmp, "room"), path], check=True,
+                           capture_output=True)
+            yaml = os.path.join(tmp, "room.yaml")
+            for read, good in ((polyc.read_log, path), (polyc.read_map, yaml)):
+                read(good)
+                for bad in (good + "\0", good + "\0.txt", os.fsencode(good) + b"\0"):
+                    with self.assertRaises(ValueError) as want:
+                        open(bad, "rb")
+                    with self.assertRaises(ValueError) as e:
+                        read(bad)
+                    self.assertEqual(str(e.exception), str(want.exception))
 
     def test_grid_image_is_what_polyc_grid_writes(self):
         image = polyc.grid_image(polyc.read_log(self.LOG))
@@ -760,6 +838,20 @@ class Calls(unittest.TestCase):
         self.assertGreater(seen["other"], 0)
         self.assertGreater(len(ctx.polylines()), 0)    # usable again afterwards
         self.assertEqual(polyc.STATUS[polyc.ERR_BUSY], "POLYC_ERR_BUSY")
+
+    def test_no_scans_is_refused_as_the_tool_refuses_it(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "empty.scans")
+            write_plain(path, [])
+            tool = subprocess.run([TOOL, path], capture_output=True, text=True)
+        self.assertEqual(tool.returncode, 1)
+        self.assertIn("no scans found", tool.stderr)
+        for call in (lambda: polyc.build_map([]), lambda: polyc.build_map(iter(())),
+                     lambda: polyc.build_map((), cell_m=0.05, progress=print),
+                     lambda: polyc.grid_image([])):
+            with self.assertRaises(ValueError) as e:
+                call()
+            self.assertIn("no scans found", str(e.exception))
 
     def test_one_large_scan_is_retried_as_the_tool_does(self):
         scan = big_scan(8000)

@@ -276,9 +276,9 @@ for _name, _cls in (("polyc_io_map", _Map), ("gridimage", _GridImage)) if _lib.h
     if _lib.polyc_io_struct_size(_name.encode()) != ctypes.sizeof(_cls):
         raise PolycError(ERR_CONFIG, "loading " + _library_path(),
                          "struct %s differs between the library and polyc" % _name)
-if _lib.has_io and _lib.polyc_io_version() != 1:
+if _lib.has_io and _lib.polyc_io_version() != 2:
     raise PolycError(ERR_CONFIG, "loading " + _library_path(),
-                     "its readers (polyc_io) are version %d, this binding wants 1"
+                     "its readers (polyc_io) are version %d, this binding wants 2"
                      % _lib.polyc_io_version())
 
 
@@ -472,6 +472,9 @@ def version():
     """(major, minor, patch) of the loaded library."""
     v = _lib.polyc_version()
     return (v // 10000, v // 100 % 100, v % 100)
+
+
+__version__ = "%d.%d.%d" % version()      # the library's: the package is built with it
 
 
 def default_config():
@@ -750,14 +753,24 @@ class Context(_Block):
         self._run(_lib.polyc_build, progress, "build")
 
     def build_grid(self):
+        """The hit/miss grid of the scans (or, for a grid added, the grid
+        kept as it is), again from the scans if it was built; drops the
+        contour and polylines. Runs no later stage."""
         with self._use("build grid"):
             self._check(_lib.polyc_build_grid(self._ctx), "build grid")
 
     def extract_contour(self):
+        """The contour cells of the grid (building the grid first if it is
+        not built), again if they were extracted; drops the polylines."""
         with self._use("extract contour"):
             self._check(_lib.polyc_extract_contour(self._ctx), "extract contour")
 
     def trace(self):
+        """The initial polylines, traced from the contour (from the beam
+        order for a context of one scan), running the earlier stages if
+        they have not run; the map starts over from them (polylines() gives
+        them, score() their BIC). A map that needs more vertices or data
+        points than the limits hold: PolycError POLYC_ERR_NOMEM."""
         with self._use("trace"):
             self._check(_lib.polyc_trace(self._ctx), "trace")
 
@@ -802,6 +815,9 @@ class Context(_Block):
                 _lib.polyc_io_grid_image_free(img)
 
     def stats(self):
+        """The fields of polyc_stats (a dict): scans, beams and hits in,
+        grid size, contour cells, the polylines and vertices traced and
+        now, iterations, bic, error_sq_m2, the block's bytes used."""
         with self._use("stats"):
             return self._get_stats()
 
@@ -965,10 +981,14 @@ class OnlineMap(_Block):
             return self._get_stats()
 
 
-def _scans_and_limits(cfg, scans):
+def _scans_and_limits(cfg, scans, what):
     """The scans as held ctypes records (with the buffers they point into)
-    and the limits polyc_limits_for_scans gives for them."""
+    and the limits polyc_limits_for_scans gives for them; no scans is a
+    ValueError, as the tool refuses a log without scans."""
     held = [_scan(s) for s in scans]
+    if not held:
+        raise ValueError("no scans found: %s was given none (the polyc tool refuses such a "
+                         "log too)" % what)
     _int_field("number of scans", len(held), _u32)
     arr = (_Scan * max(len(held), 1))(*[s for s, _ in held])
     lim = _Limits()
@@ -990,7 +1010,7 @@ def build_map(scans, memory_bytes=None, max_vertices=0, progress=None, **config)
     if progress is not None and not callable(progress):
         raise TypeError("progress must be callable or None, not %s" % type(progress).__name__)
     max_vertices = _int_field("max_vertices", max_vertices, _u32)
-    held, lim = _scans_and_limits(cfg, scans)
+    held, lim = _scans_and_limits(cfg, scans, "build_map")
     if max_vertices:
         lim.max_vertices = max_vertices
     for attempt in (0, 1):
@@ -1015,7 +1035,7 @@ def grid_image(scans, **config):
     """The scans' hit/miss grid as map_saver's image, as `polyc grid` makes
     it (limits from the scans, build_grid): a GridImage."""
     cfg = _config(config)
-    held, lim = _scans_and_limits(cfg, scans)
+    held, lim = _scans_and_limits(cfg, scans, "grid_image")
     ctx = Context((lim.max_scans, lim.max_beams, lim.max_grid_cells, lim.max_vertices,
                    lim.max_points), **config)
     for i, (s, _) in enumerate(held):
@@ -1059,18 +1079,39 @@ def _need_io(what):
                       "is the plain library" % (what, _library_path()))
 
 
+def _path(path):
+    """path (str, bytes or path-like) as the readers take it; a NUL in it is
+    a ValueError, as for open()."""
+    raw = os.fsencode(path)
+    if b"\0" in raw:
+        raise ValueError("embedded null byte")
+    return raw
+
+
+def _read_failed(status, path, error):
+    """The error of a reader: the file not opened is the OSError open()
+    raises (its errno, the path as given); anything else the tool's message
+    as a ValueError."""
+    if status > 0:
+        raise OSError(status, os.strerror(status), os.fspath(path))
+    raise ValueError(error.value.decode(errors="replace"))
+
+
 def read_log(path, max_range_m=None):
     """The scans of a laser log (CARMEN FLASER / ROBOTLASER1 or polyc's plain
     format), read by the polyc tool's reader with its rules (docs/formats.md;
     max_range_m as its --max-range). A list of Scan, ranges_m as array('f').
-    A bad log raises ValueError with the tool's message (FILE:LINE: what)."""
+    A bad log raises ValueError with the tool's message (FILE:LINE: what);
+    a file not opened the OSError open() raises (FileNotFoundError,
+    PermissionError, IsADirectoryError); a path with a NUL ValueError."""
     _need_io("read_log")
+    raw = _path(path)
     limit = 0.0 if max_range_m is None else _real_field("max_range_m", max_range_m)
     handle = ctypes.c_void_p()
     error = ctypes.create_string_buffer(1024)
-    if _lib.polyc_io_read_log(os.fsencode(path), limit, ctypes.byref(handle), error,
-                              len(error)) != 0:
-        raise ValueError(error.value.decode(errors="replace"))
+    status = _lib.polyc_io_read_log(raw, limit, ctypes.byref(handle), error, len(error))
+    if status != 0:
+        _read_failed(status, path, error)
     try:
         scans = []
         raw = _lib.polyc_io_log_scans(handle)
@@ -1090,12 +1131,16 @@ def read_map(path):
     """A ROS map_server map: the YAML at path and its image (PGM or PNG,
     next to it), converted to OccupancyGrid values as `polyc map.yaml` does (nav2's
     rules: mode, negate, the YAML's thresholds). A Map; a bad map raises
-    ValueError with the tool's message (FILE:LINE or FILE: byte N)."""
+    ValueError with the tool's message (FILE:LINE or FILE: byte N), an image
+    that is not there too; a YAML not opened the OSError open() raises; a
+    path with a NUL ValueError."""
     _need_io("read_map")
+    raw = _path(path)
     handle = ctypes.POINTER(_Map)()
     error = ctypes.create_string_buffer(1024)
-    if _lib.polyc_io_read_map(os.fsencode(path), ctypes.byref(handle), error, len(error)) != 0:
-        raise ValueError(error.value.decode(errors="replace"))
+    status = _lib.polyc_io_read_map(raw, ctypes.byref(handle), error, len(error))
+    if status != 0:
+        _read_failed(status, path, error)
     try:
         m = handle.contents
         g = m.grid
