@@ -36,9 +36,11 @@ block of polyc_online_memory_size() bytes; results are copied out.
 Errors: a failing library call raises PolycError with the status, its
 polyc_status_str() and polyc_last_error() (OnlineMap.changes_since's
 POLYC_ERR_RANGE: ResyncError, a PolycError); bad arguments raise TypeError or
-ValueError before the library sees them; an exception raised in a progress
-callback (KeyboardInterrupt too) stops the optimiser and is raised again by
-the call that ran it.
+ValueError before the library sees them (no scans at all for build_map:
+ValueError "no scans found"); read_log and read_map raise ValueError with
+the tool's message for a bad file and the OSError open() raises for a file
+not opened; an exception raised in a progress callback (KeyboardInterrupt
+too) stops the optimiser and is raised again by the call that ran it.
 Threads: each Context and OnlineMap holds a lock around every call into its
 block; a call from another thread waits for the running one, a call from
 inside the object's own progress callback raises PolycError POLYC_ERR_BUSY.
