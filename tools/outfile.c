@@ -22,6 +22,11 @@
 #define OUTFILE_REFUSED (-1)           /* locate: a symlink not to follow */
 #define OUTFILE_RULE "is a symlink in a sticky, world-writable folder that neither you nor the" \
                      " folder's owner owns: not followed (the kernel's fs.protected_symlinks rule)"
+#ifdef NSIG
+#define OUTFILE_NSIG NSIG              /* signals are 1 .. NSIG - 1 */
+#else
+#define OUTFILE_NSIG 65
+#endif
 #ifdef O_PATH
 #define OUTFILE_DIR_FLAGS (O_PATH | O_DIRECTORY | O_CLOEXEC)
 #else
@@ -79,11 +84,11 @@ void outfile_signals(void)
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = on_signal;
     sigemptyset(&caught);
-    for (int sig = 1; sig < 65; sig++)
+    for (int sig = 1; sig < OUTFILE_NSIG; sig++)
         if (ends_process(sig))
             sigaddset(&caught, sig);
     sa.sa_mask = caught;
-    for (int sig = 1; sig < 65; sig++) {
+    for (int sig = 1; sig < OUTFILE_NSIG; sig++) {
         if (!ends_process(sig))
             continue;
         /* one ignored (nohup's SIGHUP) or handled (a sanitizer's SIGSEGV)
