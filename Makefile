@@ -274,7 +274,7 @@ fuzz-merge: $(FUZZ_BIN)
 # assert() calls __assert_func, which pulls in fiprintf and all of stdio.
 CROSS  ?= arm-none-eabi-
 XBUILD ?= build-cross
-XFLAGS  = $(WARN) -mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard -Os -Werror \
+XFLAGS  = $(WARN) -mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard -Os -Werror -fno-math-errno \
           -ffunction-sections -fdata-sections -fstack-usage -fcallgraph-info=su \
           -DPOLYC_COUNTER_BITS=8 '-DPOLYC_ASSERT(x)=((x) ? (void)0 : __builtin_trap())' -Iinclude
 XOBJ    = $(LIB_SRC:src/%.c=$(XBUILD)/%.o)
@@ -284,6 +284,22 @@ X_STDIO = $(subst $(sp),|,.*printf.* .*scanf.* f?open fdopen freopen fclose frea
           fputc putc puts putchar fgets gets fgetc getc getchar ungetc fflush fseek ftell rewind \
           perror setvbuf setbuf tmpfile stdin stdout stderr __assert_func setlocale localeconv \
           strto(d|f|ld) atof)
+# Single precision by design (docs/architecture.md): the M4F's FPU has no
+# double, so a double operation is a library call of 30-100 instructions.
+# No object of the library may call software double routines, double libm,
+# newlib's float libm that computes in double (sinf, cosf, atan2f, logf,
+# expf, powf: src/fmath.c has the library's own), or libgcc's 64-bit float
+# conversions, which go through double; except the cold files of X_COLD:
+#   boundary  the API's double poses, origins and figures in and out (a few
+#             operations per scan, grid or result)
+#   config    configuration checks and sizing (polyc_limits_for_scans and
+#             its extent: a few per scan, before the library runs)
+X_COLD   = boundary config
+X_DOUBLE = __aeabi_d[a-z0-9]+|__aeabi_[fiul]+2d|__aeabi_d2[a-z]+|__[a-z]+df[23]|__extendsfdf2|\
+           __truncdfsf2|__fix(uns)?sfdi|__fix(uns)?dfsi|__float(un)?sidf|__float(un)?didf|__ieee754_[a-z0-9]+|\
+           sin|cos|tan|asin|acos|atan|atan2|sinh|cosh|tanh|exp|exp2|log|log2|log10|pow|sqrt|cbrt|\
+           hypot|floor|ceil|round|lround|trunc|rint|lrint|nearbyint|fmod|remainder|fmin|fmax|fabs|\
+           copysign|frexp|ldexp|modf|sinf|cosf|tanf|atan2f|atanf|expf|logf|powf
 XELF    = $(EMB_EXAMPLES:%=$(XBUILD)/%.elf)
 cross: $(XBUILD)/libpolyc.a $(XELF)
 	$(CROSS)size -t $(XOBJ)
@@ -295,6 +311,11 @@ cross: $(XBUILD)/libpolyc.a $(XELF)
 	  if [ -n "$$bad" ]; then echo "cross: FAIL: the linked $$e contains" $$bad; exit 1; fi; \
 	done
 	@echo "cross: no allocator and no stdio in the library or the linked examples"
+	@bad=0; for o in $(filter-out $(X_COLD:%=$(XBUILD)/%.o),$(XOBJ)); do \
+	  d=$$($(CROSS)nm -u $$o | awk '{print $$2}' | grep -Ex '$(subst $(sp),,$(X_DOUBLE))' | sort -u | tr '\n' ' '); \
+	  if [ -n "$$d" ]; then echo "cross: FAIL: $$o calls double arithmetic: $$d"; bad=1; fi; \
+	done; test $$bad = 0
+	@echo "cross: no double arithmetic outside $(X_COLD:%=src/%.c)"
 	@set -e; for x in $(EMB_EXAMPLES); do \
 	  python3 tools/eval/stack_usage.py --cross $(CROSS) --elf $(XBUILD)/$$x.elf \
 	    $(XOBJ:.o=.ci) $(XBUILD)/$$x.ci; done
@@ -350,11 +371,12 @@ target: $(EMB_EXAMPLES:%=$(TBUILD)/%.elf) $(EMB_EXAMPLES:%=$(BUILD)/%)
 	  $(BUILD)/$$x > $(TBUILD)/$$x.host; \
 	  python3 tools/target/check.py --room examples/embedded_room.h --name $$x \
 	    $(TBUILD)/$$x.out $(TBUILD)/$$x.host; done
+PROFILE_ARGS ?=
 target-profile: $(EMB_EXAMPLES:%=$(TBUILD)/%.profile.elf)
 	@set -e; for x in $(EMB_EXAMPLES); do \
 	  (cd $(TBUILD) && $(QEMU_RUN) $$x.profile.elf > $$x.profile.out 2>&1 && mv target-pcs.bin $$x.pcs); \
 	  python3 tools/target/profile.py --nm $(CROSS)nm --elf $(TBUILD)/$$x.profile.elf \
-	    --name $$x $(TBUILD)/$$x.pcs; done
+	    --name $$x $(PROFILE_ARGS) $(TBUILD)/$$x.pcs; done
 
 # Benchmark on the shared data (not in the repo): an optimised build in
 # build-bench/, then one table. `make bench DATA=dir BENCH_ARGS='--only intel'`

@@ -17,9 +17,9 @@ static float turn_of(float ax, float ay, float bx, float by, float cx, float cy)
 }
 
 /* 1 - p(turn at b) for the path a -> b -> c */
-double polyc__turn_cost(const polyc__opt *o, float ax, float ay, float bx, float by, float cx, float cy)
+float polyc__turn_cost(const polyc__opt *o, float ax, float ay, float bx, float by, float cx, float cy)
 {
-    return 1.0 - (double)polyc__prior_p(&o->prior, bx, by, turn_of(ax, ay, bx, by, cx, cy));
+    return 1.0f - (float)polyc__prior_p(&o->prior, bx, by, turn_of(ax, ay, bx, by, cx, cy));
 }
 
 /* The prior at the three vertices whose angles a move of v changes: its
@@ -40,23 +40,23 @@ static void places_init(const polyc__opt *o, int32_t v, angle_places *pl)
 }
 
 /* Angle terms of v's neighbourhood with v at (x, y). */
-static double local_angles(const polyc__opt *o, angle_places *pl, int32_t v, float x, float y)
+static float local_angles(const polyc__opt *o, angle_places *pl, int32_t v, float x, float y)
 {
     if (o->cfg->gamma <= 0.0f)
-        return 0.0;
+        return 0.0f;
     const polyc__vertex *V = o->s->v;
     int32_t p = V[v].prev, n = V[v].next;
-    double sum = 0.0;
+    float sum = 0.0f;
     if (p != POLYC__NONE && n != POLYC__NONE) {
         if (!polyc__prior_same_place(&o->prior, &pl->at, x, y))
             polyc__prior_at(&o->prior, x, y, &pl->at);
-        sum += 1.0 - (double)polyc__prior_p_at(&pl->at, turn_of(V[p].x, V[p].y, x, y, V[n].x, V[n].y));
+        sum += 1.0f - (float)polyc__prior_p_at(&pl->at, turn_of(V[p].x, V[p].y, x, y, V[n].x, V[n].y));
     }
     if (p != POLYC__NONE && V[p].prev != POLYC__NONE && V[p].prev != v)
-        sum += 1.0 - (double)polyc__prior_p_at(
+        sum += 1.0f - (float)polyc__prior_p_at(
                          &pl->prev, turn_of(V[V[p].prev].x, V[V[p].prev].y, V[p].x, V[p].y, x, y));
     if (n != POLYC__NONE && V[n].next != POLYC__NONE && V[n].next != v)
-        sum += 1.0 - (double)polyc__prior_p_at(
+        sum += 1.0f - (float)polyc__prior_p_at(
                          &pl->next, turn_of(x, y, V[n].x, V[n].y, V[V[n].next].x, V[V[n].next].y));
     return sum;
 }
@@ -93,7 +93,7 @@ static void commit_move(polyc__opt *o, int32_t v, float x, float y)
     int32_t nb[3] = {p, v, n};
     for (int k = 0; k < 3; k++)
         if (nb[k] != POLYC__NONE) {
-            o->angle -= o->acost[nb[k]];
+            polyc__ksum_add(&o->angle, -(o->acost[nb[k]]));
             o->v_touch[nb[k]] = o->touch_stamp;
         }
     if (p != POLYC__NONE)
@@ -115,16 +115,16 @@ static void commit_move(polyc__opt *o, int32_t v, float x, float y)
     id[1] = v;
     for (int32_t k = 0; k < o->ev.loc_n; k++) {
         int32_t i = o->ev.loc_pt[k];
-        double c = o->ev.loc_base[k];
+        float c = o->ev.loc_base[k];
         int32_t sg = o->ev.loc_seg[k];
         for (int j = 0; j < ns; j++) {
-            double cj = polyc__cost(&o->d.pts[i], xy[4 * j], xy[4 * j + 1], xy[4 * j + 2], xy[4 * j + 3]);
+            float cj = polyc__cost(&o->d.pts[i], xy[4 * j], xy[4 * j + 1], xy[4 * j + 2], xy[4 * j + 3]);
             if (cj < c) {
                 c = cj;
                 sg = id[j];
             }
         }
-        o->err += c - o->d.pt_cost[i];
+        polyc__ksum_add(&o->err, c - o->d.pt_cost[i]);
         o->d.pt_cost[i] = c;
         polyc__split_due_pt(o, o->d.pt_seg[i], sg);
         o->d.pt_seg[i] = sg;
@@ -133,8 +133,8 @@ static void commit_move(polyc__opt *o, int32_t v, float x, float y)
     for (int j = 0; j < ns; j++)
         for (int32_t k = 0; k < o->ev.agg_n[j]; k++) {
             int32_t i = o->ev.agg_pt[j == 0 ? k : o->ev.agg_cap - 1 - k];
-            double c = polyc__cost(&o->d.pts[i], xy[4 * j], xy[4 * j + 1], xy[4 * j + 2], xy[4 * j + 3]);
-            o->err += c - o->d.pt_cost[i];
+            float c = polyc__cost(&o->d.pts[i], xy[4 * j], xy[4 * j + 1], xy[4 * j + 2], xy[4 * j + 3]);
+            polyc__ksum_add(&o->err, c - o->d.pt_cost[i]);
             o->d.pt_cost[i] = c;
             polyc__split_due_pt(o, o->d.pt_seg[i], id[j]);
             o->d.pt_seg[i] = id[j];
@@ -142,7 +142,7 @@ static void commit_move(polyc__opt *o, int32_t v, float x, float y)
     for (int k = 0; k < 3; k++)
         if (nb[k] != POLYC__NONE) {
             o->acost[nb[k]] = polyc__vertex_angle_cost(o, nb[k]);
-            o->angle += o->acost[nb[k]];
+            polyc__ksum_add(&o->angle, o->acost[nb[k]]);
         }
 }
 
@@ -165,12 +165,12 @@ int polyc__hill_climb(polyc__opt *o, int32_t v)
     angle_places pl;
     if (gamma > 0.0f)
         places_init(o, v, &pl);
-    double cur = polyc__local_current(o) + (double)gamma * local_angles(o, &pl, v, x, y);
+    float cur = polyc__local_current(o) + (float)gamma * local_angles(o, &pl, v, x, y);
     int moved = 0, last = -1;
     int optimum = 0, cut = 0; /* no better trial in the last round; some trial was beyond reach */
     for (int it = 0; it < POLYC__CLIMB_STEPS; it++) {
         cut = 0;
-        double best = cur;
+        float best = cur;
         int best_d = -1;
         /* the direction that paid last time first: if it pays again, take
          * it without trying the other seven */
@@ -185,8 +185,8 @@ int polyc__hill_climb(polyc__opt *o, int32_t v)
                 continue;
             }
             ns = segs_at(o, v, cx, cy, xy);
-            double e = polyc__local_eval(o, xy, ns) + (double)gamma * local_angles(o, &pl, v, cx, cy);
-            if (e < best - 1e-12 * (1.0 + fabs(best))) {
+            float e = polyc__local_eval(o, xy, ns) + (float)gamma * local_angles(o, &pl, v, cx, cy);
+            if (e < best - 1e-12f * (1.0f + fabsf(best))) {
                 best = e;
                 best_d = d;
                 if (k == 0)
@@ -266,7 +266,7 @@ int polyc__op_adjust(polyc__opt *o, int max_rounds, uint32_t since)
 
 /* Gaussian noise of std-dev sigma on every vertex; the caller rescores
  * from scratch (polyc__rebuild) before anything else. */
-void polyc__op_noise(polyc__opt *o, double sigma_m)
+void polyc__op_noise(polyc__opt *o, float sigma_m)
 {
     polyc__store *s = o->s;
     for (int32_t v = 0; v < s->v_high; v++) {

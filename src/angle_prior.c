@@ -209,8 +209,8 @@ static void lay_out(const polyc_ctx *ctx, polyc__prior *p, uint64_t cap)
     p->h = (int32_t)((ty + k - 1) / k);
     p->cell_m = g->cell_m * (float)POLYC__TILE_SIDE * (float)k;
     p->inv_cell = 1.0f / p->cell_m;
-    p->origin_x = g->origin_x_m - ctx->frame_x;
-    p->origin_y = g->origin_y_m - ctx->frame_y;
+    p->origin_x = g->frame_ox;
+    p->origin_y = g->frame_oy;
 }
 
 /* per row, the sum of its counts */

@@ -68,7 +68,7 @@ polyc_status polyc__place_ctx(void *block, size_t size, size_t need, size_t head
     ctx->cfg = *config;
     ctx->arena.base = (unsigned char *)p + head;
     ctx->arena.size = size - skew - head;
-    ctx->frame_dir.cos = 1.0;
+    ctx->frame_dir.cos = 1.0f;
     ctx->stats.memory_size_bytes = size;
     ctx->err.scan = -1;
     *out = ctx;
@@ -110,8 +110,8 @@ polyc_status polyc_reset(polyc_ctx *ctx)
     ctx->have_frame = ctx->ext.have = 0;
     ctx->from_grid = 0;
     ctx->frame_x = ctx->frame_y = 0.0;
-    ctx->frame_dir.cos = 1.0;
-    ctx->frame_dir.sin = 0.0;
+    ctx->frame_dir.cos = 1.0f;
+    ctx->frame_dir.sin = 0.0f;
     memset(&ctx->grid, 0, sizeof ctx->grid);
     ctx->contour_count = 0;
     ctx->stage = POLYC__STAGE_SCANS;
@@ -161,15 +161,10 @@ polyc_status polyc_add_scan(polyc_ctx *ctx, const polyc_scan *s)
     if (ctx->scan_count >= ctx->lim.max_scans ||
         s->beam_count > ctx->lim.max_beams - ctx->range_count)
         return polyc__fail(ctx, POLYC_ERR_LIMIT, "more scans or beams than the limits allow");
-    if (!ctx->have_frame) {
-        ctx->frame_x = s->pose_x_m;
-        ctx->frame_y = s->pose_y_m;
-        ctx->have_frame = 1;
-    }
+    if (!ctx->have_frame)
+        polyc__frame_set(ctx, s->pose_x_m, s->pose_y_m);
     polyc__scan *d = &ctx->scans[ctx->scan_count];
-    d->x_m = (float)(s->pose_x_m - ctx->frame_x);
-    d->y_m = (float)(s->pose_y_m - ctx->frame_y);
-    d->theta_rad = (float)remainder(s->pose_theta_rad, 6.283185307179586);
+    polyc__frame_scan(ctx, s, d);
     d->start_rad = s->start_angle_rad;
     d->step_rad = s->angle_step_rad;
     d->min_m = s->min_range_m;
@@ -258,15 +253,7 @@ static polyc_status stage_contour(polyc_ctx *ctx)
 void polyc__export_result(polyc_ctx *ctx)
 {
     polyc__flat_from_store(&ctx->flat, &ctx->store);
-    for (uint32_t i = 0; ctx->from_grid && i < ctx->flat.points; i++) {
-        double x = (double)ctx->flat.xy[2 * i], y = (double)ctx->flat.xy[2 * i + 1];
-        ctx->flat.xy[2 * i] = (float)(ctx->frame_x + ctx->frame_dir.cos * x - ctx->frame_dir.sin * y);
-        ctx->flat.xy[2 * i + 1] = (float)(ctx->frame_y + ctx->frame_dir.sin * x + ctx->frame_dir.cos * y);
-    }
-    for (uint32_t i = 0; !ctx->from_grid && i < ctx->flat.points; i++) {
-        ctx->flat.xy[2 * i] = (float)((double)ctx->flat.xy[2 * i] + ctx->frame_x);
-        ctx->flat.xy[2 * i + 1] = (float)((double)ctx->flat.xy[2 * i + 1] + ctx->frame_y);
-    }
+    polyc__frame_export(ctx);
     ctx->stats.polylines = ctx->flat.count;
     ctx->stats.vertices = ctx->flat.points;
 }

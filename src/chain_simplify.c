@@ -46,18 +46,18 @@ void polyc__chain_simplify(chains *c, int32_t a, int32_t b)
  * sum of their squared distances to it is the scatter's smaller eigenvalue,
  * from one pass of sums taken about the first hit. */
 typedef struct span_fit {
-    double x0, y0, n, sx, sy, xx, xy, yy; /* xx, xy, yy: central */
+    float x0, y0, n, sx, sy, xx, xy, yy; /* xx, xy, yy: central */
 } span_fit;
 
-static double span_error(const chains *c, int32_t i, int32_t j, span_fit *f)
+static float span_error(const chains *c, int32_t i, int32_t j, span_fit *f)
 {
-    f->x0 = (double)c->xy[2 * i];
-    f->y0 = (double)c->xy[2 * i + 1];
-    double n = 0.0, sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0, syy = 0.0;
+    f->x0 = (float)c->xy[2 * i];
+    f->y0 = (float)c->xy[2 * i + 1];
+    float n = 0.0f, sx = 0.0f, sy = 0.0f, sxx = 0.0f, sxy = 0.0f, syy = 0.0f;
     for (int32_t k = i; k <= j; k++)
         if (polyc__chain_member(c, k)) {
-            double x = (double)c->xy[2 * k] - f->x0, y = (double)c->xy[2 * k + 1] - f->y0;
-            n += 1.0;
+            float x = (float)c->xy[2 * k] - f->x0, y = (float)c->xy[2 * k + 1] - f->y0;
+            n += 1.0f;
             sx += x;
             sy += y;
             sxx += x * x;
@@ -70,25 +70,25 @@ static double span_error(const chains *c, int32_t i, int32_t j, span_fit *f)
     f->xx = sxx - sx * sx / n;
     f->xy = sxy - sx * sy / n;
     f->yy = syy - sy * sy / n;
-    double half = 0.5 * (f->xx - f->yy), r = sqrt(half * half + f->xy * f->xy);
-    double e = 0.5 * (f->xx + f->yy) - r;
-    return e > 0.0 ? e : 0.0;
+    float half = 0.5f * (f->xx - f->yy), r = sqrtf(half * half + f->xy * f->xy);
+    float e = 0.5f * (f->xx + f->yy) - r;
+    return e > 0.0f ? e : 0.0f;
 }
 
 /* The largest distance of a hit of beams [i, j] to their fitted line f
  * along its own beam, squared: a segment on that line stands that far in
  * front of or behind the return (at most 20 times its distance across). */
-static double along_worst2(const chains *c, int32_t i, int32_t j, const span_fit *f)
+static float along_worst2(const chains *c, int32_t i, int32_t j, const span_fit *f)
 {
-    double a = 0.5 * atan2(2.0 * f->xy, f->xx - f->yy), nx = -sin(a), ny = cos(a);
-    double cx = f->x0 + f->sx / f->n, cy = f->y0 + f->sy / f->n, worst = 0.0;
+    float a = 0.5f * polyc__atan2f(2.0f * f->xy, f->xx - f->yy), nx = -polyc__sinf(a), ny = polyc__cosf(a);
+    float cx = f->x0 + f->sx / f->n, cy = f->y0 + f->sy / f->n, worst = 0.0f;
     for (int32_t k = i; k <= j; k++)
         if (polyc__chain_member(c, k)) {
-            double x = (double)c->xy[2 * k], y = (double)c->xy[2 * k + 1];
-            double d = (x - cx) * nx + (y - cy) * ny;
-            double bx = x - (double)c->ox, by = y - (double)c->oy, b2 = bx * bx + by * by;
-            double cosb = bx * nx + by * ny; /* times the range */
-            double e = d * d * b2 / (cosb * cosb > 0.0025 * b2 ? cosb * cosb : 0.0025 * b2);
+            float x = (float)c->xy[2 * k], y = (float)c->xy[2 * k + 1];
+            float d = (x - cx) * nx + (y - cy) * ny;
+            float bx = x - (float)c->ox, by = y - (float)c->oy, b2 = bx * bx + by * by;
+            float cosb = bx * nx + by * ny; /* times the range */
+            float e = d * d * b2 / (cosb * cosb > 0.0025f * b2 ? cosb * cosb : 0.0025f * b2);
             worst = e > worst ? e : worst;
         }
     return worst;
@@ -117,11 +117,11 @@ static int32_t kept_before(const chains *c, int32_t j)
 static float drop_cost(const chains *c, int32_t i, int32_t j, int32_t k)
 {
     span_fit merged, part;
-    double gain = span_error(c, i, k, &merged) - span_error(c, i, j, &part) -
+    float gain = span_error(c, i, k, &merged) - span_error(c, i, j, &part) -
                   span_error(c, j, k, &part);
-    gain = (double)c->alpha * gain - (double)c->log_n;
-    double limit = POLYC__RAY_TOLERANCE_M;
-    if (gain < 0.0 && along_worst2(c, i, k, &merged) > limit * limit)
+    gain = (float)c->alpha * gain - (float)c->log_n;
+    float limit = POLYC__RAY_TOLERANCE_M;
+    if (gain < 0.0f && along_worst2(c, i, k, &merged) > limit * limit)
         return INFINITY;
     return (float)gain;
 }

@@ -65,8 +65,8 @@ void polyc__chg_dirty(polyc__opt *o, int32_t v)
     if (o->chg.v_dirty[v] == o->chg.epoch || o->chg.dirty_n >= o->chg.dirty_cap)
         return;
     o->chg.v_dirty[v] = o->chg.epoch;
-    o->angle -= o->acost[v];
-    o->acost[v] = 0.0;
+    polyc__ksum_add(&o->angle, -(o->acost[v]));
+    o->acost[v] = 0.0f;
     o->chg.dirty_list[o->chg.dirty_n++] = v;
 }
 
@@ -101,7 +101,7 @@ void polyc__chg_commit(polyc__opt *o)
     for (int32_t k = 0; k < o->chg.bucket_n; k++) {
         int32_t b = o->chg.bucket_list[k];
         for (uint32_t i = h->pt_start[b]; i < h->pt_start[b + 1]; i++) {
-            double old = o->d.pt_cost[i], c;
+            float old = o->d.pt_cost[i], c;
             int32_t seg = o->d.pt_seg[i];
             if (o->chg.added_overflow || (seg != POLYC__NONE && o->chg.seg_dead[seg] == o->chg.epoch)) {
                 c = polyc__nearest(o, (int32_t)i, NULL, 0, &seg);
@@ -111,7 +111,7 @@ void polyc__chg_commit(polyc__opt *o)
                     int32_t sg = o->chg.added[a];
                     if (!o->seg_in[sg])
                         continue;
-                    double ca = polyc__cost_seg(o, &o->d.pts[i], sg);
+                    float ca = polyc__cost_seg(o, &o->d.pts[i], sg);
                     if (ca < c) {
                         c = ca;
                         seg = sg;
@@ -121,7 +121,7 @@ void polyc__chg_commit(polyc__opt *o)
             o->d.pt_cost[i] = c;
             polyc__split_due_pt(o, o->d.pt_seg[i], seg);
             o->d.pt_seg[i] = seg;
-            o->err += c - old;
+            polyc__ksum_add(&o->err, c - old);
         }
     }
     for (int32_t k = 0; k < o->chg.dirty_n; k++) {
@@ -129,7 +129,7 @@ void polyc__chg_commit(polyc__opt *o)
         if (o->s->v[v].line == POLYC__NONE)
             continue;
         o->acost[v] = polyc__vertex_angle_cost(o, v);
-        o->angle += o->acost[v];
+        polyc__ksum_add(&o->angle, o->acost[v]);
     }
     o->chg.bucket_n = o->chg.added_n = o->chg.dirty_n = 0;
 }

@@ -165,7 +165,7 @@ const char *polyc__check_books(const polyc__opt *o, int32_t *at)
         }
     }
     *at = -1;
-    if (!close_rel(o->err, err, 1e-9))
+    if (!close_rel((double)polyc__err(o), err, 1e-5))
         return "books: the error differs from its sum from scratch";
     for (int32_t v = 0; v < o->s->v_high; v++) {
         if (o->s->v[v].line == POLYC__NONE)
@@ -177,7 +177,7 @@ const char *polyc__check_books(const polyc__opt *o, int32_t *at)
             return "books: a vertex's angle cost differs from scratch";
     }
     *at = -1;
-    if (!close_rel(o->angle, angle, 1e-9))
+    if (!close_rel((double)polyc__ksum_get(&o->angle), angle, 1e-5))
         return "books: the angle term differs from its sum from scratch";
     return NULL;
 }

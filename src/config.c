@@ -125,25 +125,42 @@ int polyc__pose_ok(double x, double y, double th)
 }
 
 /* Extent rule: the poses and every reflected endpoint. Free-space beams do
- * not widen it (they are clipped to it). ox, oy shift the frame. */
+ * not widen it (they are clipped to it). ox, oy shift the frame.
+ * The endpoints' offsets from the pose are found in float (ranges are
+ * small numbers; a double per beam is a software call on the target), the
+ * box in double once per scan (poses may be far from the origin). */
 void polyc__extent_add(const polyc_scan *s, double ox, double oy, double *box, int *have)
 {
     double px = s->pose_x_m - ox, py = s->pose_y_m - oy;
-#define EXT(X, Y) do { \
-        if (!*have) { box[0] = box[2] = (X); box[1] = box[3] = (Y); *have = 1; } \
-        else { box[0] = fmin(box[0], X); box[1] = fmin(box[1], Y); \
-               box[2] = fmax(box[2], X); box[3] = fmax(box[3], Y); } } while (0)
-    EXT(px, py);
-    if (!s->range_m)
-        return;
-    for (uint32_t i = 0; i < s->beam_count; i++) {
+    float off[4] = {0.0f, 0.0f, 0.0f, 0.0f}; /* min x, min y, max x, max y */
+    float theta = polyc__heading(s->pose_theta_rad);
+    for (uint32_t i = 0; s->range_m && i < s->beam_count; i++) {
         float r = s->range_m[i];
         if (!(r >= s->min_range_m && r < s->max_range_m))
             continue;
-        double a = s->pose_theta_rad + (double)s->start_angle_rad + (double)i * (double)s->angle_step_rad;
-        EXT(px + (double)r * cos(a), py + (double)r * sin(a));
+        float a = theta + s->start_angle_rad + (float)i * s->angle_step_rad;
+        float sn, cs;
+        polyc__sincosf(a, &sn, &cs);
+        float x = r * cs, y = r * sn;
+        off[0] = x < off[0] ? x : off[0];
+        off[1] = y < off[1] ? y : off[1];
+        off[2] = x > off[2] ? x : off[2];
+        off[3] = y > off[3] ? y : off[3];
     }
-#undef EXT
+    double lo_x = px + (double)off[0], lo_y = py + (double)off[1];
+    double hi_x = px + (double)off[2], hi_y = py + (double)off[3];
+    if (!*have) {
+        box[0] = lo_x;
+        box[1] = lo_y;
+        box[2] = hi_x;
+        box[3] = hi_y;
+        *have = 1;
+        return;
+    }
+    box[0] = fmin(box[0], lo_x);
+    box[1] = fmin(box[1], lo_y);
+    box[2] = fmax(box[2], hi_x);
+    box[3] = fmax(box[3], hi_y);
 }
 
 void polyc_scan_extent(const polyc_config *config, const polyc_scan *scan, polyc_box *box)
@@ -179,15 +196,17 @@ polyc_status polyc_limits_for_scans(const polyc_config *config, const polyc_scan
     out->max_scans = scan_count;
     out->max_beams = (uint32_t)beams;
     if (box.min_x_m <= box.max_x_m) {
-        double cell = (double)config->cell_m, ext = (double)config->max_extent_m;
-        double pad = 4.0 * cell;
-        double w = box.max_x_m - box.min_x_m + pad, h = box.max_y_m - box.min_y_m + pad;
+        /* in float once the spans are known (the grid lays itself out in
+         * float too, with 4 cells less of padding than allowed here) */
+        float cell = config->cell_m, ext = config->max_extent_m;
+        float pad = 4.0f * cell;
+        float w = (float)(box.max_x_m - box.min_x_m) + pad, h = (float)(box.max_y_m - box.min_y_m) + pad;
         if (w > ext || h > ext)
             return POLYC_ERR_EXTENT;
-        double tx = ceil(ceil(w / cell + 1.0) / POLYC__TILE_SIDE);
-        double ty = ceil(ceil(h / cell + 1.0) / POLYC__TILE_SIDE);
-        double cells = tx * ty * POLYC__TILE_CELLS;
-        if (cells > 4294967295.0)
+        float tx = ceilf(ceilf(w / cell + 1.0f) / POLYC__TILE_SIDE);
+        float ty = ceilf(ceilf(h / cell + 1.0f) / POLYC__TILE_SIDE);
+        float cells = tx * ty * POLYC__TILE_CELLS;
+        if (cells > 4294967040.0f) /* (the largest float below 2^32) */
             return POLYC_ERR_EXTENT;
         out->max_grid_cells = (uint32_t)cells;
     }

@@ -25,7 +25,7 @@ typedef struct polyc__error {
 
 /* a direction, as its cosine and sine */
 typedef struct polyc__turn {
-    double cos, sin;
+    float cos, sin;
 } polyc__turn;
 
 /* a box, with whether it holds anything yet */

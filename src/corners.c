@@ -50,9 +50,9 @@ static int try_corner(polyc__opt *o, int32_t b, int32_t c, int k)
         old[n_old++] = v;
     float xy[8] = {V[a].x, V[a].y, x, y, x, y, V[d].x, V[d].y};
     polyc__local_prepare(o, old, n_old, xy, 2, 0.0f);
-    double derr = polyc__local_eval(o, xy, 2) - polyc__local_current(o);
-    double gamma = (double)o->cfg->gamma, dangle = 0.0;
-    if (gamma > 0.0) {
+    float derr = polyc__local_eval(o, xy, 2) - polyc__local_current(o);
+    float gamma = (float)o->cfg->gamma, dangle = 0.0f;
+    if (gamma > 0.0f) {
         for (int32_t v = a; v != V[d].next && v != POLYC__NONE; v = V[v].next)
             dangle -= o->acost[v];
         int32_t pa = V[a].prev, nd = V[d].next;
@@ -62,8 +62,8 @@ static int try_corner(polyc__opt *o, int32_t b, int32_t c, int k)
         if (nd != POLYC__NONE && nd != a)
             dangle += polyc__turn_cost(o, x, y, V[d].x, V[d].y, V[nd].x, V[nd].y);
     }
-    double dbic = (double)o->cfg->alpha * (derr + gamma * dangle) - (double)k * o->d.log_n;
-    if (dbic >= 0.0)
+    float dbic = (float)o->cfg->alpha * (derr + gamma * dangle) - (float)k * o->d.log_n;
+    if (dbic >= 0.0f)
         return 0;
     float old_xy[4 * POLYC__EDIT_SEGS];
     int n_xy = polyc__edit_segments(o, old, n_old, old_xy);

@@ -9,37 +9,37 @@
 
 /* Sum of squared distances of a weighted point's endpoints to segment a-b,
  * all of them taken to fall in the region (interior or end) of their mean. */
-inline double polyc__cost(const polyc__point *p, float ax, float ay, float bx, float by)
+inline float polyc__cost(const polyc__point *p, float ax, float ay, float bx, float by)
 {
-    double dx = (double)bx - (double)ax, dy = (double)by - (double)ay;
-    double mx = (double)p->x - (double)ax, my = (double)p->y - (double)ay;
-    double l2 = dx * dx + dy * dy;
-    double trace = (double)p->cxx + (double)p->cyy;
-    double t = l2 > 1e-18 ? (mx * dx + my * dy) / l2 : 0.0;
-    if (t <= 0.0)
-        return (double)p->w * (mx * mx + my * my) + trace;
-    if (t >= 1.0) {
-        double ex = (double)p->x - (double)bx, ey = (double)p->y - (double)by;
-        return (double)p->w * (ex * ex + ey * ey) + trace;
+    float dx = (float)bx - (float)ax, dy = (float)by - (float)ay;
+    float mx = (float)p->x - (float)ax, my = (float)p->y - (float)ay;
+    float l2 = dx * dx + dy * dy;
+    float trace = (float)p->cxx + (float)p->cyy;
+    float t = l2 > 1e-18f ? (mx * dx + my * dy) / l2 : 0.0f;
+    if (t <= 0.0f)
+        return (float)p->w * (mx * mx + my * my) + trace;
+    if (t >= 1.0f) {
+        float ex = (float)p->x - (float)bx, ey = (float)p->y - (float)by;
+        return (float)p->w * (ex * ex + ey * ey) + trace;
     }
     /* w (n.m)^2 + n'Cn with n = (-dy, dx) / |d|: one division, no root.
      * C, central moments summed in float, can be a rounding error short of
      * positive semi-definite (cxy^2 > cxx cyy): n'Cn then dips below 0 for
      * a point whose endpoints lie on a line, and a map's error could be
      * -1e-12 (found by fuzz_library). A sum of squares is never negative. */
-    double cross = dx * my - dy * mx;
-    double c = ((double)p->w * cross * cross + dy * dy * (double)p->cxx -
-                2.0 * dx * dy * (double)p->cxy + dx * dx * (double)p->cyy) / l2;
-    return c > 0.0 ? c : 0.0;
+    float cross = dx * my - dy * mx;
+    float c = ((float)p->w * cross * cross + dy * dy * (float)p->cxx -
+                2.0f * dx * dy * (float)p->cxy + dx * dx * (float)p->cyy) / l2;
+    return c > 0.0f ? c : 0.0f;
 }
 
 /* a point's cost when no segment is within the search radius: w R^2 */
-inline double polyc__point_cap(const polyc__opt *o, const polyc__point *p)
+inline float polyc__point_cap(const polyc__opt *o, const polyc__point *p)
 {
-    return (double)p->w * (double)o->R2;
+    return (float)p->w * (float)o->R2;
 }
 
-inline double polyc__cost_seg(const polyc__opt *o, const polyc__point *p, int32_t seg)
+inline float polyc__cost_seg(const polyc__opt *o, const polyc__point *p, int32_t seg)
 {
     const polyc__vertex *a = &o->s->v[seg];
     const polyc__vertex *b = &o->s->v[a->next];

@@ -5,12 +5,14 @@
  * ranks removal candidates by it). */
 #include "trial.h"
 
+#include <float.h>
+
 /* ---- bounded change of the error (removal candidates) ---- */
 
 /* Max-heap on loc_base (the most a pending point can add) over loc_pt. */
 static void pend_sift(polyc__opt *o, int32_t i, int32_t n)
 {
-    double key = o->ev.loc_base[i];
+    float key = o->ev.loc_base[i];
     int32_t pt = o->ev.loc_pt[i];
     for (;;) {
         int32_t c = 2 * i + 1;
@@ -36,8 +38,8 @@ static void pend_sift(polyc__opt *o, int32_t i, int32_t n)
  * queried largest possible loss first, and the queries stop as soon as the
  * sure losses reach the limit. Most vertices worth keeping are settled by
  * the few points at their corner. */
-double polyc__local_delta(polyc__opt *o, const int32_t *old, int n_old, const float *seg_xy,
-                          int n_new, double limit)
+float polyc__local_delta(polyc__opt *o, const int32_t *old, int n_old, const float *seg_xy,
+                          int n_new, float limit)
 {
     const polyc__hash *h = &o->h;
     const polyc__old_set olds = polyc__old_set_of(old, n_old);
@@ -54,16 +56,16 @@ double polyc__local_delta(polyc__opt *o, const int32_t *old, int n_old, const fl
         const float *s = seg_xy + 4 * k;
         polyc__segment_region(o, s[0], s[1], s[2], s[3]);
     }
-    double sure = 0.0; /* exact part so far; pending points add >= 0 each */
+    float sure = 0.0f; /* exact part so far; pending points add >= 0 each */
     int32_t n = 0;
     o->ev.lsoa_n = -1; /* loc_pt and loc_base are a heap here */
     for (int32_t k = 0; k < o->chg.bucket_n; k++) {
         int32_t b = o->chg.bucket_list[k];
         for (uint32_t i = h->pt_start[b]; i < h->pt_start[b + 1]; i++) {
             const polyc__point *p = &o->d.pts[i];
-            double cur = o->d.pt_cost[i], c = 1e300;
+            float cur = o->d.pt_cost[i], c = FLT_MAX;
             for (int j = 0; j < n_new; j++) {
-                double cj = polyc__seg_pre_cost(&q[j], p);
+                float cj = polyc__seg_pre_cost(&q[j], p);
                 if (cj < c)
                     c = cj;
             }
@@ -75,7 +77,7 @@ double polyc__local_delta(polyc__opt *o, const int32_t *old, int n_old, const fl
                 sure += (c < cur ? c : cur) - cur;
                 continue;
             }
-            double cap = polyc__point_cap(o, p);
+            float cap = polyc__point_cap(o, p);
             o->ev.loc_pt[n] = (int32_t)i;
             o->ev.loc_base[n] = (c < cap ? c : cap) - cur;
             n++;
@@ -86,7 +88,7 @@ double polyc__local_delta(polyc__opt *o, const int32_t *old, int n_old, const fl
         pend_sift(o, i, n);
     while (n > 0 && sure < limit) {
         int32_t i = o->ev.loc_pt[0];
-        double most = o->ev.loc_base[0];
+        float most = o->ev.loc_base[0];
         /* only a segment cheaper than the new one matters: a query within
          * that cost (usually the point's own bucket) */
         sure += polyc__nearest_below(o, i, old, n_old, most + o->d.pt_cost[i], NULL) - o->d.pt_cost[i];

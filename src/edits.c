@@ -94,7 +94,7 @@ int32_t polyc__op_insert_after(polyc__opt *o, int32_t u, float x, float y)
     /* a fresh slot holds no angle; a slot freed and reused within this same
      * change was already taken out of the angle sum when it was freed */
     if (o->chg.v_dirty[v] != o->chg.epoch)
-        o->acost[v] = 0.0;
+        o->acost[v] = 0.0f;
     o->seg_in[v] = 0;
     polyc__chg_dirty(o, v);
     polyc__chg_seg_in(o, u);

@@ -115,8 +115,8 @@ static float incidence_sin(const polyc_ctx *ctx, const polyc__scan *s, uint32_t 
         return 1.0f;
     step_rot own;
     if (!rot) {
-        own.cs = cosf(s->step_rad);
-        own.sn = sinf(s->step_rad);
+        own.cs = polyc__cosf(s->step_rad);
+        own.sn = polyc__sinf(s->step_rad);
         rot = &own;
     }
     float cs = rot->cs, sn = rot->sn;
@@ -143,9 +143,10 @@ static int beam_fill(const polyc_ctx *ctx, const polyc__scan *s, uint32_t i, pol
     if (!(r == r) || r < 0.0f)
         return 0; /* NaN or negative: skipped (counted at add time) */
     float a = s->theta_rad + s->start_rad + (float)i * s->step_rad;
-    float dx = cosf(a), dy = sinf(a);
-    float ox = (float)((double)s->x_m - (g->origin_x_m - ctx->frame_x));
-    float oy = (float)((double)s->y_m - (g->origin_y_m - ctx->frame_y));
+    float dx, dy;
+    polyc__sincosf(a, &dy, &dx);
+    float ox = s->x_m - g->frame_ox;
+    float oy = s->y_m - g->frame_oy;
     b->sx = ox * g->inv_cell;
     b->sy = oy * g->inv_cell;
     float len_m;
@@ -438,18 +439,17 @@ static inline void count_beam(const count_pass *p, const polyc__beam *b, int tak
 /* The grid's cells over w_m x h_m metres from the frame-relative corner
  * (x0, y0), its directory, wanted bits and spill tile; the tiles follow in
  * the block as beams reach them. */
-static polyc_status grid_lay_out(polyc_ctx *ctx, double x0, double y0, double w_m, double h_m,
+static polyc_status grid_lay_out(polyc_ctx *ctx, float x0, float y0, float w_m, float h_m,
                                  uint32_t tile_cap)
 {
     polyc__grid *g = &ctx->grid;
     float cell = ctx->cfg.cell_m;
-    double cell_d = (double)cell;
+    float cell_d = (float)cell;
     g->cell_m = cell;
     g->inv_cell = 1.0f / cell;
-    g->origin_x_m = ctx->frame_x + x0;
-    g->origin_y_m = ctx->frame_y + y0;
-    double wc = ceil(w_m / cell_d), hc = ceil(h_m / cell_d);
-    if (wc > 2147483000.0 || hc > 2147483000.0)
+    polyc__frame_grid_origin(ctx, g, x0, y0);
+    float wc = ceilf(w_m / cell_d), hc = ceilf(h_m / cell_d);
+    if (wc > 2147483000.0f || hc > 2147483000.0f)
         return polyc__fail(ctx, POLYC_ERR_EXTENT, "grid too large for 32-bit cell indices");
     g->width = (int32_t)wc;
     g->height = (int32_t)hc;
@@ -503,7 +503,7 @@ static polyc_status count_scan(polyc_ctx *ctx, const polyc__scan *s, int take_ba
     p.wanted = g->wanted;
     p.spill = g->spill;
     p.records = records && g->pre_miss;
-    step_rot rot = {cosf(s->step_rad), sinf(s->step_rad)};
+    step_rot rot = {polyc__cosf(s->step_rad), polyc__sinf(s->step_rad)};
     for (uint32_t i = 0; i < s->count; i++) {
         polyc__beam b;
         if (!beam_fill(ctx, s, i, &b, 1, &rot))
@@ -607,7 +607,7 @@ static void redo_beam(polyc__grid *g, const polyc__beam *b, uint32_t *on_hits)
 
 void polyc__grid_redo_scan(polyc_ctx *ctx, const polyc__scan *s, uint32_t *on_hits)
 {
-    step_rot rot = {cosf(s->step_rad), sinf(s->step_rad)};
+    step_rot rot = {polyc__cosf(s->step_rad), polyc__sinf(s->step_rad)};
     for (uint32_t i = 0; i < s->count; i++) {
         polyc__beam b;
         if (beam_fill(ctx, s, i, &b, 1, &rot))
@@ -628,13 +628,15 @@ polyc_status polyc__grid_build(polyc_ctx *ctx)
     memset(g, 0, sizeof *g);
     if (!ctx->ext.have)
         return POLYC_OK; /* no data: an empty grid */
-    double ext = (double)ctx->cfg.max_extent_m, pad = 2.0 * (double)ctx->cfg.cell_m;
-    double w_m = ctx->ext.max_x - ctx->ext.min_x + 2.0 * pad;
-    double h_m = ctx->ext.max_y - ctx->ext.min_y + 2.0 * pad;
+    float ext = (float)ctx->cfg.max_extent_m, pad = 2.0f * (float)ctx->cfg.cell_m;
+    float box[4];
+    polyc__frame_box(ctx, box);
+    float w_m = box[2] - box[0] + 2.0f * pad;
+    float h_m = box[3] - box[1] + 2.0f * pad;
     if (w_m > ext || h_m > ext)
         return polyc__fail(ctx, POLYC_ERR_EXTENT,
                            "the data span more than config.max_extent_m (a far-away scan?)");
-    polyc_status st = grid_lay_out(ctx, ctx->ext.min_x - pad, ctx->ext.min_y - pad, w_m, h_m, 0);
+    polyc_status st = grid_lay_out(ctx, box[0] - pad, box[1] - pad, w_m, h_m, 0);
     if (st != POLYC_OK)
         return st;
     for (uint32_t si = 0; si < ctx->scan_count; si++)
@@ -646,11 +648,11 @@ polyc_status polyc__grid_build(polyc_ctx *ctx)
     return POLYC_OK;
 }
 
-polyc_status polyc__grid_online_init(polyc_ctx *ctx, double side_m, uint32_t max_cells)
+polyc_status polyc__grid_online_init(polyc_ctx *ctx, float side_m, uint32_t max_cells)
 {
     memset(&ctx->grid, 0, sizeof ctx->grid);
     uint32_t tiles = (max_cells + POLYC__TILE_CELLS - 1) / POLYC__TILE_CELLS;
-    return grid_lay_out(ctx, -0.5 * side_m, -0.5 * side_m, side_m, side_m, tiles);
+    return grid_lay_out(ctx, -0.5f * side_m, -0.5f * side_m, side_m, side_m, tiles);
 }
 
 void polyc__grid_want(polyc_ctx *ctx, const polyc__scan *s)

@@ -47,8 +47,17 @@ typedef struct polyc__rng {
     uint64_t state;
 } polyc__rng;
 uint64_t polyc__rng_next(polyc__rng *r);
-double polyc__rng_uniform(polyc__rng *r);   /* [0, 1) */
-double polyc__rng_normal(polyc__rng *r);    /* N(0, 1) */
+float polyc__rng_uniform(polyc__rng *r);   /* [0, 1) */
+float polyc__rng_normal(polyc__rng *r);    /* N(0, 1) */
+
+/* fmath.c: float sine, cosine, arc tangent, logarithm (libm's compute in
+ * double on the target); angles within a few thousand turns, log of a
+ * finite normal x > 0 */
+void polyc__sincosf(float a, float *s, float *c);
+float polyc__sinf(float a);
+float polyc__cosf(float a);
+float polyc__atan2f(float y, float x);
+float polyc__logf(float x);
 
 /* ---- grid.c: hit/miss grid in 32 x 32 tiles ---- */
 #define POLYC__TILE_SHIFT 5
@@ -74,6 +83,7 @@ typedef struct polyc__tile {
 
 typedef struct polyc__grid {
     double origin_x_m, origin_y_m; /* lower-left corner of cell (0, 0) */
+    float frame_ox, frame_oy;      /* the same, relative to the frame (first pose) */
     float cell_m, inv_cell;
     int32_t width, height;         /* cells */
     int32_t tiles_x, tiles_y;
@@ -174,7 +184,7 @@ typedef struct polyc__hash {
 #define POLYC__ANGLE_BINS 18       /* 10 degree bins of the turn angle, 0..180 */
 #define POLYC__BINS_PER_RAD 5.729577951f /* 18 / pi: 10 degree bins */
 typedef struct polyc__prior {
-    double origin_x, origin_y;     /* frame-relative lower-left corner */
+    float origin_x, origin_y;     /* frame-relative lower-left corner */
     float cell_m, inv_cell;
     int32_t w, h;
     /* per cell (w * h): 1 + its row of counts, 0 for a cell without evidence */
@@ -286,6 +296,20 @@ int polyc__pose_ok(double x, double y, double th);
 const char *polyc__scan_problem(const polyc_scan *s);
 void polyc__extent_add(const polyc_scan *s, double ox, double oy, double *box, int *have);
 
+/* boundary.c: the API's doubles in and out (the library computes in float) */
+float polyc__narrow(double v); /* a double of the API (an area, a limit) as a float */
+void polyc__frame_set(polyc_ctx *ctx, double x_m, double y_m);
+float polyc__heading(double theta_rad); /* a pose's heading in [-pi, pi] */
+void polyc__frame_scan(const polyc_ctx *ctx, const polyc_scan *s, polyc__scan *d);
+void polyc__frame_grid_origin(const polyc_ctx *ctx, polyc__grid *g, float x0_m, float y0_m);
+int polyc__frame_inside(const polyc_ctx *ctx, const polyc_scan *s, float half_m);
+void polyc__frame_box(const polyc_ctx *ctx, float box[4]); /* the data's extent, frame metres */
+void polyc__frame_export(polyc_ctx *ctx);
+void polyc__frame_of_grid(polyc_ctx *ctx, const polyc_occupancy_grid *grid);
+int polyc__grid_origin_ok(const polyc_occupancy_grid *grid);
+void polyc__figures_out(float bic, float err, double *bic_out, double *err_out);
+void polyc__figures_iteration(polyc_iteration *rep, float bic, float best_bic, float noise_m);
+
 /* grid.c */
 /* entries the grid's tile directory may have under the limits */
 size_t polyc__grid_dir_cap(const polyc_limits *lim);
@@ -296,7 +320,7 @@ polyc_status polyc__grid_build(polyc_ctx *ctx);
 /* online: a grid over a square of side_m centred on the frame origin, with
  * no tile yet; one scan counted into it, or taken back (a pose correction);
  * on_hits (per tile, may be NULL) counts the misses in cells with hits */
-polyc_status polyc__grid_online_init(polyc_ctx *ctx, double side_m, uint32_t max_cells);
+polyc_status polyc__grid_online_init(polyc_ctx *ctx, float side_m, uint32_t max_cells);
 polyc_status polyc__grid_add_scan(polyc_ctx *ctx, const polyc__scan *s, int take_back,
                                   uint32_t *on_hits);
 /* online: the tiles the scan's hits end in wanted (stored when a beam
@@ -323,7 +347,7 @@ static inline int polyc__cell_index(int32_t ix, int32_t iy)
  * return, nor behind one of its own returns, by more than this along the
  * beam; scan_chains.c links hits across beams whose return is in front of
  * the link by more than this */
-#define POLYC__RAY_TOLERANCE_M 0.10
+#define POLYC__RAY_TOLERANCE_M 0.10f
 
 /* min and max of two floats that are not NaN: fminf and fmaxf are libm
  * calls on x86-64 (their NaN rules keep the compiler from using minss) */

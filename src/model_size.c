@@ -24,7 +24,7 @@ int polyc__size_carve(polyc__arena *a, polyc__size_scratch *sz, int32_t V)
 }
 
 
-static void heap_push(polyc__opt *o, double delta, int32_t v)
+static void heap_push(polyc__opt *o, float delta, int32_t v)
 {
     if (o->size.heap_n >= o->size.heap_cap)
         return; /* full: the candidate is simply not retried */
@@ -65,30 +65,30 @@ static polyc__heap_entry heap_pop(polyc__opt *o)
 /* Change of the BIC if v is removed (see polyc__op_remove for the cases),
  * exact if it is below `bound`, else some value >= bound: proving that a
  * removal does not pay needs fewer nearest-segment queries than its value. */
-double polyc__removal_delta_below(polyc__opt *o, int32_t v, double bound)
+float polyc__removal_delta_below(polyc__opt *o, int32_t v, float bound)
 {
     const polyc__store *s = o->s;
     const polyc__vertex *V = s->v;
     const polyc__line *ln = &s->l[V[v].line];
     int32_t p = V[v].prev, n = V[v].next;
-    double gamma = (double)o->cfg->gamma;
+    float gamma = (float)o->cfg->gamma;
     int32_t old[3];
     int n_old = 0;
     float xy[4];
     int n_new = 0;
-    double dk, dangle;
+    float dk, dangle;
     if (!ln->closed && ln->count == 2) {
         if (o->rays.on)
             return INFINITY; /* a single scan's return stays on the map */
         old[n_old++] = p != POLYC__NONE ? p : v;
-        dk = -2.0;
-        dangle = 0.0;
+        dk = -2.0f;
+        dangle = 0.0f;
     } else if (p == POLYC__NONE || n == POLYC__NONE) {
         int32_t nb = p == POLYC__NONE ? n : p;
         if (o->rays.on && polyc__holds_returns(&o->rays, V[v].x, V[v].y, V[nb].x, V[nb].y))
             return INFINITY; /* a single scan's end return stays on the map */
         old[n_old++] = p == POLYC__NONE ? v : p;
-        dk = -1.0;
+        dk = -1.0f;
         dangle = -o->acost[nb]; /* the neighbour becomes an end: no angle */
     } else {
         old[n_old++] = p;
@@ -107,9 +107,9 @@ double polyc__removal_delta_below(polyc__opt *o, int32_t v, double bound)
                 return INFINITY; /* a single scan saw through there, or a return would go */
         }
         n_new = 1;
-        dk = -1.0;
+        dk = -1.0f;
         dangle = -o->acost[p] - o->acost[v] - o->acost[n];
-        if (!(ln->closed && ln->count == 3) && gamma > 0.0) {
+        if (!(ln->closed && ln->count == 3) && gamma > 0.0f) {
             /* new angles at p and n with v gone */
             int32_t pp = V[p].prev, nn = V[n].next;
             if (pp != POLYC__NONE && pp != n)
@@ -118,10 +118,10 @@ double polyc__removal_delta_below(polyc__opt *o, int32_t v, double bound)
                 dangle += polyc__turn_cost(o, V[p].x, V[p].y, V[n].x, V[n].y, V[nn].x, V[nn].y);
         }
     }
-    double alpha = (double)o->cfg->alpha;
+    float alpha = (float)o->cfg->alpha;
     /* delta < bound  <=>  derr < limit */
-    double limit = isinf(bound) ? bound : (bound - dk * o->d.log_n) / alpha - gamma * dangle;
-    double derr = polyc__local_delta(o, old, n_old, xy, n_new, limit);
+    float limit = isinf(bound) ? bound : (bound - dk * o->d.log_n) / alpha - gamma * dangle;
+    float derr = polyc__local_delta(o, old, n_old, xy, n_new, limit);
     return alpha * (derr + gamma * dangle) + dk * o->d.log_n;
 }
 
@@ -135,8 +135,8 @@ int polyc__op_remove_vertices(polyc__opt *o, uint32_t since)
     for (int32_t v = 0; v < s->v_high; v++) {
         if (s->v[v].line == POLYC__NONE || o->v_touch[v] < since)
             continue;
-        double d = polyc__removal_delta_below(o, v, 0.0);
-        if (d < 0.0)
+        float d = polyc__removal_delta_below(o, v, 0.0f);
+        if (d < 0.0f)
             heap_push(o, d, v);
     }
     int removed = 0;
@@ -144,10 +144,10 @@ int polyc__op_remove_vertices(polyc__opt *o, uint32_t since)
         polyc__heap_entry e = heap_pop(o);
         if (s->v[e.v].line == POLYC__NONE)
             continue;
-        double d = polyc__removal_delta_below(o, e.v, 0.0);
-        if (d >= 0.0)
+        float d = polyc__removal_delta_below(o, e.v, 0.0f);
+        if (d >= 0.0f)
             continue;
-        if (o->size.heap_n > 0 && d > o->size.heap[0].delta + 1e-9) {
+        if (o->size.heap_n > 0 && d > o->size.heap[0].delta + 1e-9f) {
             heap_push(o, d, e.v); /* no longer the best: back in line */
             continue;
         }
@@ -159,8 +159,8 @@ int polyc__op_remove_vertices(polyc__opt *o, uint32_t since)
         for (int k = 0; k < 2; k++) {
             if (nb[k] == POLYC__NONE || s->v[nb[k]].line == POLYC__NONE)
                 continue;
-            double dn = polyc__removal_delta_below(o, nb[k], 0.0);
-            if (dn < 0.0)
+            float dn = polyc__removal_delta_below(o, nb[k], 0.0f);
+            if (dn < 0.0f)
                 heap_push(o, dn, nb[k]);
         }
     }
@@ -207,13 +207,13 @@ int polyc__op_add_vertices(polyc__opt *o, int max_tries)
     for (int round = 0; round < max_tries; round++) {
         segment_stats(o);
         int32_t cand[ADD_CANDIDATES];
-        double score[ADD_CANDIDATES];
+        float score[ADD_CANDIDATES];
         int nc = 0;
         for (int32_t v = 0; v < s->v_high; v++) {
             if (s->v[v].line == POLYC__NONE || s->v[v].next == POLYC__NONE || o->size.seg_w[v] < 4.0f ||
                 o->size.seg_far[v] == POLYC__NONE)
                 continue;
-            double m = (double)(o->size.seg_sum[v] / o->size.seg_w[v]);
+            float m = (float)(o->size.seg_sum[v] / o->size.seg_w[v]);
             if (nc == ADD_CANDIDATES && m <= score[nc - 1])
                 continue;
             int k = nc < ADD_CANDIDATES ? nc++ : nc - 1;
@@ -242,7 +242,7 @@ int polyc__op_add_vertices(polyc__opt *o, int max_tries)
                  polyc__blocks_beams(&o->rays, o->d.pts[far].x, o->d.pts[far].y, s->v[w].x, s->v[w].y,
                                      old_xy, n_xy)))
                 continue;
-            double before = polyc__bic(o);
+            float before = polyc__bic(o);
             float ux = s->v[u].x, uy = s->v[u].y, wx = s->v[w].x, wy = s->v[w].y;
             polyc__chg_begin(o);
             int32_t v = polyc__op_insert_after(o, u, o->d.pts[far].x, o->d.pts[far].y);
@@ -254,7 +254,7 @@ int polyc__op_add_vertices(polyc__opt *o, int max_tries)
                 polyc__hill_climb(o, u);
                 polyc__hill_climb(o, w);
             }
-            if (polyc__bic(o) < before - 1e-9 * fabs(before)) {
+            if (polyc__bic(o) < before - 1e-6f * fabsf(before)) { /* (as optimize.c) */
                 added++;
                 any = 1;
                 continue;

@@ -16,13 +16,13 @@ enum { CELL_UNKNOWN = 0, CELL_FREE = 1, CELL_OCCUPIED = 2, CELL_BAD = 3 };
 /* The class of every int8 value under the thresholds, indexed by value + 128. */
 static void classes(const polyc_config *cfg, uint8_t *cls)
 {
-    double occ = 100.0 * (double)cfg->occupied_thresh, fre = 100.0 * (double)cfg->free_thresh;
+    float occ = 100.0f * (float)cfg->occupied_thresh, fre = 100.0f * (float)cfg->free_thresh;
     for (int v = -128; v < 128; v++) {
         uint8_t c = CELL_BAD;
         if (v == -1)
             c = CELL_UNKNOWN;
         else if (v >= 0 && v <= 100)
-            c = (double)v >= occ ? CELL_OCCUPIED : ((double)v <= fre ? CELL_FREE : CELL_UNKNOWN);
+            c = (float)v >= occ ? CELL_OCCUPIED : ((float)v <= fre ? CELL_FREE : CELL_UNKNOWN);
         cls[v + 128] = c;
     }
 }
@@ -48,12 +48,10 @@ static polyc_status check_grid(const polyc_config *cfg, const polyc_occupancy_gr
         w = "grid resolution_m must be in [0.0001, 100]";
     } else if (grid->reserved != 0) {
         w = "grid.reserved must be 0";
-    } else if (!isfinite(grid->origin_x_m) || !isfinite(grid->origin_y_m) ||
-               !isfinite(grid->origin_yaw_rad) || fabs(grid->origin_x_m) >= 1e7 ||
-               fabs(grid->origin_y_m) >= 1e7 || fabs(grid->origin_yaw_rad) > 100.0) {
+    } else if (!polyc__grid_origin_ok(grid)) {
         w = "grid origin is not finite or beyond 1e7 m";
-    } else if ((double)grid->width * (double)r > (double)cfg->max_extent_m ||
-               (double)grid->height * (double)r > (double)cfg->max_extent_m) {
+    } else if ((float)grid->width * (float)r > (float)cfg->max_extent_m ||
+               (float)grid->height * (float)r > (float)cfg->max_extent_m) {
         w = "the grid spans more than config.max_extent_m";
         st = POLYC_ERR_EXTENT;
     } else {
@@ -211,8 +209,6 @@ static polyc_status fill(polyc_ctx *ctx, const polyc_occupancy_grid *grid, const
     polyc__grid *g = &ctx->grid;
     g->cell_m = grid->resolution_m;
     g->inv_cell = 1.0f / grid->resolution_m;
-    g->origin_x_m = grid->origin_x_m; /* = the frame: the grid's corner is at 0, 0 */
-    g->origin_y_m = grid->origin_y_m;
     g->width = (int32_t)grid->width;
     g->height = (int32_t)grid->height;
     g->tiles_x = (int32_t)tiles_x;
@@ -328,11 +324,7 @@ polyc_status polyc__occ_add(polyc_ctx *ctx, const polyc_occupancy_grid *grid)
         return st;
     }
     ctx->from_grid = 1;
-    ctx->frame_x = grid->origin_x_m;
-    ctx->frame_y = grid->origin_y_m;
-    ctx->have_frame = 1;
-    ctx->frame_dir.cos = cos(grid->origin_yaw_rad);
-    ctx->frame_dir.sin = sin(grid->origin_yaw_rad);
+    polyc__frame_of_grid(ctx, grid);
     /* the grid and its contour are this context's input: stages restart
      * after them */
     ctx->scans_mark = ctx->grid_mark = ctx->contour_mark = ctx->arena.used;
@@ -343,9 +335,9 @@ polyc_status polyc__occ_add(polyc_ctx *ctx, const polyc_occupancy_grid *grid)
 int polyc__occ_free_at(const polyc_ctx *ctx, float x, float y)
 {
     const polyc__grid *g = &ctx->grid;
-    double fx = ((double)x - (g->origin_x_m - ctx->frame_x)) / (double)g->cell_m;
-    double fy = ((double)y - (g->origin_y_m - ctx->frame_y)) / (double)g->cell_m;
-    if (!(fx >= 0.0 && fy >= 0.0 && fx < (double)g->width && fy < (double)g->height))
+    float fx = ((float)x - g->frame_ox) / (float)g->cell_m;
+    float fy = ((float)y - g->frame_oy) / (float)g->cell_m;
+    if (!(fx >= 0.0f && fy >= 0.0f && fx < (float)g->width && fy < (float)g->height))
         return 0;
     int32_t ix = (int32_t)fx, iy = (int32_t)fy;
     const polyc__tile *t = polyc__grid_tile(g, ix, iy);

@@ -16,7 +16,7 @@
  * where the map is seen again and again, a scan changes a tile's data by a
  * few per cent, too little to move a vertex, and the update leaves it;
  * where the robot sees something new, the first endpoints count whole. */
-#define CHANGE_SHARE 0.25
+#define CHANGE_SHARE 0.25f
 /* and at least this many endpoints: a few far returns a scan (a sparse
  * tile) wait for the next */
 #define CHANGE_MIN 16u
@@ -34,7 +34,7 @@
 
 /* Endpoints and poses must stay this far inside the area: vertices may
  * wander a little past the data (the spatial hash's own margin is 2 m). */
-#define AREA_MARGIN_M 1.0
+#define AREA_MARGIN_M 1.0f
 
 /* relabel: the marks pay when the scans' beams times this reach the
  * stored cells (a beam walks some tens of cells in the tiles it does not
@@ -66,7 +66,9 @@ void polyc__online_stage_limits(const polyc_online_limits *ol, polyc_limits *lim
  * refuses data spanning more than it. */
 static int limits_ok(const polyc_config *cfg, const polyc_online_limits *ol)
 {
-    return ol->area_m > 1.0 && ol->area_m <= 1e5 && ol->area_m <= 2.0 * (double)cfg->max_extent_m && ol->max_grid_cells >= POLYC__TILE_CELLS &&
+    float area = polyc__narrow(ol->area_m);
+    return area > 1.0f && area <= 1e5f && area <= 2.0f * cfg->max_extent_m &&
+           ol->max_grid_cells >= POLYC__TILE_CELLS &&
            ol->max_grid_cells <= 0x40000000u && ol->max_vertices >= 16 &&
            ol->max_vertices <= 0x10000000u && ol->max_points >= 16 && ol->max_points <= 0x10000000u &&
            ol->max_scan_beams > 0 && ol->max_scan_beams <= 0x1000000u &&
@@ -81,29 +83,30 @@ polyc_status polyc_online_limits_for_area(const polyc_config *config, double are
     if (polyc_config_check(config, NULL) != POLYC_OK)
         return POLYC_ERR_CONFIG;
     memset(out, 0, sizeof *out);
-    if (!(area_m > 1.0 && area_m <= 1e5) || max_scan_beams == 0)
+    float area = polyc__narrow(area_m);
+    if (!(area > 1.0f && area <= 1e5f) || max_scan_beams == 0)
         return POLYC_ERR_CONFIG;
-    if (area_m > 2.0 * (double)config->max_extent_m)
+    if (area > 2.0f * config->max_extent_m)
         return POLYC_ERR_EXTENT;
-    double side = ceil(area_m / (double)config->cell_m / POLYC__TILE_SIDE);
-    double tiles = side * side;
+    float side = ceilf(area / config->cell_m / POLYC__TILE_SIDE);
+    float tiles = side * side;
     /* the tiles a building's walls reach: intel 851 of its 50 m square's
      * 3,906, freiburg-campus 15,399 of its 524 m square's 429,025; a small
      * square is taken whole, a large one for a sixteenth (at least 1,024) */
-    double stored = tiles <= 1024.0 ? tiles : fmax(1024.0, ceil(tiles / 16.0));
-    double cells = fmin(stored * POLYC__TILE_CELLS, 0x40000000);
+    float stored = tiles <= 1024.0f ? tiles : fmaxf(1024.0f, ceilf(tiles / 16.0f));
+    float cells = fminf(stored * POLYC__TILE_CELLS, 0x40000000);
     /* endpoints fall in one cell in 15 of a stored tile on intel (57,712
      * cells in 851 tiles), one in 5 on freiburg-079 (143,127 in 720, long
      * range in a small building): room for one in 4 (the tool doubles the
      * limits of a map that needs more) */
-    double points = fmin(fmax(cells / 4.0, 4096.0), 0x10000000);
+    float points = fminf(fmaxf(cells / 4.0f, 4096.0f), 0x10000000);
     out->area_m = area_m;
     out->max_grid_cells = (uint32_t)cells;
     out->max_points = (uint32_t)points;
     /* vertices: the map and what the rounds and the finishing call trace
      * into it, a vertex per 16 data cells (room for a whole contour traced
      * at once: intel's batch trace is 15,000 of them) */
-    out->max_vertices = (uint32_t)(points / 16.0) + 4096;
+    out->max_vertices = (uint32_t)(points / 16.0f) + 4096;
     out->max_scan_beams = max_scan_beams;
     return POLYC_OK;
 }
@@ -148,7 +151,7 @@ static int lay_out(polyc_ctx *ctx, polyc__online *on, polyc__arena *a)
     polyc__arena_counting(&probe);
     polyc__arena saved = ctx->arena;
     ctx->arena = probe;
-    polyc_status st = polyc__grid_online_init(ctx, ol->area_m, ol->max_grid_cells);
+    polyc_status st = polyc__grid_online_init(ctx, polyc__narrow(ol->area_m), ol->max_grid_cells);
     ctx->arena = saved;
     if (st != POLYC_OK)
         return 0;
@@ -186,7 +189,7 @@ static int lay_out(polyc_ctx *ctx, polyc__online *on, polyc__arena *a)
         return 0;
     saved = ctx->arena;
     ctx->arena = *a;
-    st = polyc__grid_online_init(ctx, ol->area_m, ol->max_grid_cells);
+    st = polyc__grid_online_init(ctx, polyc__narrow(ol->area_m), ol->max_grid_cells);
     *a = ctx->arena;
     ctx->arena = saved;
     if (st != POLYC_OK)
@@ -327,7 +330,7 @@ void polyc__online_backlog_misses(polyc_ctx *ctx)
         if (!g->dir[d])
             continue;
         uint32_t k = g->dir[d] - 1;
-        if (on->tile_miss[k] >= CHANGE_MIN && (double)on->tile_miss[k] >= on->tile_raw[k])
+        if (on->tile_miss[k] >= CHANGE_MIN && (float)on->tile_miss[k] >= on->tile_raw[k])
             mark_dirty(on, d);
         else if (on->tile_new[k] >= SPARSE_MIN && on->tile_new[k] >= on->tile_raw[k])
             mark_dirty(on, d);
@@ -385,7 +388,7 @@ static int sum_endpoints(polyc_ctx *ctx, const polyc__scan *s, float sign)
         if (d < 0 || g->dir[d] == 0)
             continue;
         uint32_t k = g->dir[d] - 1;
-        if (++on->tile_new[k] >= CHANGE_MIN && (double)on->tile_new[k] >= CHANGE_SHARE * on->tile_raw[k])
+        if (++on->tile_new[k] >= CHANGE_MIN && (float)on->tile_new[k] >= CHANGE_SHARE * on->tile_raw[k])
             mark_dirty(on, (size_t)d);
         uint32_t key = polyc__cell_key(k, polyc__cell_index(ix, iy));
         uint32_t e = sign < 0.0f ? polyc__cell_find(on, key) : polyc__cell_add(on, key);
@@ -498,8 +501,8 @@ static polyc_status accumulate(polyc_ctx *ctx, const polyc__scan *s, uint32_t nu
         ctx->arena.used = mark;
         on->learn_cache = NULL;
     }
-    int64_t d = tile_of(g, (int32_t)floorf((float)((double)s->x_m - (g->origin_x_m - ctx->frame_x)) * g->inv_cell),
-                        (int32_t)floorf((float)((double)s->y_m - (g->origin_y_m - ctx->frame_y)) * g->inv_cell));
+    int64_t d = tile_of(g, (int32_t)floorf((s->x_m - g->frame_ox) * g->inv_cell),
+                        (int32_t)floorf((s->y_m - g->frame_oy) * g->inv_cell));
     if (d >= 0 && !((on->pose_bits[d >> 5] >> (d & 31)) & 1u)) {
         on->pose_bits[d >> 5] |= 1u << (d & 31);
         on->spacing_stale = 1;
@@ -516,19 +519,13 @@ static polyc_status accumulate(polyc_ctx *ctx, const polyc__scan *s, uint32_t nu
 /* Whether the scan at its pose lies inside the area (frame metres). */
 static int inside_area(const polyc_ctx *ctx, const polyc_scan *s)
 {
-    double box[4] = {0.0, 0.0, 0.0, 0.0};
-    int have = 0;
-    polyc__extent_add(s, ctx->frame_x, ctx->frame_y, box, &have);
-    double half = 0.5 * ctx->online->lim.area_m - AREA_MARGIN_M;
-    return !have || (box[0] > -half && box[1] > -half && box[2] < half && box[3] < half);
+    return polyc__frame_inside(ctx, s, 0.5f * polyc__narrow(ctx->online->lim.area_m) - AREA_MARGIN_M);
 }
 
 /* The stored form of a scan (pose relative to the frame). */
 static void store_scan(polyc_ctx *ctx, polyc__scan *d, const polyc_scan *s, uint32_t first)
 {
-    d->x_m = (float)(s->pose_x_m - ctx->frame_x);
-    d->y_m = (float)(s->pose_y_m - ctx->frame_y);
-    d->theta_rad = (float)remainder(s->pose_theta_rad, 6.283185307179586);
+    polyc__frame_scan(ctx, s, d);
     d->start_rad = s->start_angle_rad;
     d->step_rad = s->angle_step_rad;
     d->min_m = s->min_range_m;
@@ -580,12 +577,9 @@ polyc_status polyc_online_add_scan(polyc_ctx *ctx, const polyc_scan *s, int keep
             return cst2;
     }
     polyc__online_learn_due(ctx); /* (before this scan's lines join the prior) */
-    if (!ctx->have_frame) {
-        ctx->frame_x = s->pose_x_m;
-        ctx->frame_y = s->pose_y_m;
-        ctx->grid.origin_x_m += ctx->frame_x; /* laid out around (0, 0) */
-        ctx->grid.origin_y_m += ctx->frame_y;
-        ctx->have_frame = 1;
+    if (!ctx->have_frame) { /* the grid was laid out around (0, 0) */
+        polyc__frame_set(ctx, s->pose_x_m, s->pose_y_m);
+        polyc__frame_grid_origin(ctx, &ctx->grid, ctx->grid.frame_ox, ctx->grid.frame_oy);
     }
     if (!inside_area(ctx, s))
         return polyc__fail(ctx, POLYC_ERR_EXTENT, "the scan reaches outside limits.area_m around the first pose");

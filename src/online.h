@@ -83,7 +83,7 @@ typedef struct polyc__online {
      * position (online_data.c); per stored tile the endpoints its points
      * hold */
     uint32_t *pt_tile, *bucket_fill;
-    double *tile_raw;
+    float *tile_raw;
     uint32_t *tile_new;            /* per stored tile: endpoints in or out since its refresh */
     uint32_t *tile_miss;           /* and misses counted in its cells with hits */
 

@@ -13,7 +13,7 @@
 static uint32_t table_bits(uint32_t entries)
 {
     uint32_t bits = 4;
-    while (3.0 * (double)(1u << bits) < 4.0 * (double)entries)
+    while (3.0f * (float)(1u << bits) < 4.0f * (float)entries)
         bits++;
     return bits;
 }

@@ -87,7 +87,7 @@ static polyc_status refresh(polyc_ctx *ctx, uint32_t n_taken)
                 kept++;
                 continue;
             }
-            o->err -= o->d.pt_cost[i];
+            polyc__ksum_add(&o->err, -(o->d.pt_cost[i]));
             if (o->d.pt_seg[i] != POLYC__NONE)
                 o->split_due[o->d.pt_seg[i]] = 1;
         }
@@ -129,13 +129,13 @@ static polyc_status refresh(polyc_ctx *ctx, uint32_t n_taken)
     for (int32_t i = 0; i < o->d.np; i++)
         if (o->d.pt_seg[i] == POLYC__NONE - 1) {
             o->d.pt_cost[i] = polyc__nearest(o, i, NULL, 0, &o->d.pt_seg[i]);
-            o->err += o->d.pt_cost[i];
+            polyc__ksum_add(&o->err, o->d.pt_cost[i]);
             if (o->d.pt_seg[i] != POLYC__NONE)
                 o->split_due[o->d.pt_seg[i]] = 1;
         }
-    o->d.log_n = log(o->d.n > 1.0 ? o->d.n : 1.0);
+    o->d.log_n = polyc__logf(o->d.n > 1.0f ? o->d.n : 1.0f);
     ctx->stats.weighted_points = (uint32_t)o->d.np;
-    ctx->stats.data_points = (uint64_t)o->d.n;
+    ctx->stats.data_points = (uint32_t)o->d.n; /* (a count of returns, < 2^32) */
     return POLYC_OK;
 }
 
@@ -150,7 +150,7 @@ void polyc__online_drop_lines(polyc_ctx *ctx, uint32_t after_id)
         int32_t v = s->l[l].head;
         for (int32_t k = 0; k < s->l[l].count; k++, v = s->v[v].next)
             if (o->chg.v_dirty[v] != o->chg.epoch && !o->seg_in[v])
-                o->acost[v] = 0.0; /* never counted: nothing to take out */
+                o->acost[v] = 0.0f; /* never counted: nothing to take out */
         while (s->l[l].closed != POLYC__NONE && s->l[l].count > 1)
             polyc__op_remove(o, s->l[l].head);
         if (s->l[l].closed != POLYC__NONE) /* one vertex left (a trace cut short) */
@@ -173,7 +173,7 @@ polyc_status polyc__online_add_lines(polyc_ctx *ctx, uint32_t after_id)
         for (int32_t k = 0; k < ln->count; k++) {
             if (!polyc__chg_seg_in(o, v))
                 return polyc__fail(ctx, POLYC_ERR_NOMEM, "spatial hash full (limits.max_vertices)");
-            o->acost[v] = 0.0; /* a new vertex: no angle counted yet */
+            o->acost[v] = 0.0f; /* a new vertex: no angle counted yet */
             polyc__chg_dirty(o, v);
             o->split_due[v] = 1;
             v = s->v[v].next;

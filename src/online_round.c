@@ -54,7 +54,7 @@ static float tile_key(const polyc_ctx *ctx, uint32_t d)
     const polyc__grid *g = &ctx->grid;
     const polyc__online *on = ctx->online;
     float tile_m = g->cell_m * (float)POLYC__TILE_SIDE;
-    float ox = (float)(g->origin_x_m - ctx->frame_x), oy = (float)(g->origin_y_m - ctx->frame_y);
+    float ox = g->frame_ox, oy = g->frame_oy;
     float cx = ox + ((float)(d % (uint32_t)g->tiles_x) + 0.5f) * tile_m;
     float cy = oy + ((float)(d / (uint32_t)g->tiles_x) + 0.5f) * tile_m;
     float dx = cx - on->last_x, dy = cy - on->last_y;
@@ -162,7 +162,7 @@ static int32_t taken_points(polyc_ctx *ctx, uint32_t taken)
     const polyc__grid *g = &ctx->grid;
     const polyc__hash *h = &o->h;
     float tile_m = g->cell_m * (float)POLYC__TILE_SIDE;
-    float ox = (float)(g->origin_x_m - ctx->frame_x), oy = (float)(g->origin_y_m - ctx->frame_y);
+    float ox = g->frame_ox, oy = g->frame_oy;
     polyc__chg_begin(o); /* a new epoch for the bucket marks */
     for (uint32_t k = 0; k < taken; k++) {
         uint32_t d = on->dirty[k];
@@ -208,7 +208,7 @@ static uint32_t unexplained_cells(polyc_ctx *ctx, uint32_t taken, float near, in
         polyc__find_sides(o, list, np, o->size.seg_sum, o->size.seg_w);
     }
     float thr = ctx->cfg.contour_threshold;
-    double ox = g->origin_x_m - ctx->frame_x, oy = g->origin_y_m - ctx->frame_y;
+    float ox = g->frame_ox, oy = g->frame_oy;
     for (uint32_t k = 0; k < g->tile_count; k++)
         memset(g->tiles[k].mark, 0, sizeof g->tiles[k].mark);
     uint32_t n = 0;
@@ -226,8 +226,8 @@ static uint32_t unexplained_cells(polyc_ctx *ctx, uint32_t taken, float near, in
                     (!polyc__cell_occupied(t, idx, thr) &&
                      !polyc__contour_data_alone(ctx, tx + c, ty + r, 0)))
                     continue;
-                float x = (float)(ox + ((double)(tx + c) + 0.5) * (double)g->cell_m);
-                float y = (float)(oy + ((double)(ty + r) + 0.5) * (double)g->cell_m);
+                float x = (float)(ox + ((float)(tx + c) + 0.5f) * (float)g->cell_m);
+                float y = (float)(oy + ((float)(ty + r) + 0.5f) * (float)g->cell_m);
                 float vx = 0.0f, vy = 0.0f;
                 if (sides)
                     polyc__online_cell_view(ctx, tx + c, ty + r, &vx, &vy);
@@ -252,7 +252,7 @@ static void stamp_region(polyc_ctx *ctx, uint32_t taken, uint32_t since)
     const polyc__grid *g = &ctx->grid;
     const polyc__hash *h = &o->h;
     float tile_m = g->cell_m * (float)POLYC__TILE_SIDE, pad = o->R;
-    float ox = (float)(g->origin_x_m - ctx->frame_x), oy = (float)(g->origin_y_m - ctx->frame_y);
+    float ox = g->frame_ox, oy = g->frame_oy;
     for (uint32_t k = 0; k < taken; k++) {
         uint32_t d = on->dirty[k];
         float x0 = ox + (float)(d % (uint32_t)g->tiles_x) * tile_m - pad;
@@ -292,10 +292,10 @@ static void drop_dataless(polyc__opt *o)
     for (int32_t v = 0; v < s->v_high; v++)
         has[v] = 0.0f;
     int32_t np = polyc__region_points(o, polyc__in_region);
-    double sup2 = (double)o->d.support_m * (double)o->d.support_m;
+    float sup2 = (float)o->d.support_m * (float)o->d.support_m;
     for (int32_t j = 0; j < np; j++) {
         int32_t i = o->region_pt[j], sg = o->d.pt_seg[i];
-        if (sg != POLYC__NONE && o->d.pt_cost[i] <= sup2 * (double)o->d.pts[i].w)
+        if (sg != POLYC__NONE && o->d.pt_cost[i] <= sup2 * (float)o->d.pts[i].w)
             has[sg] = 1.0f;
     }
     for (int32_t l = 0; l < s->l_high; l++) {
@@ -479,8 +479,9 @@ static polyc_status online_ctx(polyc_ctx *ctx)
 static void report(polyc_ctx *ctx, uint64_t work, uint32_t changed, polyc_online_report *out)
 {
     polyc__online *on = ctx->online;
-    ctx->stats.bic = on->opt_ready ? polyc__bic(&on->opt) : 0.0;
-    ctx->stats.error_sq_m2 = on->opt_ready ? on->opt.err : 0.0;
+    polyc__figures_out(on->opt_ready ? polyc__bic(&on->opt) : 0.0f,
+                       on->opt_ready ? polyc__err(&on->opt) : 0.0f, &ctx->stats.bic,
+                       &ctx->stats.error_sq_m2);
     if (!out)
         return;
     memset(out, 0, sizeof *out);
@@ -549,7 +550,7 @@ polyc_status polyc_online_update(polyc_ctx *ctx, uint64_t work, polyc_online_rep
 static int occupied_near(const polyc_ctx *ctx, float x, float y)
 {
     const polyc__grid *g = &ctx->grid;
-    float ox = (float)(g->origin_x_m - ctx->frame_x), oy = (float)(g->origin_y_m - ctx->frame_y);
+    float ox = g->frame_ox, oy = g->frame_oy;
     int32_t cx = (int32_t)floorf((x - ox) * g->inv_cell), cy = (int32_t)floorf((y - oy) * g->inv_cell);
     for (int32_t dy = -1; dy <= 1; dy++)
         for (int32_t dx = -1; dx <= 1; dx++) {

@@ -242,7 +242,7 @@ int polyc__op_zigzag(polyc__opt *o)
         int spike = lu < 0.3f && lw < 0.3f && dot < -0.5f * lu * lw;
         if (!fold && !spike)
             continue;
-        double bound = spike ? o->d.log_n : 0.0;
+        float bound = spike ? o->d.log_n : 0.0f;
         if (polyc__removal_delta_below(o, v, bound) >= bound)
             continue;
         polyc__apply_remove(o, v);
@@ -317,9 +317,9 @@ static int32_t close_cap(polyc__opt *o, int32_t v)
     const polyc__vertex *e = lu <= lw ? a : d, *l0 = lu <= lw ? c : a, *l1 = lu <= lw ? d : b;
     if (polyc__seg_dist2(e->x, e->y, l0->x, l0->y, l1->x, l1->y) > tol2)
         return POLYC__NONE;
-    double db = polyc__removal_delta_below(o, v, DBL_MAX);
-    double dc = polyc__removal_delta_below(o, w, DBL_MAX);
-    if ((db < dc ? db : dc) >= DBL_MAX)
+    float db = polyc__removal_delta_below(o, v, FLT_MAX);
+    float dc = polyc__removal_delta_below(o, w, FLT_MAX);
+    if ((db < dc ? db : dc) >= FLT_MAX)
         return POLYC__NONE; /* (a single scan's return stays on the map: INFINITY) */
     polyc__apply_remove(o, db < dc ? v : w);
     return db < dc ? w : v;
@@ -357,10 +357,10 @@ int polyc__op_unfold(polyc__opt *o)
         /* the fold's vertex, or the leg's far end where that keeps the map
          * nearer its data (a corner's vertex at the fold: intel's 13 cm
          * end) */
-        double dv = polyc__removal_delta_below(o, v, DBL_MAX);
-        double df = unfolds(o, v, f) ? polyc__removal_delta_below(o, f, DBL_MAX) : HUGE_VAL;
+        float dv = polyc__removal_delta_below(o, v, FLT_MAX);
+        float df = unfolds(o, v, f) ? polyc__removal_delta_below(o, f, FLT_MAX) : HUGE_VALF;
         int32_t go = df < dv ? f : v;
-        if ((df < dv ? df : dv) >= DBL_MAX)
+        if ((df < dv ? df : dv) >= FLT_MAX)
             continue; /* (a single scan's return stays on the map: INFINITY) */
         polyc__apply_remove(o, go);
         changed++;

@@ -78,7 +78,7 @@ void polyc__optimizer_reserve(polyc__arena *a, const polyc_config *cfg, const po
  * maze the first iteration's map stayed the best through 12 more (its noise
  * a whole cell), and the search took 1.4 of the 1.5 s; with these rules 6
  * iterations, 0.85 s, the same map. */
-#define GRID_GAIN 2e-3
+#define GRID_GAIN 2e-3f
 
 static polyc__policy policy_for(polyc__input kind)
 {
@@ -86,7 +86,7 @@ static polyc__policy policy_for(polyc__input kind)
     uint8_t one = kind == POLYC__INPUT_ONE_SCAN, grid = kind == POLYC__INPUT_GRID;
     p.restructure = p.add_vertices = p.noise = !one;
     p.climb_since_prev = p.stop_without_gain = one;
-    p.gain_share = grid ? GRID_GAIN : 0.0;
+    p.gain_share = grid ? GRID_GAIN : 0.0f;
     p.noise_spares_patience = p.recover = !grid;
     p.gaps_free_only = grid;
     p.noise_skip = 0;
@@ -141,7 +141,7 @@ int polyc__opt_carve_online(polyc_ctx *ctx, polyc__arena *a, polyc__opt *o)
     polyc__points_spans(o, 0);
     /* no points yet: every bucket empty */
     memset(o->h.pt_start, 0, ((size_t)o->h.bx * (size_t)o->h.by + 1) * sizeof(uint32_t));
-    memset(o->acost, 0, (size_t)V * sizeof(double));
+    memset(o->acost, 0, (size_t)V * sizeof(float));
     memset(o->v_work, 0, (size_t)V * sizeof(uint32_t));
     memset(o->v_touch, 0, (size_t)V * sizeof(uint32_t));
     memset(o->seg_in, 0, (size_t)V);
@@ -168,7 +168,7 @@ polyc_status polyc__opt_refresh(polyc__opt *o)
     ctx->arena.used = mark;
     if (st != POLYC_OK)
         return st;
-    o->d.log_n = log(o->d.n > 1.0 ? o->d.n : 1.0);
+    o->d.log_n = polyc__logf(o->d.n > 1.0f ? o->d.n : 1.0f);
     return polyc__rebuild(o);
 }
 
@@ -192,7 +192,7 @@ polyc_status polyc__opt_setup(polyc_ctx *ctx, polyc__opt *o)
         return st;
     if ((st = polyc__points_collect(o)) != POLYC_OK)
         return st;
-    o->d.log_n = log(o->d.n > 1.0 ? o->d.n : 1.0);
+    o->d.log_n = polyc__logf(o->d.n > 1.0f ? o->d.n : 1.0f);
     int32_t P = o->d.np > 0 ? o->d.np : 1;
     if (!opt_carve(&ctx->arena, o, P, V, o->d.pt_view != NULL, loc_soa_cap(o->cfg, &ctx->lim), 0))
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the optimiser");

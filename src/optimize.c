@@ -12,8 +12,7 @@
 static void fill_stats(polyc__opt *o)
 {
     polyc_stats *st = &o->ctx->stats;
-    st->bic = polyc__bic(o);
-    st->error_sq_m2 = o->err;
+    polyc__figures_out(polyc__bic(o), polyc__err(o), &st->bic, &st->error_sq_m2);
 }
 
 static int32_t live_lines(const polyc__store *s)
@@ -49,7 +48,7 @@ static polyc_status restore_best(polyc__opt *o, polyc_status st)
  * trimmed, no double cover, no fold doubling a wall (op_unfold), no
  * crossing. Returns a status (the store holds
  * the result, scored). */
-static polyc_status polish(polyc__opt *o, double best)
+static polyc_status polish(polyc__opt *o, float best)
 {
     polyc_status st;
     o->untangle_mark = o->zip_mark = 0; /* the best map is a fresh store */
@@ -136,36 +135,36 @@ polyc_status polyc__search(polyc__opt *o, polyc_progress_fn progress, void *user
     polyc_status st;
     const polyc_config *cfg = o->cfg;
     polyc__flat_from_store(&o->best, o->s);
-    double best = polyc__bic(o);
-    double sigma = (double)cfg->noise_m;
+    float best = polyc__bic(o);
+    float sigma = (float)cfg->noise_m;
     for (uint8_t k = 0; k < o->pol.noise_skip; k++)
-        sigma *= (double)cfg->noise_decay;
+        sigma *= (float)cfg->noise_decay;
     uint32_t quiet = 0, it;
     polyc_status result = POLYC_OK;
     uint32_t prev_start = 0, prev_mark = 0;
-    double prev_bic = best;
+    float prev_bic = best;
     for (it = 0; it < cfg->max_iterations; it++) {
         uint32_t start = ++o->touch_stamp;
         /* F: noise to leave local minima, shrinking every iteration. Below
          * half a hill-climbing step it is not applied any more: the steps
          * could not correct it. Without noise, only what changed since the
          * previous iteration is adjusted and offered for removal again. */
-        double noise = it > 0 && sigma >= 0.5 * (double)cfg->step_m ? sigma : 0.0;
+        float noise = it > 0 && sigma >= 0.5f * (float)cfg->step_m ? sigma : 0.0f;
         if (!o->pol.noise)
-            noise = 0.0;
-        if (noise > 0.0) {
+            noise = 0.0f;
+        if (noise > 0.0f) {
             polyc__op_noise(o, noise);
             o->untangle_mark = o->zip_mark = 0; /* every segment moved */
             if ((st = polyc__rebuild(o)) != POLYC_OK)
                 return restore_best(o, st);
         }
-        uint32_t since = it == 0 || noise > 0.0 ? 0 : prev_start;
+        uint32_t since = it == 0 || noise > 0.0f ? 0 : prev_start;
         prev_start = start;
         prev_mark = polyc__operators(o, since, o->pol.climb_since_prev && it > 0 ? prev_mark : since);
         if (o->h.out_of_entries)
             return restore_best(o, polyc__fail(ctx, POLYC_ERR_NOMEM, "spatial hash full"));
         POLYC__CHECKS_ITERATION(o);
-        double bic = polyc__bic(o);
+        float bic = polyc__bic(o);
         /* any better map is kept; a gain under one BIC unit (no evidence
          * either way) does not restart the patience: late iterations can
          * cycle between maps that differ by a vertex and a fraction of it.
@@ -173,13 +172,15 @@ polyc_status polyc__search(polyc__opt *o, polyc_progress_fn progress, void *user
          * on purpose, and a run of them all worse than iteration 0 stopped
          * infinite-corridor at iteration 5 with 5,766 vertices (3,793 when
          * the noise is allowed to decay) */
-        int gained = bic < best - (o->pol.gain_share > 0.0 ? fmax(1.0, o->pol.gain_share * fabs(best)) : 1.0);
+        int gained = bic < best - (o->pol.gain_share > 0.0f ? fmaxf(1.0f, o->pol.gain_share * fabsf(best)) : 1.0f);
         /* Nor do iterations that are still coming down from the noise by
          * more than POLYC__RECOVER_GAIN of the BIC each (tunables.h) */
-        int recovering = o->pol.recover && it > 0 && bic < prev_bic - POLYC__RECOVER_GAIN * fabs(prev_bic);
+        int recovering = o->pol.recover && it > 0 && bic < prev_bic - POLYC__RECOVER_GAIN * fabsf(prev_bic);
         prev_bic = bic;
-        quiet = gained ? 0 : ((noise > 0.0 && o->pol.noise_spares_patience) || recovering ? quiet : quiet + 1);
-        if (bic < best - 1e-9 * fabs(best)) {
+        quiet = gained ? 0 : ((noise > 0.0f && o->pol.noise_spares_patience) || recovering ? quiet : quiet + 1);
+        /* (better by more than the float total's rounding: its terms are
+         * summed with compensation, to about 1e-7 of it) */
+        if (bic < best - 1e-6f * fabsf(best)) {
             best = bic;
             polyc__flat_from_store(&o->best, o->s);
         }
@@ -188,11 +189,9 @@ polyc_status polyc__search(polyc__opt *o, polyc_progress_fn progress, void *user
         rep.iteration = it;
         rep.vertices = (uint32_t)o->s->v_live;
         rep.polylines = (uint32_t)live_lines(o->s);
-        rep.bic = bic;
-        rep.best_bic = best;
-        rep.noise_m = noise;
+        polyc__figures_iteration(&rep, bic, best, noise);
         if (it > 0)
-            sigma *= (double)cfg->noise_decay;
+            sigma *= (float)cfg->noise_decay;
         if (progress && progress(user, &rep)) {
             result = POLYC_ERR_STOPPED;
             it++;
@@ -204,7 +203,7 @@ polyc_status polyc__search(polyc__opt *o, polyc_progress_fn progress, void *user
          * and of what the previous one edited: one that edited nothing is
          * followed by copies of itself, so the patience would run out on
          * the same best map. */
-        int noisy_later = o->pol.noise && sigma >= 0.5 * (double)cfg->step_m;
+        int noisy_later = o->pol.noise && sigma >= 0.5f * (float)cfg->step_m;
         if (!noisy_later && !edited_since(o, start))
             break;
         /* A single scan has no noise either: an iteration that gained less
@@ -234,9 +233,6 @@ polyc_status polyc__score(polyc_ctx *ctx, double *bic, double *err)
     if (st != POLYC_OK)
         return st;
     fill_stats(&o);
-    if (bic)
-        *bic = polyc__bic(&o);
-    if (err)
-        *err = o.err;
+    polyc__figures_out(polyc__bic(&o), polyc__err(&o), bic, err);
     return POLYC_OK;
 }

@@ -5,21 +5,42 @@
 
 #include "context.h"
 
+/* A float sum with Kahan's compensation: the map's totals (the error and
+ * the angle cost, over up to millions of terms, updated by each change)
+ * to about float's precision of the total, without double arithmetic
+ * (software calls on a single-precision FPU). */
+typedef struct polyc__ksum {
+    float sum, carry;
+} polyc__ksum;
+
+static inline void polyc__ksum_add(polyc__ksum *k, float x)
+{
+    float y = x - k->carry;
+    float t = k->sum + y;
+    k->carry = (t - k->sum) - y;
+    k->sum = t;
+}
+
+static inline float polyc__ksum_get(const polyc__ksum *k)
+{
+    return k->sum - k->carry;
+}
+
 typedef struct polyc__heap_entry {
-    double delta;                  /* change of the BIC if the vertex goes */
+    float delta;                  /* change of the BIC if the vertex goes */
     int32_t v;
     int32_t pad;
 } polyc__heap_entry;
 
 typedef struct polyc__rays {
     int on;                        /* the map comes from a single scan */
-    double x, y, base, step;       /* origin, direction of beam 0, step */
-    double step_cos, step_sin;     /* cos and sin of step */
+    float x, y, base, step;       /* origin, direction of beam 0, step */
+    float step_cos, step_sin;     /* cos and sin of step */
     const float *range;
     float min_m, max_m;
     int32_t count, turn;           /* beams, beams per full turn */
-    double tol_m;
-    double own_m;                  /* a return this near a segment's line is its own */
+    float tol_m;
+    float own_m;                  /* a return this near a segment's line is its own */
 } polyc__rays;
 
 /* The books of one change (a batch of edits) being recorded (score.c). */
@@ -38,21 +59,25 @@ typedef struct polyc__change {
 /* Trial evaluation's scratch (score.c; read by adjust.c and trial_costs.c). */
 typedef struct polyc__eval_scratch {
     int32_t *loc_pt;               /* points near the edited segments */
-    double *loc_base;              /* their cost without the edited segments */
+    float *loc_base;              /* their cost without the edited segments */
     int32_t *loc_seg;              /* and the segment giving it */
     int32_t loc_n;
     /* the listed points again, by field (when there are 8 to lsoa_cap of
      * them), so that a trial's costs are computed several at a time
      * (trial_costs.c): lsoa_n == loc_n when they are valid */
-    double *lsoa_x, *lsoa_y, *lsoa_w, *lsoa_cxx, *lsoa_cxy, *lsoa_cyy;
-    double *lsoa_c;
+    float *lsoa_x, *lsoa_y, *lsoa_w, *lsoa_cxx, *lsoa_cxy, *lsoa_cyy;
+    float *lsoa_c;
     int32_t lsoa_n, lsoa_cap;
-    double loc_fixed, loc_fixed_cur; /* pruned points: base and current sums */
+    float loc_fixed, loc_fixed_cur; /* pruned points: base and current sums */
     /* moving one vertex: points sure to stay in the interior of one of its
      * segments and nearest to it, whatever the move within reach, are
-     * summed as second moments about the segment's fixed end (agg_m: xx,
-     * xy, yy), so that a trial costs O(1) for them: listed in agg_pt, those
-     * of segment 0 from the front (agg_n[0]), of segment 1 from the back */
+     * summed as second moments about the segment's fixed end (agg_m: aa,
+     * ab, bb in the frame of the segment before the move: a along it, b
+     * across; agg_t: its direction), so that a trial costs O(1) for them:
+     * listed in agg_pt, those of segment 0 from the front (agg_n[0]), of
+     * segment 1 from the back. (In x and y, the small sum across a long
+     * wall is the difference of large ones: in float, a map of ten passes
+     * over a log lost it to rounding and kept 120 vertices for 68.) */
     int32_t *agg_pt, agg_cap, agg_n[2];
     /* the segments (other than the old ones) near the prepared region, for
      * the points whose own segment goes: cand_n < 0 not gathered yet,
@@ -63,7 +88,7 @@ typedef struct polyc__eval_scratch {
     float *cand_box;               /* per candidate: min x, min y, max x, max y */
     int agg_on;                    /* 0: no aggregation prepared */
     int agg_moving_b[2];           /* the moving end is the segment's b */
-    double agg_ax[2], agg_ay[2], agg_m[2][3];
+    float agg_ax[2], agg_ay[2], agg_tx[2], agg_ty[2], agg_m[2][3];
 } polyc__eval_scratch;
 
 /* Split and end trimming's scratch (operators.c): per segment offsets,
@@ -96,8 +121,8 @@ typedef struct polyc__data {
                                     * and single scans) */
     int32_t np;
     int32_t *pt_seg;               /* nearest segment (its start vertex) or NONE */
-    double *pt_cost;               /* capped cost of the point's endpoints */
-    double n, log_n;               /* BIC's n: every endpoint */
+    float *pt_cost;               /* capped cost of the point's endpoints */
+    float n, log_n;               /* BIC's n: every endpoint */
     float point_span_m;            /* side of the block a weighted point stands for */
     float support_m;               /* a point supports the map this near it: POLYC__SUPPORT_M,
                                     * or a point's span where that is wider (grids) */
@@ -108,7 +133,7 @@ typedef struct polyc__data {
 typedef struct polyc__policy {
     /* an occupancy grid: an iteration gains only if the BIC falls by more
      * than gain_share of it (0: by one unit) */
-    double gain_share;
+    float gain_share;
     /* flags (bytes: the policy rides on the optimiser's stack). A single scan's chains already join what its beam order joins: no
      * overlaps, merges, splits or zips (A, B, C), nor the polish of the
      * best map; they start with more than enough vertices: no additions
@@ -141,9 +166,9 @@ typedef struct polyc__opt {
     float *seg_side;               /* 2 per vertex: what its segment is seen from (zip.c) */
 
     /* model terms, kept incrementally */
-    double err;                    /* sum of pt_cost */
-    double angle;                  /* sum over vertices of (1 - p(turn | x, y)) */
-    double *acost;                 /* per vertex: 1 - p */
+    polyc__ksum err;               /* sum of pt_cost */
+    polyc__ksum angle;                             /* sum over vertices of (1 - p(turn | x, y)) */
+    float *acost;                 /* per vertex: 1 - p */
     polyc__prior prior;
     polyc__spacing spacing;        /* expected point spacing: the split scale */
     polyc__rays rays;              /* single-scan mode: the beams' free space */
@@ -253,7 +278,7 @@ void polyc__point_weigh(const polyc__prior *prior, polyc__point *p);
  * most cap; returns their count (-1: more than cap); tile_raw (by tile
  * storage index) gets each tile's endpoints */
 int32_t polyc__points_of_tiles(polyc__opt *o, const uint32_t *dirs, uint32_t nd, polyc__point *out,
-                               float *view, uint32_t *tile, int32_t cap, double *tile_raw);
+                               float *view, uint32_t *tile, int32_t cap, float *tile_raw);
 /* online: the points (in o->d), carved once (their unsorted copy is the
  * update's scratch, online.h) */
 int polyc__points_carve_online(polyc__arena *a, polyc__opt *o);
@@ -302,19 +327,20 @@ void polyc__segment_region(polyc__opt *o, float ax, float ay, float bx, float by
 
 /* A segment prepared for many cost evaluations (score.c). */
 typedef struct polyc__seg_pre {
-    double ax, ay, bx, by, dx, dy, inv_l2, nx, ny;
+    float ax, ay, bx, by, dx, dy, inv_l2, nx, ny;
 } polyc__seg_pre;
 
 /* trial_costs.c: c[k] = min(c[k], cost of listed point k on segment q) for
  * the lsoa_n points copied by field; the values of score.c's per-point cost */
-void polyc__trial_costs_min(const polyc__opt *o, const polyc__seg_pre *q, double *c);
+void polyc__trial_costs_min(const polyc__opt *o, const polyc__seg_pre *q, float *c);
 
 /* score.c */
 /* nearest segment within reach, skipping up to n_skip segments */
-double polyc__nearest(const polyc__opt *o, int32_t pi, const int32_t *skip, int n_skip,
+float polyc__nearest(const polyc__opt *o, int32_t pi, const int32_t *skip, int n_skip,
                       int32_t *seg);
-double polyc__vertex_angle_cost(const polyc__opt *o, int32_t v);
-double polyc__bic(const polyc__opt *o);
+float polyc__vertex_angle_cost(const polyc__opt *o, int32_t v);
+float polyc__bic(const polyc__opt *o);
+float polyc__err(const polyc__opt *o); /* the map's sum of squared distances */
 polyc_status polyc__rebuild(polyc__opt *o);          /* hash and assignment from scratch */
 /* recording a change: segments out before an edit, in after it */
 void polyc__chg_begin(polyc__opt *o);
@@ -330,12 +356,12 @@ void polyc__local_prepare(polyc__opt *o, const int32_t *old, int n_old, const fl
  * they are now; with aggregation */
 void polyc__local_prepare_move(polyc__opt *o, const int32_t *old, int n_old, const float *seg_xy,
                                int n_new, float reach, float mx, float my);
-double polyc__local_eval(const polyc__opt *o, const float *seg_xy, int n_new);
-double polyc__local_current(const polyc__opt *o);
+float polyc__local_eval(const polyc__opt *o, const float *seg_xy, int n_new);
+float polyc__local_current(const polyc__opt *o);
 /* the change of the error replacing `old` by seg_xy: exact below `limit`,
  * else some value >= limit */
-double polyc__local_delta(polyc__opt *o, const int32_t *old, int n_old, const float *seg_xy,
-                          int n_new, double limit);
+float polyc__local_delta(polyc__opt *o, const int32_t *old, int n_old, const float *seg_xy,
+                          int n_new, float limit);
 
 /* edits (operators.c): each records its change; call chg_begin/commit around */
 void polyc__op_move(polyc__opt *o, int32_t v, float x, float y);
@@ -376,11 +402,11 @@ void polyc__find_sides(polyc__opt *o, const int32_t *list, int32_t n, float *lef
  * right weights polyc__find_sides left in o->size.seg_sum and seg_w */
 int polyc__two_sided(const polyc__opt *o, int32_t sg);
 int polyc__op_zip(polyc__opt *o);
-void polyc__op_noise(polyc__opt *o, double sigma_m);
+void polyc__op_noise(polyc__opt *o, float sigma_m);
 int polyc__op_remove_vertices(polyc__opt *o, uint32_t since);
 /* the change of the BIC if v is removed when that is below `bound`, else
  * some value >= bound (INFINITY: always exact) */
-double polyc__removal_delta_below(polyc__opt *o, int32_t v, double bound);
+float polyc__removal_delta_below(polyc__opt *o, int32_t v, float bound);
 /* Squared distance from (px, py) to segment a-b. */
 inline float polyc__seg_dist2(float px, float py, float ax, float ay, float bx, float by)
 {
@@ -426,7 +452,7 @@ float polyc__ray_position(const polyc__rays *rays, float ax, float ay, float bx,
                           float px, float py, float projection);
 int polyc__op_add_vertices(polyc__opt *o, int max_tries);
 int polyc__hill_climb(polyc__opt *o, int32_t v);
-double polyc__turn_cost(const polyc__opt *o, float ax, float ay, float bx, float by, float cx,
+float polyc__turn_cost(const polyc__opt *o, float ax, float ay, float bx, float by, float cx,
                         float cy);
 
 #endif

@@ -34,9 +34,9 @@ static int endpoint_of(const polyc_ctx *ctx, const polyc__scan *s, uint32_t i, e
     return t && polyc__cell_holds_data(t, polyc__cell_index(e->ix, e->iy), ctx->cfg.data_min_m);
 }
 
-static float cell_centre(double origin, int32_t i, float cell)
+static float cell_centre(float origin, int32_t i, float cell)
 {
-    return (float)(origin + ((double)i + 0.5) * (double)cell);
+    return (float)(origin + ((float)i + 0.5f) * (float)cell);
 }
 
 /* Weighted points gather the endpoints of a block of 2 x 2 grid cells (5 cm
@@ -57,9 +57,9 @@ static void to_block(const endpoint *e, float cell, int32_t *bx, int32_t *by, fl
     *fy = e->fy + ((float)(e->iy - *by) - half) * cell;
 }
 
-static float block_centre(double origin, int32_t i, float cell)
+static float block_centre(float origin, int32_t i, float cell)
 {
-    return (float)(origin + ((double)i + 0.5 * BLOCK_SIDE) * (double)cell);
+    return (float)(origin + ((float)i + 0.5f * BLOCK_SIDE) * (float)cell);
 }
 
 /* Marks the blocks of tile t that hold data, from the counters (the grid
@@ -131,7 +131,7 @@ static uint32_t block_number(const polyc__tile *t, int32_t bx, int32_t by)
 static void finish_tile(const polyc_ctx *ctx, int32_t d, polyc__point *tmp)
 {
     const polyc__grid *g = &ctx->grid;
-    double ox = g->origin_x_m - ctx->frame_x, oy = g->origin_y_m - ctx->frame_y;
+    float ox = g->frame_ox, oy = g->frame_oy;
     const polyc__tile *t = &g->tiles[g->dir[d] - 1];
     int32_t tx = (d % g->tiles_x) << POLYC__TILE_SHIFT, ty = (d / g->tiles_x) << POLYC__TILE_SHIFT;
     uint32_t k = t->mark_base;
@@ -217,14 +217,14 @@ static polyc_status collect_cells(polyc__opt *o, polyc__point *tmp, float *view,
  * scans are not kept) into its marked blocks' points. A cell's offsets
  * move to its block's centre by (dx, dy): the sums of products gain the
  * cross terms. Returns the endpoints taken. */
-static double sum_tile(const polyc_ctx *ctx, int32_t d, polyc__point *tmp, float *view)
+static float sum_tile(const polyc_ctx *ctx, int32_t d, polyc__point *tmp, float *view)
 {
     const polyc__online *on = ctx->online;
     const polyc__grid *g = &ctx->grid;
     const float half = 0.5f * (float)(BLOCK_SIDE - 1);
     uint32_t k = g->dir[d] - 1;
     const polyc__tile *t = &g->tiles[k];
-    double raw = 0.0;
+    float raw = 0.0f;
     for (int idx = 0; idx < POLYC__TILE_CELLS; idx++) {
         if (!t->hits[idx] || !polyc__cell_holds_data(t, idx, ctx->cfg.data_min_m))
             continue;
@@ -246,7 +246,7 @@ static double sum_tile(const polyc_ctx *ctx, int32_t d, polyc__point *tmp, float
         p->cxx += c->fxx + 2.0f * dx * c->fx + w * dx * dx;
         p->cxy += c->fxy + dx * c->fy + dy * c->fx + w * dx * dy;
         p->cyy += c->fyy + 2.0f * dy * c->fy + w * dy * dy;
-        raw += (double)w;
+        raw += (float)w;
     }
     return raw;
 }
@@ -293,7 +293,7 @@ static polyc_status collect_sums(polyc__opt *o, polyc__point *tmp, float *view, 
 }
 
 int32_t polyc__points_of_tiles(polyc__opt *o, const uint32_t *dirs, uint32_t nd, polyc__point *out,
-                               float *view, uint32_t *tile, int32_t cap, double *tile_raw)
+                               float *view, uint32_t *tile, int32_t cap, float *tile_raw)
 {
     polyc_ctx *ctx = o->ctx;
     polyc__grid *g = &ctx->grid;
@@ -327,7 +327,7 @@ static polyc_status collect_raw(polyc__opt *o, polyc__point *tmp, float *view, i
 {
     polyc_ctx *ctx = o->ctx;
     polyc__grid *g = &ctx->grid;
-    double ox = g->origin_x_m - ctx->frame_x, oy = g->origin_y_m - ctx->frame_y;
+    float ox = g->frame_ox, oy = g->frame_oy;
     int32_t n = 0;
     endpoint e;
     for (uint32_t si = 0; si < ctx->scan_count; si++)
@@ -399,8 +399,8 @@ static polyc_status collect_occupied(polyc__opt *o, polyc__point *tmp, int32_t c
                 return polyc__fail(ctx, POLYC_ERR_NOMEM, "more data points than limits.max_points");
             polyc__point *p = &tmp[n++];
             memset(p, 0, sizeof *p);
-            p->x = cell_centre(0.0, ix, g->cell_m);
-            p->y = cell_centre(0.0, iy, g->cell_m);
+            p->x = cell_centre(0.0f, ix, g->cell_m);
+            p->y = cell_centre(0.0f, iy, g->cell_m);
             p->w = OCC_WEIGHT;
         }
     }
@@ -505,10 +505,10 @@ polyc_status polyc__points_collect(polyc__opt *o)
     polyc__hash *h = &o->h;
     int32_t nb = h->bx * h->by;
     memset(h->pt_start, 0, ((size_t)nb + 1) * sizeof(uint32_t));
-    double total = 0.0;
+    float total = 0.0f;
     for (int32_t i = 0; i < n; i++) {
         h->pt_start[polyc__bucket_of(h, tmp[i].x, tmp[i].y) + 1]++;
-        total += (double)tmp[i].w;
+        total += (float)tmp[i].w;
         polyc__point_weigh(&o->prior, &tmp[i]);
     }
     for (int32_t b = 0; b < nb; b++)
@@ -531,7 +531,7 @@ polyc_status polyc__points_collect(polyc__opt *o)
     o->d.np = n;
     o->d.n = total;
     polyc__points_spans(o, exact);
-    ctx->stats.data_points = (uint64_t)total;
+    ctx->stats.data_points = (uint32_t)total; /* (a count of returns, < 2^32) */
     ctx->stats.weighted_points = (uint32_t)n;
     return POLYC_OK;
 }

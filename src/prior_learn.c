@@ -63,8 +63,10 @@ static void endpoint(const prior_pass *q, uint32_t i, float *x, float *y, float 
     const polyc__scan *s = q->s;
     float rr = q->ctx->ranges[s->first + i];
     float a = s->theta_rad + s->start_rad + (float)i * s->step_rad;
-    *x = s->x_m + rr * cosf(a);
-    *y = s->y_m + rr * sinf(a);
+    float sn, cs;
+    polyc__sincosf(a, &sn, &cs);
+    *x = s->x_m + rr * cs;
+    *y = s->y_m + rr * sn;
     *r = rr;
 }
 

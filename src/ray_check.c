@@ -12,7 +12,7 @@
 #include <math.h>
 #include <string.h>
 
-#define TWO_PI 6.283185307179586
+#define TWO_PI 6.283185307179586f
 
 void polyc__rays_init(polyc__rays *rays, const polyc_ctx *ctx)
 {
@@ -22,34 +22,34 @@ void polyc__rays_init(polyc__rays *rays, const polyc_ctx *ctx)
     const polyc__scan *s = &ctx->scans[0];
     rays->x = s->x_m;
     rays->y = s->y_m;
-    rays->base = (double)s->theta_rad + (double)s->start_rad;
-    rays->step = (double)s->step_rad;
-    rays->step_cos = cos(rays->step);
-    rays->step_sin = sin(rays->step);
+    rays->base = (float)s->theta_rad + (float)s->start_rad;
+    rays->step = (float)s->step_rad;
+    rays->step_cos = polyc__cosf(rays->step);
+    rays->step_sin = polyc__sinf(rays->step);
     rays->count = (int32_t)s->count;
     rays->range = &ctx->ranges[s->first];
     rays->min_m = s->min_m;
     rays->max_m = s->max_m;
     /* beams per turn: indices that far apart are the same direction */
-    double per_turn = rays->step != 0.0 ? TWO_PI / fabs(rays->step) : 0.0;
-    rays->turn = per_turn < 1e9 ? (int32_t)lround(per_turn) : 0;
+    float per_turn = rays->step != 0.0f ? TWO_PI / fabsf(rays->step) : 0.0f;
+    rays->turn = per_turn < 1e9f ? (int32_t)lroundf(per_turn) : 0;
     rays->tol_m = POLYC__RAY_TOLERANCE_M;
-    rays->own_m = (double)ctx->cfg.search_radius_m;
+    rays->own_m = (float)ctx->cfg.search_radius_m;
 }
 
 /* Range along beam direction (c, s) from the origin to segment a-b, or
  * INFINITY if the beam misses it. */
-static double range_to(const polyc__rays *rays, double c, double sn, double ax, double ay,
-                       double bx, double by)
+static float range_to(const polyc__rays *rays, float c, float sn, float ax, float ay,
+                       float bx, float by)
 {
-    double ex = bx - ax, ey = by - ay;
-    double den = c * ey - sn * ex;
-    if (den == 0.0)
+    float ex = bx - ax, ey = by - ay;
+    float den = c * ey - sn * ex;
+    if (den == 0.0f)
         return INFINITY;
-    double qx = ax - rays->x, qy = ay - rays->y;
-    double t = (qx * ey - qy * ex) / den;  /* along the beam */
-    double u = (qx * sn - qy * c) / den;   /* along the segment */
-    return t > 0.0 && u >= 0.0 && u <= 1.0 ? t : (double)INFINITY;
+    float qx = ax - rays->x, qy = ay - rays->y;
+    float t = (qx * ey - qy * ex) / den;  /* along the beam */
+    float u = (qx * sn - qy * c) / den;   /* along the segment */
+    return t > 0.0f && u >= 0.0f && u <= 1.0f ? t : (float)INFINITY;
 }
 
 /* Where the beam through (px, py) crosses the line of segment a-b, in
@@ -58,18 +58,18 @@ static double range_to(const polyc__rays *rays, double c, double sn, double ax, 
 float polyc__ray_position(const polyc__rays *rays, float ax, float ay, float bx, float by,
                           float px, float py, float projection)
 {
-    double ex = (double)bx - (double)ax, ey = (double)by - (double)ay, len = sqrt(ex * ex + ey * ey);
-    double cx = (double)px - rays->x, cy = (double)py - rays->y, r = sqrt(cx * cx + cy * cy);
-    if (len <= 0.0 || r <= 0.0)
+    float ex = (float)bx - (float)ax, ey = (float)by - (float)ay, len = sqrtf(ex * ex + ey * ey);
+    float cx = (float)px - rays->x, cy = (float)py - rays->y, r = sqrtf(cx * cx + cy * cy);
+    if (len <= 0.0f || r <= 0.0f)
         return projection;
     ex /= len;
     ey /= len;
-    double den = cx * ey - cy * ex; /* r sin(incidence) */
-    if (fabs(den) < 0.05 * r)
+    float den = cx * ey - cy * ex; /* r sin(incidence) */
+    if (fabsf(den) < 0.05f * r)
         return projection;
-    double qx = (double)ax - rays->x, qy = (double)ay - rays->y;
-    double u = (qx * cy - qy * cx) / den;
-    return fabs(u - (double)projection) <= 0.5 ? (float)u : projection;
+    float qx = (float)ax - rays->x, qy = (float)ay - rays->y;
+    float u = (qx * cy - qy * cx) / den;
+    return fabsf(u - (float)projection) <= 0.5f ? (float)u : projection;
 }
 
 int polyc__edit_segments(const polyc__opt *o, const int32_t *segs, int n, float *old_xy)
@@ -100,11 +100,11 @@ typedef struct beam_query {
 
 /* Whether one of the n segments in xy meets beam (c, sn) within the
  * tolerance of range r. */
-static int met_by_any(const polyc__rays *rays, double c, double sn, float r, const float *xy, int n)
+static int met_by_any(const polyc__rays *rays, float c, float sn, float r, const float *xy, int n)
 {
     for (int k = 0; k < n; k++) {
         const float *e = xy + 4 * k;
-        if (fabs(range_to(rays, c, sn, e[0], e[1], e[2], e[3]) - (double)r) <= rays->tol_m)
+        if (fabsf(range_to(rays, c, sn, e[0], e[1], e[2], e[3]) - (float)r) <= rays->tol_m)
             return 1;
     }
     return 0;
@@ -116,23 +116,23 @@ static int met_by_any(const polyc__rays *rays, double c, double sn, float r, con
  * second rule a removal on a wall seen at a grazing angle can leave a
  * return 15-20 cm off the new line, and its beam then meets the map metres
  * behind it (freiburg-079: one beam 2 m off made most of the ray RMSE). */
-static int beam_blocked(const polyc__rays *rays, int32_t i, double c, double sn,
+static int beam_blocked(const polyc__rays *rays, int32_t i, float c, float sn,
                         const beam_query *q)
 {
     float r = rays->range[i];
     if (!(r >= rays->min_m && r < rays->max_m))
         return 0; /* no return: it proves nothing about a wall */
     float ax = q->ax, ay = q->ay, bx = q->bx, by = q->by;
-    double t = range_to(rays, c, sn, ax, ay, bx, by);
-    if (t < (double)r - rays->tol_m)
+    float t = range_to(rays, c, sn, ax, ay, bx, by);
+    if (t < (float)r - rays->tol_m)
         return 1;
-    if (isfinite(t) && t > (double)r + rays->tol_m) {
+    if (isfinite(t) && t > (float)r + rays->tol_m) {
         /* the return is in front of the segment: a misfit if it is near
          * enough to be the segment's own point (within the search radius
          * of its line) */
-        double px = rays->x + (double)r * c - (double)ax, py = rays->y + (double)r * sn - (double)ay;
-        double ex = (double)bx - (double)ax, ey = (double)by - (double)ay;
-        double cr = px * ey - py * ex;
+        float px = rays->x + (float)r * c - (float)ax, py = rays->y + (float)r * sn - (float)ay;
+        float ex = (float)bx - (float)ax, ey = (float)by - (float)ay;
+        float cr = px * ey - py * ex;
         if (cr * cr < rays->own_m * rays->own_m * (ex * ex + ey * ey))
             return 1;
         return met_by_any(rays, c, sn, r, q->others, q->n_others);
@@ -147,31 +147,31 @@ static int beam_blocked(const polyc__rays *rays, int32_t i, double c, double sn,
  * of each real log, f >= 0.999 and ray RMSE <= 34 mm. (Without beam_blocked's
  * rule, holding far or flat returns raised acapulco's ray RMSE from 115 to
  * 188 mm, with ends kept decimetres off along beams 25-40 m long.) */
-static int beam_own(const polyc__rays *rays, int32_t i, double c, double sn, const beam_query *q)
+static int beam_own(const polyc__rays *rays, int32_t i, float c, float sn, const beam_query *q)
 {
     float ax = q->ax, ay = q->ay, bx = q->bx, by = q->by;
     float r = rays->range[i];
     if (!(r >= rays->min_m && r < rays->max_m))
         return 0;
-    return fabs(range_to(rays, c, sn, ax, ay, bx, by) - (double)r) <= rays->tol_m;
+    return fabsf(range_to(rays, c, sn, ax, ay, bx, by) - (float)r) <= rays->tol_m;
 }
 
 /* A test of beam i, whose direction is (c, sn), against segment a-b. */
-typedef int (*beam_test)(const polyc__rays *rays, int32_t i, double c, double sn,
+typedef int (*beam_test)(const polyc__rays *rays, int32_t i, float c, float sn,
                          const beam_query *q);
 
 /* The direction of (x, y) in (-pi, pi], to within 2e-6 rad (polyc__turn_rad:
  * libm's atan2 would take a tenth of the ray checks' time) */
-static double angle_of(double x, double y)
+static float angle_of(float x, float y)
 {
-    double a = (double)polyc__turn_rad((float)y, (float)x);
-    return y < 0.0 ? -a : a;
+    float a = (float)polyc__turn_rad((float)y, (float)x);
+    return y < 0.0f ? -a : a;
 }
 
 /* d wrapped into [-pi, pi] */
-static double wrap(double d)
+static float wrap(float d)
 {
-    return d - TWO_PI * floor(d / TWO_PI + 0.5);
+    return d - TWO_PI * floorf(d / TWO_PI + 0.5f);
 }
 
 /* Whether `test` holds for some beam whose direction crosses segment a-b.
@@ -180,33 +180,34 @@ static double wrap(double d)
 static int any_beam(const polyc__rays *rays, const beam_query *q, beam_test test)
 {
     float ax = q->ax, ay = q->ay, bx = q->bx, by = q->by;
-    if (!rays->on || rays->step == 0.0)
+    if (!rays->on || rays->step == 0.0f)
         return 0;
-    double ta = angle_of((double)ax - rays->x, (double)ay - rays->y);
-    double tb = angle_of((double)bx - rays->x, (double)by - rays->y);
+    float ta = angle_of((float)ax - rays->x, (float)ay - rays->y);
+    float tb = angle_of((float)bx - rays->x, (float)by - rays->y);
     /* beam index space: the segment covers [ia, ib] the short way round,
      * widened by a hundredth of a beam for the angles' error (a beam that
      * does not cross the segment passes every test) */
-    double ia = wrap(ta - rays->base) / rays->step;
-    double span = wrap(tb - ta) / rays->step;
-    double lo = span < 0.0 ? ia + span : ia, hi = span < 0.0 ? ia : ia + span;
-    lo -= 0.01;
-    hi += 0.01;
+    float ia = wrap(ta - rays->base) / rays->step;
+    float span = wrap(tb - ta) / rays->step;
+    float lo = span < 0.0f ? ia + span : ia, hi = span < 0.0f ? ia : ia + span;
+    lo -= 0.01f;
+    hi += 0.01f;
     /* lo, hi lie in [-turn, turn]: beam i is index i, i - turn or i + turn
      * (bounded by the beam count, however fine the step) */
     int32_t offsets[3] = {0, rays->turn, -rays->turn};
     for (int k = 0; k < (rays->turn > 0 ? 3 : 1); k++) {
-        double from = ceil(lo), to = (double)offsets[k] + (double)rays->count - 1.0;
-        from = from > (double)offsets[k] ? from : (double)offsets[k];
+        float from = ceilf(lo), to = (float)offsets[k] + (float)rays->count - 1.0f;
+        from = from > (float)offsets[k] ? from : (float)offsets[k];
         to = hi < to ? hi : to;
         if (!(from <= to))
             continue;
-        double a = rays->base + (from - (double)offsets[k]) * rays->step;
-        double c = cos(a), sn = sin(a);
-        for (double at = from; at <= to; at += 1.0) {
+        float a = rays->base + (from - (float)offsets[k]) * rays->step;
+        float c, sn;
+        polyc__sincosf(a, &sn, &c);
+        for (float at = from; at <= to; at += 1.0f) {
             if (test(rays, (int32_t)at - offsets[k], c, sn, q))
                 return 1;
-            double next_c = c * rays->step_cos - sn * rays->step_sin;
+            float next_c = c * rays->step_cos - sn * rays->step_sin;
             sn = sn * rays->step_cos + c * rays->step_sin;
             c = next_c;
         }
@@ -223,7 +224,7 @@ int polyc__blocks_beams(const polyc__rays *rays, float ax, float ay, float bx, f
 
 /* Beam i is blocked by the query's (new) segment and by none of the old
  * segments (the query's others): a block the edit adds. */
-static int beam_newly_blocked(const polyc__rays *rays, int32_t i, double c, double sn,
+static int beam_newly_blocked(const polyc__rays *rays, int32_t i, float c, float sn,
                               const beam_query *q)
 {
     if (!beam_blocked(rays, i, c, sn, q))
@@ -278,7 +279,7 @@ int polyc__holds_returns(const polyc__rays *rays, float ax, float ay, float bx, 
 
 /* A return the query's (old) segment holds that none of the new segments
  * (the query's others) meets within the tolerance. */
-static int beam_lost(const polyc__rays *rays, int32_t i, double c, double sn, const beam_query *q)
+static int beam_lost(const polyc__rays *rays, int32_t i, float c, float sn, const beam_query *q)
 {
     return beam_own(rays, i, c, sn, q) &&
            !met_by_any(rays, c, sn, rays->range[i], q->others, q->n_others);

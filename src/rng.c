@@ -12,17 +12,19 @@ uint64_t polyc__rng_next(polyc__rng *r)
     return z ^ (z >> 31);
 }
 
-double polyc__rng_uniform(polyc__rng *r)
+float polyc__rng_uniform(polyc__rng *r)
 {
-    return (double)(polyc__rng_next(r) >> 11) * (1.0 / 9007199254740992.0);
+    /* 24 bits, a float's mantissa: exact, and a 32-bit conversion (one
+     * instruction on an FPU; a 64-bit one is a software call) */
+    return (float)(uint32_t)(polyc__rng_next(r) >> 40) * (1.0f / 16777216.0f);
 }
 
 /* Box-Muller; one value per call keeps the state simple. */
-double polyc__rng_normal(polyc__rng *r)
+float polyc__rng_normal(polyc__rng *r)
 {
-    double u1 = polyc__rng_uniform(r);
-    double u2 = polyc__rng_uniform(r);
-    if (u1 < 1e-300)
-        u1 = 1e-300;
-    return sqrt(-2.0 * log(u1)) * cos(6.283185307179586 * u2);
+    float u1 = polyc__rng_uniform(r);
+    float u2 = polyc__rng_uniform(r);
+    if (u1 <= 0.0f)
+        u1 = 1.0f / 33554432.0f; /* 2^-25: half the smallest step */
+    return sqrtf(-2.0f * polyc__logf(u1)) * polyc__cosf(6.283185307179586f * u2);
 }

@@ -117,9 +117,9 @@ static void fit(const chains *c, int32_t i, int32_t j, fitted *f)
             xy += ex * ey;
             yy += ey * ey;
         }
-    float a = 0.5f * atan2f(2.0f * xy, xx - yy);
-    f->dx = cosf(a);
-    f->dy = sinf(a);
+    float a = 0.5f * polyc__atan2f(2.0f * xy, xx - yy);
+    f->dx = polyc__cosf(a);
+    f->dy = polyc__sinf(a);
     float bx = f->cx - c->ox, by = f->cy - c->oy, r = sqrtf(bx * bx + by * by);
     if (r <= 0.0f)
         return;
@@ -325,8 +325,8 @@ static int links(const chains *c, const open_chain *h, int32_t i, int32_t n)
             return 0;
     }
     float dphi = c->step; /* each beam between widens the reach by a step */
-    float reach = (float)(i - last) * c->range[last] * sinf(dphi) /
-                      sinf(polyc__maxf(LAMBDA_RAD - dphi, 0.01f)) +
+    float reach = (float)(i - last) * c->range[last] * polyc__sinf(dphi) /
+                      polyc__sinf(polyc__maxf(LAMBDA_RAD - dphi, 0.01f)) +
                   2.0f * c->ctx->cfg.cell_m;
     float d2 = dx * dx + dy * dy;
     if (missing < MAX_SKIP_NEAR && d2 <= reach * reach)
@@ -371,14 +371,16 @@ polyc_status polyc__chains_build(polyc_ctx *ctx)
     int32_t returns = 0;
     for (int32_t i = 0; i < n; i++)
         returns += is_hit(s, r[i]);
-    c.log_n = logf(returns > 1 ? (float)returns : 1.0f);
+    c.log_n = polyc__logf(returns > 1 ? (float)returns : 1.0f);
     for (int32_t i = 0; i < n; i++) {
         float a = s->theta_rad + s->start_rad + (float)i * s->step_rad;
         c.chain_of[i] = 0;
         c.xy[2 * i] = c.xy[2 * i + 1] = NAN;
         if (is_hit(s, r[i])) {
-            c.xy[2 * i] = c.ox + r[i] * cosf(a);
-            c.xy[2 * i + 1] = c.oy + r[i] * sinf(a);
+            float sn, cs;
+            polyc__sincosf(a, &sn, &cs);
+            c.xy[2 * i] = c.ox + r[i] * cs;
+            c.xy[2 * i + 1] = c.oy + r[i] * sn;
         }
     }
     /* chains: hits linked to the last hit of an open chain */

@@ -11,7 +11,7 @@
 /* the external definitions of trial.h's inline functions (C99: used
  * where a caller does not inline them, as at -Os) */
 extern inline void polyc__seg_prepare(polyc__seg_pre *q, const float *xy);
-extern inline double polyc__seg_pre_cost(const polyc__seg_pre *q, const polyc__point *p);
+extern inline float polyc__seg_pre_cost(const polyc__seg_pre *q, const polyc__point *p);
 extern inline polyc__old_set polyc__old_set_of(const int32_t *old, int n_old);
 extern inline int polyc__is_old(const polyc__old_set *s, int32_t seg);
 
@@ -44,37 +44,37 @@ int polyc__eval_carve(polyc__arena *a, polyc__eval_scratch *ev, int32_t P, int32
  * only if it is nearer than the best cost so far allows: a segment is
  * entered in every bucket it crosses, so one within distance D of the point
  * crosses a bucket within D of it, and its cost is at least w D^2. */
-double polyc__nearest_below(const polyc__opt *o, int32_t pi, const int32_t *skip, int n_skip,
-                            double start, int32_t *seg)
+float polyc__nearest_below(const polyc__opt *o, int32_t pi, const int32_t *skip, int n_skip,
+                            float start, int32_t *seg)
 {
     static const int8_t ORDER[9][2] = {{0, 0}, {-1, 0}, {1, 0}, {0, -1}, {0, 1},
                                        {-1, -1}, {1, -1}, {-1, 1}, {1, 1}};
     const polyc__hash *h = &o->h;
     const polyc__point *p = &o->d.pts[pi];
-    double best = start, w = (double)p->w;
+    float best = start, w = (float)p->w;
     int32_t best_seg = POLYC__NONE;
     int32_t bx, by;
     polyc__bucket_xy(h, p->x, p->y, &bx, &by);
     /* distances to the bucket's four sides (0 if outside that side) */
-    double fx = ((double)p->x - (double)h->origin_x) - (double)bx * (double)h->bucket_m;
-    double fy = ((double)p->y - (double)h->origin_y) - (double)by * (double)h->bucket_m;
-    double side[2][3];
-    side[0][0] = fx > 0.0 ? fx : 0.0;
-    side[0][1] = 0.0;
-    side[0][2] = (double)h->bucket_m - fx > 0.0 ? (double)h->bucket_m - fx : 0.0;
-    side[1][0] = fy > 0.0 ? fy : 0.0;
-    side[1][1] = 0.0;
-    side[1][2] = (double)h->bucket_m - fy > 0.0 ? (double)h->bucket_m - fy : 0.0;
-    double near = side[0][0];
+    float fx = ((float)p->x - (float)h->origin_x) - (float)bx * (float)h->bucket_m;
+    float fy = ((float)p->y - (float)h->origin_y) - (float)by * (float)h->bucket_m;
+    float side[2][3];
+    side[0][0] = fx > 0.0f ? fx : 0.0f;
+    side[0][1] = 0.0f;
+    side[0][2] = (float)h->bucket_m - fx > 0.0f ? (float)h->bucket_m - fx : 0.0f;
+    side[1][0] = fy > 0.0f ? fy : 0.0f;
+    side[1][1] = 0.0f;
+    side[1][2] = (float)h->bucket_m - fy > 0.0f ? (float)h->bucket_m - fy : 0.0f;
+    float near = side[0][0];
     for (int k = 1; k < 4; k++) {
-        double g = side[k >> 1][k & 1 ? 2 : 0];
+        float g = side[k >> 1][k & 1 ? 2 : 0];
         near = g < near ? g : near;
     }
     for (int k = 0; k < 9; k++) {
         /* the own bucket done: no neighbour is nearer than its nearest side */
         if (k == 1 && w * near * near >= best)
             break;
-        double sx = side[0][ORDER[k][0] + 1], sy = side[1][ORDER[k][1] + 1];
+        float sx = side[0][ORDER[k][0] + 1], sy = side[1][ORDER[k][1] + 1];
         if (w * (sx * sx + sy * sy) >= best)
             continue;
         int32_t x = bx + ORDER[k][0], y = by + ORDER[k][1];
@@ -87,7 +87,7 @@ double polyc__nearest_below(const polyc__opt *o, int32_t pi, const int32_t *skip
                 skipped |= skip[j] == sg;
             if (skipped)
                 continue;
-            double c = polyc__cost_seg(o, p, sg);
+            float c = polyc__cost_seg(o, p, sg);
             if (c < best) {
                 best = c;
                 best_seg = sg;
@@ -99,7 +99,7 @@ double polyc__nearest_below(const polyc__opt *o, int32_t pi, const int32_t *skip
     return best;
 }
 
-double polyc__nearest(const polyc__opt *o, int32_t pi, const int32_t *skip, int n_skip,
+float polyc__nearest(const polyc__opt *o, int32_t pi, const int32_t *skip, int n_skip,
                       int32_t *seg)
 {
     return polyc__nearest_below(o, pi, skip, n_skip, polyc__point_cap(o, &o->d.pts[pi]), seg);
@@ -109,29 +109,29 @@ double polyc__nearest(const polyc__opt *o, int32_t pi, const int32_t *skip, int 
 
 /* A segment's start, direction and squared length, for point_seg_dist. */
 typedef struct seg_span {
-    double ax, ay, dx, dy, l2;
+    float ax, ay, dx, dy, l2;
 } seg_span;
 
 static seg_span seg_span_of(const float *xy)
 {
     seg_span q;
-    q.ax = (double)xy[0];
-    q.ay = (double)xy[1];
-    q.dx = (double)xy[2] - (double)xy[0];
-    q.dy = (double)xy[3] - (double)xy[1];
+    q.ax = (float)xy[0];
+    q.ay = (float)xy[1];
+    q.dx = (float)xy[2] - (float)xy[0];
+    q.dy = (float)xy[3] - (float)xy[1];
     q.l2 = q.dx * q.dx + q.dy * q.dy;
     return q;
 }
 
-static double point_seg_dist(const polyc__point *p, const seg_span *q)
+static float point_seg_dist(const polyc__point *p, const seg_span *q)
 {
-    double dx = q->dx, dy = q->dy;
-    double mx = (double)p->x - q->ax, my = (double)p->y - q->ay;
-    double l2 = q->l2;
-    double t = l2 > 1e-18 ? (mx * dx + my * dy) / l2 : 0.0;
-    t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
-    double ex = mx - t * dx, ey = my - t * dy;
-    return sqrt(ex * ex + ey * ey);
+    float dx = q->dx, dy = q->dy;
+    float mx = (float)p->x - q->ax, my = (float)p->y - q->ay;
+    float l2 = q->l2;
+    float t = l2 > 1e-18f ? (mx * dx + my * dy) / l2 : 0.0f;
+    t = t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
+    float ex = mx - t * dx, ey = my - t * dy;
+    return sqrtf(ex * ex + ey * ey);
 }
 
 /* Can a move of the shared end c (by at most rho) take point p out of the
@@ -141,23 +141,23 @@ static double point_seg_dist(const polyc__point *p, const seg_span *q)
  * than the bound either, the point can join the segment's moments. d_own
  * and d_other are the distances of p to this segment and to the other
  * moving one (1e30 if none). Returns 0 if the point may leave. */
-static double stay_bound(const polyc__point *p, double ax, double ay, double cx, double cy,
-                         double rho, double d_own, double d_other)
+static float stay_bound(const polyc__point *p, float ax, float ay, float cx, float cy,
+                         float rho, float d_own, float d_other)
 {
-    double px = (double)p->x, py = (double)p->y;
-    double ux = cx - ax, uy = cy - ay, pax = px - ax, pay = py - ay;
+    float px = (float)p->x, py = (float)p->y;
+    float ux = cx - ax, uy = cy - ay, pax = px - ax, pay = py - ay;
     /* projection after the end at a: (p-a).(c-a) > 0 for all |dc| <= rho */
-    if (pax * ux + pay * uy - sqrt(pax * pax + pay * pay) * rho <= 0.0)
-        return 0.0;
+    if (pax * ux + pay * uy - sqrtf(pax * pax + pay * pay) * rho <= 0.0f)
+        return 0.0f;
     /* before the end at c: (c-p).(c-a) >= (c0-p).(c0-a) - rho |2c0-p-a| */
-    double cpx = cx - px, cpy = cy - py, sx = cpx + ux, sy = cpy + uy;
-    if (cpx * ux + cpy * uy - rho * sqrt(sx * sx + sy * sy) <= 0.0)
-        return 0.0;
+    float cpx = cx - px, cpy = cy - py, sx = cpx + ux, sy = cpy + uy;
+    if (cpx * ux + cpy * uy - rho * sqrtf(sx * sx + sy * sy) <= 0.0f)
+        return 0.0f;
     /* its cost here is at most w (d + rho)^2 + trace(C), the other's at
      * least w (d' - rho)^2 */
-    double w = (double)p->w, up = d_own + rho, lo = d_other - rho;
-    double worst = w * up * up + ((double)p->cxx + (double)p->cyy);
-    return lo > 0.0 && worst < w * lo * lo ? worst : 0.0;
+    float w = (float)p->w, up = d_own + rho, lo = d_other - rho;
+    float worst = w * up * up + ((float)p->cxx + (float)p->cyy);
+    return lo > 0.0f && worst < w * lo * lo ? worst : 0.0f;
 }
 
 /* The candidates of the points whose own segment goes: the segments other
@@ -214,23 +214,23 @@ static void gather_around(polyc__opt *o, int32_t b)
 
 /* nearest_below over the gathered candidates: the same segments it would
  * look at, and a box test instead of the bucket walk. */
-static double nearest_candidate(const polyc__opt *o, int32_t pi, double start, int32_t *seg)
+static float nearest_candidate(const polyc__opt *o, int32_t pi, float start, int32_t *seg)
 {
     const polyc__point *p = &o->d.pts[pi];
-    double best = start, w = (double)p->w;
+    float best = start, w = (float)p->w;
     int32_t best_seg = POLYC__NONE;
     for (int32_t k = 0; k < o->ev.cand_n; k++) {
         const float *box = o->ev.cand_box + 4 * k;
         /* distance to the box, a lower bound of the segment's: differences
          * of floats are exact in double, so the bound is never too high */
-        double px = (double)p->x, py = (double)p->y;
-        double gx = (double)box[0] - px > px - (double)box[2] ? (double)box[0] - px : px - (double)box[2];
-        double gy = (double)box[1] - py > py - (double)box[3] ? (double)box[1] - py : py - (double)box[3];
-        gx = gx > 0.0 ? gx : 0.0;
-        gy = gy > 0.0 ? gy : 0.0;
-        if (0.999 * w * (gx * gx + gy * gy) >= best)
+        float px = (float)p->x, py = (float)p->y;
+        float gx = (float)box[0] - px > px - (float)box[2] ? (float)box[0] - px : px - (float)box[2];
+        float gy = (float)box[1] - py > py - (float)box[3] ? (float)box[1] - py : py - (float)box[3];
+        gx = gx > 0.0f ? gx : 0.0f;
+        gy = gy > 0.0f ? gy : 0.0f;
+        if (0.999f * w * (gx * gx + gy * gy) >= best)
             continue;
-        double c = polyc__cost_seg(o, p, o->ev.cand_seg[k]);
+        float c = polyc__cost_seg(o, p, o->ev.cand_seg[k]);
         if (c < best) {
             best = c;
             best_seg = o->ev.cand_seg[k];
@@ -250,17 +250,23 @@ static void agg_begin(polyc__eval_scratch *ev, int move, const float *seg_xy, in
     ev->agg_on = move && n_new <= 2;
     ev->agg_n[0] = ev->agg_n[1] = 0;
     for (int j = 0; j < 2; j++) {
-        ev->agg_m[j][0] = ev->agg_m[j][1] = ev->agg_m[j][2] = 0.0;
+        ev->agg_m[j][0] = ev->agg_m[j][1] = ev->agg_m[j][2] = 0.0f;
         ev->agg_moving_b[j] = 0;
-        ev->agg_ax[j] = ev->agg_ay[j] = 0.0;
+        ev->agg_ax[j] = ev->agg_ay[j] = 0.0f;
+        ev->agg_tx[j] = 1.0f;
+        ev->agg_ty[j] = 0.0f;
     }
     if (ev->agg_on)
         for (int j = 0; j < n_new; j++) {
             const float *q = seg_xy + 4 * j;
             int b = q[2] == mx && q[3] == my;
             ev->agg_moving_b[j] = b;
-            ev->agg_ax[j] = (double)(b ? q[0] : q[2]);
-            ev->agg_ay[j] = (double)(b ? q[1] : q[3]);
+            ev->agg_ax[j] = (float)(b ? q[0] : q[2]);
+            ev->agg_ay[j] = (float)(b ? q[1] : q[3]);
+            float tx = (b ? q[2] : q[0]) - ev->agg_ax[j], ty = (b ? q[3] : q[1]) - ev->agg_ay[j];
+            float len = sqrtf(tx * tx + ty * ty);
+            ev->agg_tx[j] = len > 0.0f ? tx / len : 1.0f;
+            ev->agg_ty[j] = len > 0.0f ? ty / len : 0.0f;
         }
 }
 
@@ -273,12 +279,12 @@ static void copy_listed(polyc__opt *o)
     if (o->ev.loc_n >= 8 && o->ev.loc_n <= o->ev.lsoa_cap) {
         for (int32_t k = 0; k < o->ev.loc_n; k++) {
             const polyc__point *p = &o->d.pts[o->ev.loc_pt[k]];
-            o->ev.lsoa_x[k] = (double)p->x;
-            o->ev.lsoa_y[k] = (double)p->y;
-            o->ev.lsoa_w[k] = (double)p->w;
-            o->ev.lsoa_cxx[k] = (double)p->cxx;
-            o->ev.lsoa_cxy[k] = (double)p->cxy;
-            o->ev.lsoa_cyy[k] = (double)p->cyy;
+            o->ev.lsoa_x[k] = (float)p->x;
+            o->ev.lsoa_y[k] = (float)p->y;
+            o->ev.lsoa_w[k] = (float)p->w;
+            o->ev.lsoa_cxx[k] = (float)p->cxx;
+            o->ev.lsoa_cxy[k] = (float)p->cxy;
+            o->ev.lsoa_cyy[k] = (float)p->cyy;
         }
         o->ev.lsoa_n = o->ev.loc_n;
     }
@@ -313,8 +319,8 @@ static void prepare(polyc__opt *o, const int32_t *old, int n_old, const float *s
     }
     o->ev.cand_n = -1;
     o->ev.loc_n = 0;
-    o->ev.loc_fixed = 0.0;
-    o->ev.loc_fixed_cur = 0.0;
+    o->ev.loc_fixed = 0.0f;
+    o->ev.loc_fixed_cur = 0.0f;
     agg_begin(&o->ev, move, seg_xy, n_new, mx, my);
     for (int32_t k = 0; k < o->chg.bucket_n; k++) {
         int32_t b = o->chg.bucket_list[k];
@@ -322,33 +328,33 @@ static void prepare(polyc__opt *o, const int32_t *old, int n_old, const float *s
             int32_t seg = o->d.pt_seg[i];
             int hit = polyc__is_old(&olds, seg);
             int32_t base_seg = seg;
-            double base = o->d.pt_cost[i];
+            float base = o->d.pt_cost[i];
             const polyc__point *p = &o->d.pts[i];
-            double d[2] = {1e30, 1e30};
+            float d[2] = {1e30f, 1e30f};
             if (reach > 0.0f) {
-                double dmin = 1e30;
+                float dmin = 1e30f;
                 for (int j = 0; j < n_new; j++) {
-                    double dj = point_seg_dist(p, &span[j]);
+                    float dj = point_seg_dist(p, &span[j]);
                     if (j < 2)
                         d[j] = dj;
                     if (dj < dmin)
                         dmin = dj;
                 }
-                dmin -= (double)reach;
-                if (!hit && dmin > 0.0 && base <= (double)p->w * dmin * dmin) {
+                dmin -= (float)reach;
+                if (!hit && dmin > 0.0f && base <= (float)p->w * dmin * dmin) {
                     o->ev.loc_fixed += base;
                     o->ev.loc_fixed_cur += o->d.pt_cost[i];
                     continue;
                 }
             }
             int j = n_new == 2 && d[1] < d[0];
-            double bound = o->ev.agg_on ? stay_bound(p, o->ev.agg_ax[j], o->ev.agg_ay[j], (double)mx,
-                                                  (double)my, (double)reach, d[j], d[1 - j])
-                                     : 0.0;
+            float bound = o->ev.agg_on ? stay_bound(p, o->ev.agg_ax[j], o->ev.agg_ay[j], (float)mx,
+                                                  (float)my, (float)reach, d[j], d[1 - j])
+                                     : 0.0f;
             if (hit) {
                 /* without the old segments: a query within the bound is
                  * enough to tell that the point stays (most do) */
-                double cap = polyc__point_cap(o, p), start = bound > 0.0 && bound < cap ? bound : cap;
+                float cap = polyc__point_cap(o, p), start = bound > 0.0f && bound < cap ? bound : cap;
                 if (o->ev.cand_n < 0)
                     gather_start(o, old, n_old);
                 if (o->ev.cand_n >= 0 && o->ev.cand_n <= POLYC__CAND_MAX)
@@ -357,20 +363,26 @@ static void prepare(polyc__opt *o, const int32_t *old, int n_old, const float *s
                            ? nearest_candidate(o, (int32_t)i, start, &base_seg)
                            : polyc__nearest_below(o, (int32_t)i, old, n_old, start, &base_seg);
                 if (base_seg != POLYC__NONE)
-                    bound = 0.0;
-                else if (bound > 0.0 && bound < cap)
+                    bound = 0.0f;
+                else if (bound > 0.0f && bound < cap)
                     base = cap; /* unknown but irrelevant: the point stays */
                 else
-                    bound = 0.0;
+                    bound = 0.0f;
             } else if (bound >= base) {
-                bound = 0.0;
+                bound = 0.0f;
             }
-            if (bound > 0.0) {
-                double dx = (double)p->x - o->ev.agg_ax[j], dy = (double)p->y - o->ev.agg_ay[j];
-                double w = (double)p->w;
-                o->ev.agg_m[j][0] += w * dx * dx + (double)p->cxx;
-                o->ev.agg_m[j][1] += w * dx * dy + (double)p->cxy;
-                o->ev.agg_m[j][2] += w * dy * dy + (double)p->cyy;
+            if (bound > 0.0f) {
+                /* in the segment's frame: a along, b across (its C turned too) */
+                float tx = o->ev.agg_tx[j], ty = o->ev.agg_ty[j];
+                float dx = p->x - o->ev.agg_ax[j], dy = p->y - o->ev.agg_ay[j];
+                float a = dx * tx + dy * ty, bn = dy * tx - dx * ty, w = p->w;
+                float txy = tx * ty, c2 = tx * tx - ty * ty;
+                float caa = tx * tx * p->cxx + 2.0f * txy * p->cxy + ty * ty * p->cyy;
+                float cab = txy * (p->cyy - p->cxx) + c2 * p->cxy;
+                float cbb = ty * ty * p->cxx - 2.0f * txy * p->cxy + tx * tx * p->cyy;
+                o->ev.agg_m[j][0] += w * a * a + caa;
+                o->ev.agg_m[j][1] += w * a * bn + cab;
+                o->ev.agg_m[j][2] += w * bn * bn + cbb;
                 int32_t slot = j == 0 ? o->ev.agg_n[0] : o->ev.agg_cap - 1 - o->ev.agg_n[1];
                 o->ev.agg_pt[slot] = (int32_t)i;
                 o->ev.agg_n[j]++;
@@ -399,25 +411,27 @@ void polyc__local_prepare_move(polyc__opt *o, const int32_t *old, int n_old, con
     prepare(o, old, n_old, seg_xy, n_new, reach, 1, mx, my);
 }
 
-double polyc__local_eval(const polyc__opt *o, const float *seg_xy, int n_new)
+float polyc__local_eval(const polyc__opt *o, const float *seg_xy, int n_new)
 {
     polyc__seg_pre q[4];
     POLYC_ASSERT(n_new <= 4);
     for (int j = 0; j < n_new; j++)
         polyc__seg_prepare(&q[j], seg_xy + 4 * j);
-    double sum = o->ev.loc_fixed;
+    float sum = o->ev.loc_fixed;
     if (o->ev.agg_on)
         for (int j = 0; j < n_new; j++) {
             if (o->ev.agg_n[j] == 0)
                 continue;
             /* n'Mn with n the unit normal of the segment from its fixed end */
             const float *e = seg_xy + 4 * j + (o->ev.agg_moving_b[j] ? 2 : 0);
-            double ux = (double)e[0] - o->ev.agg_ax[j], uy = (double)e[1] - o->ev.agg_ay[j];
-            const double *m = o->ev.agg_m[j];
-            sum += (m[0] * uy * uy - 2.0 * m[1] * ux * uy + m[2] * ux * ux) / (ux * ux + uy * uy);
+            float dx = e[0] - o->ev.agg_ax[j], dy = e[1] - o->ev.agg_ay[j];
+            float tx = o->ev.agg_tx[j], ty = o->ev.agg_ty[j];
+            float ux = dx * tx + dy * ty, uy = dy * tx - dx * ty; /* (the moments' frame) */
+            const float *m = o->ev.agg_m[j];
+            sum += (m[0] * uy * uy - 2.0f * m[1] * ux * uy + m[2] * ux * ux) / (ux * ux + uy * uy);
         }
     if (o->ev.lsoa_n == o->ev.loc_n) {
-        double *c = o->ev.lsoa_c;
+        float *c = o->ev.lsoa_c;
         for (int32_t k = 0; k < o->ev.loc_n; k++)
             c[k] = o->ev.loc_base[k];
         for (int j = 0; j < n_new; j++)
@@ -429,9 +443,9 @@ double polyc__local_eval(const polyc__opt *o, const float *seg_xy, int n_new)
     }
     for (int32_t k = 0; k < o->ev.loc_n; k++) {
         const polyc__point *p = &o->d.pts[o->ev.loc_pt[k]];
-        double c = o->ev.loc_base[k];
+        float c = o->ev.loc_base[k];
         for (int j = 0; j < n_new; j++) {
-            double cj = polyc__seg_pre_cost(&q[j], p);
+            float cj = polyc__seg_pre_cost(&q[j], p);
             if (cj < c)
                 c = cj;
         }
@@ -440,9 +454,9 @@ double polyc__local_eval(const polyc__opt *o, const float *seg_xy, int n_new)
     return sum;
 }
 
-double polyc__local_current(const polyc__opt *o)
+float polyc__local_current(const polyc__opt *o)
 {
-    double sum = o->ev.loc_fixed_cur;
+    float sum = o->ev.loc_fixed_cur;
     for (int32_t k = 0; k < o->ev.loc_n; k++)
         sum += o->d.pt_cost[o->ev.loc_pt[k]];
     return sum;

@@ -82,8 +82,8 @@ polyc_status polyc__spacing_build(polyc_ctx *ctx, polyc__spacing *sp)
     sp->w = g->tiles_x;
     sp->h = g->tiles_y;
     sp->tile_m = g->cell_m * (float)POLYC__TILE_SIDE;
-    sp->origin_x = (float)(g->origin_x_m - ctx->frame_x);
-    sp->origin_y = (float)(g->origin_y_m - ctx->frame_y);
+    sp->origin_x = g->frame_ox;
+    sp->origin_y = g->frame_oy;
     sp->min_step_rad = 0.0f;
     sp->dist = NULL;
     sp->poses = NULL;

@@ -85,14 +85,14 @@ int polyc__hash_lay_out(polyc__opt *o, polyc__arena *a)
     float h_m = (float)g->height * g->cell_m + 2.0f * HASH_MARGIN_M;
     /* at least the search radius plus the reach of one hill-climbing round */
     float b = o->R + POLYC__CLIMB_REACH_M;
-    while ((double)ceilf(w_m / b) * (double)ceilf(h_m / b) > (double)cap)
+    while ((float)ceilf(w_m / b) * (float)ceilf(h_m / b) > (float)cap)
         b *= 1.25f;
     h->bucket_m = b;
     h->inv_bucket = 1.0f / b;
     h->bx = (int32_t)ceilf(w_m / b);
     h->by = (int32_t)ceilf(h_m / b);
-    h->origin_x = (float)(g->origin_x_m - ctx->frame_x) - HASH_MARGIN_M;
-    h->origin_y = (float)(g->origin_y_m - ctx->frame_y) - HASH_MARGIN_M;
+    h->origin_x = g->frame_ox - HASH_MARGIN_M;
+    h->origin_y = g->frame_oy - HASH_MARGIN_M;
     size_t nb = (size_t)h->bx * (size_t)h->by;
     return hash_carve(a, o, nb, polyc__hash_entry_cap(&ctx->lim, nb));
 }

@@ -20,23 +20,23 @@ extern inline int polyc__edited_since(const polyc__opt *o, int32_t v, uint32_t s
 
 #define CROSS_END_M 0.002f  /* a crossing this near a segment end is a junction */
 #define CUT_BACK_M 0.002f   /* a cut arm ends this short of the other segment */
-#define LOSES_RETURNS 1e6   /* single scans: an edit that loses returns comes last */
+#define LOSES_RETURNS 1e6f   /* single scans: an edit that loses returns comes last */
 
 /* Whether segments p0-p1 and q0-q1 cross with the crossing at least
  * CROSS_END_M from all four ends; *t and *u: its position along each. */
 static int proper_cross(float p0x, float p0y, float p1x, float p1y, float q0x, float q0y,
                         float q1x, float q1y, float *t, float *u)
 {
-    double rx = (double)p1x - (double)p0x, ry = (double)p1y - (double)p0y;
-    double sx = (double)q1x - (double)q0x, sy = (double)q1y - (double)q0y;
-    double den = rx * sy - ry * sx;
-    if (den == 0.0)
+    float rx = (float)p1x - (float)p0x, ry = (float)p1y - (float)p0y;
+    float sx = (float)q1x - (float)q0x, sy = (float)q1y - (float)q0y;
+    float den = rx * sy - ry * sx;
+    if (den == 0.0f)
         return 0;
-    double wx = (double)q0x - (double)p0x, wy = (double)q0y - (double)p0y;
-    double tt = (wx * sy - wy * sx) / den, uu = (wx * ry - wy * rx) / den;
-    double lp = sqrt(rx * rx + ry * ry), lq = sqrt(sx * sx + sy * sy);
-    double e = (double)CROSS_END_M;
-    if (tt * lp < e || (1.0 - tt) * lp < e || uu * lq < e || (1.0 - uu) * lq < e)
+    float wx = (float)q0x - (float)p0x, wy = (float)q0y - (float)p0y;
+    float tt = (wx * sy - wy * sx) / den, uu = (wx * ry - wy * rx) / den;
+    float lp = sqrtf(rx * rx + ry * ry), lq = sqrtf(sx * sx + sy * sy);
+    float e = (float)CROSS_END_M;
+    if (tt * lp < e || (1.0f - tt) * lp < e || uu * lq < e || (1.0f - uu) * lq < e)
         return 0;
     *t = (float)tt;
     *u = (float)uu;
@@ -83,7 +83,7 @@ typedef struct fix {
     int kind;          /* 0 none, 1 remove vertex v, 2 keep v's side of segment seg up to (x, y) */
     int32_t v, seg;
     float x, y;
-    double delta;      /* change of the BIC */
+    float delta;      /* change of the BIC */
 } fix;
 
 static void consider(fix *best, const fix *f)
@@ -105,8 +105,8 @@ static void try_remove(polyc__opt *o, int32_t v, fix *best)
     }
     /* only a removal cheaper than the best fix so far matters: its change is
      * exact below that bound (INFINITY: a single scan's return would go) */
-    double bound = best->kind != 0 ? best->delta : (double)INFINITY;
-    double d = polyc__removal_delta_below(o, v, bound);
+    float bound = best->kind != 0 ? best->delta : (float)INFINITY;
+    float d = polyc__removal_delta_below(o, v, bound);
     if (isinf(d) || (best->kind != 0 && d >= bound))
         return;
     fix f = {1, v, POLYC__NONE, 0.0f, 0.0f, d};
@@ -131,22 +131,22 @@ static void try_cut(polyc__opt *o, int32_t seg, float t, int32_t keep, fix *best
     int32_t gone = keep == a ? b : a; /* the vertex on the far side */
     const float old_xy[4] = {V[a].x, V[a].y, V[b].x, V[b].y};
     float new_xy[4] = {V[keep].x, V[keep].y, x, y};
-    double dk = 0.0, dangle = 0.0;
+    float dk = 0.0f, dangle = 0.0f;
     int end = keep == a ? V[b].next == POLYC__NONE : V[a].prev == POLYC__NONE;
     if (!end) {
-        dk = 1.0;                  /* the cut adds the vertex at the cut */
+        dk = 1.0f;                  /* the cut adds the vertex at the cut */
         dangle = -o->acost[gone];  /* and the far vertex becomes an end */
     }
-    double alpha = (double)o->cfg->alpha, fixed = alpha * (double)o->cfg->gamma * dangle + dk * o->d.log_n;
+    float alpha = (float)o->cfg->alpha, fixed = alpha * (float)o->cfg->gamma * dangle + dk * o->d.log_n;
     /* a cut only takes map away, so its error change is >= 0: it matters
      * only below the best fix so far, and is exact below that */
-    double limit = best->kind != 0 ? (best->delta - fixed) / alpha : (double)INFINITY;
-    if (limit <= 0.0)
+    float limit = best->kind != 0 ? (best->delta - fixed) / alpha : (float)INFINITY;
+    if (limit <= 0.0f)
         return;
-    double derr = polyc__local_delta(o, &seg, 1, new_xy, 1, limit);
+    float derr = polyc__local_delta(o, &seg, 1, new_xy, 1, limit);
     if (derr >= limit)
         return;
-    double d = alpha * derr + fixed;
+    float d = alpha * derr + fixed;
     if (o->rays.on && polyc__loses_returns(&o->rays, old_xy, 1, new_xy, 1))
         d += LOSES_RETURNS;
     fix f = {2, keep, seg, x, y, d};
@@ -195,7 +195,7 @@ int polyc__op_untangle(polyc__opt *o)
             if (other == POLYC__NONE)
                 break;
             int32_t ends[4] = {v, w, other, s->v[other].next};
-            fix best = {0, POLYC__NONE, POLYC__NONE, 0.0f, 0.0f, 0.0};
+            fix best = {0, POLYC__NONE, POLYC__NONE, 0.0f, 0.0f, 0.0f};
             /* cuts first: an overshooting end is the usual crossing, and its
              * trim bounds the rest */
             try_cut(o, v, t, v, &best);

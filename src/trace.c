@@ -51,7 +51,7 @@ static int unvisited_degree(const polyc__grid *g, int32_t ix, int32_t iy)
 typedef struct tracer {
     const polyc__grid *g;
     polyc__spacing spacing;
-    double ox, oy;                 /* frame-relative grid origin */
+    float ox, oy;                 /* frame-relative grid origin */
     int32_t link;                  /* cells: the merge distance */
     int32_t link_max;              /* cells: the widest gap bridged in sparse data */
 } tracer;
@@ -61,8 +61,8 @@ typedef struct tracer {
 static int32_t link_radius(const tracer *tr, int32_t ix, int32_t iy)
 {
     const polyc__grid *g = tr->g;
-    float x = (float)(tr->ox + ((double)ix + 0.5) * (double)g->cell_m);
-    float y = (float)(tr->oy + ((double)iy + 0.5) * (double)g->cell_m);
+    float x = (float)(tr->ox + ((float)ix + 0.5f) * (float)g->cell_m);
+    float y = (float)(tr->oy + ((float)iy + 0.5f) * (float)g->cell_m);
     float cells = POLYC__GAP_SPACINGS * polyc__spacing_at(&tr->spacing, x, y) * g->inv_cell;
     int32_t r = cells > (float)tr->link_max ? tr->link_max : (int32_t)cells;
     return r > tr->link ? r : tr->link;
@@ -210,20 +210,22 @@ static uint32_t simplify(int32_t *xy, uint32_t n)
         uint32_t a = lo[top], b = hi[top];
         if (b <= a + 1)
             continue;
-        double ax = xy[2 * a], ay = xy[2 * a + 1], dx = xy[2 * b] - ax, dy = xy[2 * b + 1] - ay;
-        double len = sqrt(dx * dx + dy * dy);
-        double worst = -1.0;
+        /* cell steps: integer differences, exact as floats below 2^24 */
+        int32_t ax = xy[2 * a], ay = xy[2 * a + 1];
+        float dx = (float)(xy[2 * b] - ax), dy = (float)(xy[2 * b + 1] - ay);
+        float len = sqrtf(dx * dx + dy * dy);
+        float worst = -1.0f;
         uint32_t at = a;
         for (uint32_t i = a + 1; i < b; i++) {
-            double px = xy[2 * i] - ax, py = xy[2 * i + 1] - ay;
-            double d = len > 0.0 ? fabs(px * dy - py * dx) / len : sqrt(px * px + py * py);
+            float px = (float)(xy[2 * i] - ax), py = (float)(xy[2 * i + 1] - ay);
+            float d = len > 0.0f ? fabsf(px * dy - py * dx) / len : sqrtf(px * px + py * py);
             if (d > worst) {
                 worst = d;
                 at = i;
             }
         }
-        if (worst <= 0.5 || top + 2 > DP_STACK) {
-            if (worst <= 0.5)
+        if (worst <= 0.5f || top + 2 > DP_STACK) {
+            if (worst <= 0.5f)
                 for (uint32_t i = a + 1; i < b; i++)
                     xy[2 * i] = INT32_MIN;
             continue;
@@ -305,10 +307,10 @@ static polyc_status emit(polyc_ctx *ctx, walk *w, int closed)
     if (l == POLYC__NONE)
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "too many polylines for limits.max_vertices");
     /* store coordinates relative to the frame (first pose) */
-    double ox = g->origin_x_m - ctx->frame_x, oy = g->origin_y_m - ctx->frame_y;
+    float ox = g->frame_ox, oy = g->frame_oy;
     for (uint32_t i = 0; i < m; i++) {
-        float x = (float)(ox + ((double)w->xy[2 * i] + 0.5) * (double)g->cell_m);
-        float y = (float)(oy + ((double)w->xy[2 * i + 1] + 0.5) * (double)g->cell_m);
+        float x = (float)(ox + ((float)w->xy[2 * i] + 0.5f) * (float)g->cell_m);
+        float y = (float)(oy + ((float)w->xy[2 * i + 1] + 0.5f) * (float)g->cell_m);
         if (polyc__vertex_append(s, l, x, y) == POLYC__NONE)
             return polyc__fail(ctx, POLYC_ERR_NOMEM, "too many vertices for limits.max_vertices");
     }
@@ -364,8 +366,8 @@ polyc_status polyc__trace_more(polyc_ctx *ctx)
     tracer tr;
     float link_f = ctx->cfg.merge_dist_m / g->cell_m;
     tr.g = g;
-    tr.ox = g->origin_x_m - ctx->frame_x;
-    tr.oy = g->origin_y_m - ctx->frame_y;
+    tr.ox = g->frame_ox;
+    tr.oy = g->frame_oy;
     tr.link = link_f < 1.0f ? 1 : (link_f > 8.0f ? 8 : (int32_t)link_f);
     tr.link_max = (int32_t)fminf(fmaxf(0.5f / g->cell_m, (float)tr.link), 32.0f);
     if ((st = polyc__spacing_build(ctx, &tr.spacing)) != POLYC_OK)

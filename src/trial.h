@@ -11,35 +11,35 @@
 
 inline void polyc__seg_prepare(polyc__seg_pre *q, const float *xy)
 {
-    q->ax = (double)xy[0];
-    q->ay = (double)xy[1];
-    q->bx = (double)xy[2];
-    q->by = (double)xy[3];
+    q->ax = (float)xy[0];
+    q->ay = (float)xy[1];
+    q->bx = (float)xy[2];
+    q->by = (float)xy[3];
     q->dx = q->bx - q->ax;
     q->dy = q->by - q->ay;
-    double l2 = q->dx * q->dx + q->dy * q->dy;
-    q->inv_l2 = l2 > 1e-18 ? 1.0 / l2 : 0.0;
-    double inv = l2 > 1e-18 ? 1.0 / sqrt(l2) : 0.0;
+    float l2 = q->dx * q->dx + q->dy * q->dy;
+    q->inv_l2 = l2 > 1e-18f ? 1.0f / l2 : 0.0f;
+    float inv = l2 > 1e-18f ? 1.0f / sqrtf(l2) : 0.0f;
     q->nx = -q->dy * inv;
     q->ny = q->dx * inv;
 }
 
 /* Same value as polyc__cost, without the per-call divisions. */
-inline double polyc__seg_pre_cost(const polyc__seg_pre *q, const polyc__point *p)
+inline float polyc__seg_pre_cost(const polyc__seg_pre *q, const polyc__point *p)
 {
-    double mx = (double)p->x - q->ax, my = (double)p->y - q->ay;
-    double t = (mx * q->dx + my * q->dy) * q->inv_l2;
-    if (t <= 0.0 || q->inv_l2 == 0.0)
-        return (double)p->w * (mx * mx + my * my) + ((double)p->cxx + (double)p->cyy);
-    if (t >= 1.0) {
-        double ex = (double)p->x - q->bx, ey = (double)p->y - q->by;
-        return (double)p->w * (ex * ex + ey * ey) + ((double)p->cxx + (double)p->cyy);
+    float mx = (float)p->x - q->ax, my = (float)p->y - q->ay;
+    float t = (mx * q->dx + my * q->dy) * q->inv_l2;
+    if (t <= 0.0f || q->inv_l2 == 0.0f)
+        return (float)p->w * (mx * mx + my * my) + ((float)p->cxx + (float)p->cyy);
+    if (t >= 1.0f) {
+        float ex = (float)p->x - q->bx, ey = (float)p->y - q->by;
+        return (float)p->w * (ex * ex + ey * ey) + ((float)p->cxx + (float)p->cyy);
     }
-    double d = q->nx * mx + q->ny * my;
-    double c = (double)p->w * d * d + (q->nx * q->nx * (double)p->cxx +
-                                       2.0 * q->nx * q->ny * (double)p->cxy +
-                                       q->ny * q->ny * (double)p->cyy);
-    return c > 0.0 ? c : 0.0; /* as polyc__cost */
+    float d = q->nx * mx + q->ny * my;
+    float c = (float)p->w * d * d + (q->nx * q->nx * (float)p->cxx +
+                                       2.0f * q->nx * q->ny * (float)p->cxy +
+                                       q->ny * q->ny * (float)p->cyy);
+    return c > 0.0f ? c : 0.0f; /* as polyc__cost */
 }
 
 
@@ -72,7 +72,7 @@ inline int polyc__is_old(const polyc__old_set *s, int32_t seg)
 
 /* The nearest segment costing less than `start`, skipping `skip` (NONE
  * and `start` if there is none); score.c. */
-double polyc__nearest_below(const polyc__opt *o, int32_t pi, const int32_t *skip, int n_skip,
-                            double start, int32_t *seg);
+float polyc__nearest_below(const polyc__opt *o, int32_t pi, const int32_t *skip, int n_skip,
+                            float start, int32_t *seg);
 
 #endif

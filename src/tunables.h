@@ -90,6 +90,6 @@
  * (accuracy.c) the climb back is slower, and belgioioso's search stopped at
  * iteration 0's map (958 vertices) while each iteration still gained 1-2 %
  * (760 vertices when it may go on). */
-#define POLYC__RECOVER_GAIN 5e-3
+#define POLYC__RECOVER_GAIN 5e-3f
 
 #endif

@@ -31,11 +31,13 @@ typedef struct polyc__walk {
     float per_key;                 /* beam parameter per key unit */
 } polyc__walk;
 
-/* floor(v * scale) of a finite v that fits, scale a power of two: exact in
- * float, so no double arithmetic (a microcontroller's FPU has none) */
+/* floor(v * scale) of a finite v, scale a power of two: exact in float, so
+ * no double arithmetic (a microcontroller's FPU has none); below 2^30 in
+ * magnitude (polyc__walk_start's choice of scale), so a 32-bit conversion,
+ * one instruction where a 64-bit one is a library call */
 static inline int64_t polyc__fixed(float v, float scale)
 {
-    return (int64_t)floorf(v * scale);
+    return (int64_t)(int32_t)floorf(v * scale);
 }
 
 static inline float polyc__max_abs(float a, float b)
@@ -76,7 +78,7 @@ static inline void polyc__walk_start(polyc__walk *w, const polyc__beam *b)
         w->inc_x = one * dya;
         w->inc_y = one * dxa;
         w->end_key = dxa * dya;
-        w->per_key = 1.0f / ((float)dxa * (float)dya);
+        w->per_key = 1.0f / ((float)(int32_t)dxa * (float)(int32_t)dya); /* (each < 2^31) */
     } else {
         /* along one axis only (or not at all): its distance is the key */
         w->kx = dxa > 0 ? ax : INT64_MAX;
@@ -84,7 +86,7 @@ static inline void polyc__walk_start(polyc__walk *w, const polyc__beam *b)
         w->inc_x = dxa > 0 ? one : 0;
         w->inc_y = dya > 0 ? one : 0;
         w->end_key = dxa > 0 ? dxa : dya;
-        w->per_key = dxa > 0 ? 1.0f / (float)dxa : (dya > 0 ? 1.0f / (float)dya : 0.0f);
+        w->per_key = dxa > 0 ? 1.0f / (float)(int32_t)dxa : (dya > 0 ? 1.0f / (float)(int32_t)dya : 0.0f);
     }
     /* the step count is fixed in advance, so the walk always ends */
     w->n = (w->ex > w->ix ? w->ex - w->ix : w->ix - w->ex) +

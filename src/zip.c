@@ -68,7 +68,7 @@ void polyc__find_sides(polyc__opt *o, const int32_t *list, int32_t n, float *lef
 {
     const polyc__store *s = o->s;
     float *side = o->seg_side;
-    const double reach2 = (double)SIDE_REACH_M * (double)SIDE_REACH_M;
+    const float reach2 = (float)SIDE_REACH_M * (float)SIDE_REACH_M;
     for (int32_t v = 0; v < s->v_high; v++) {
         side[2 * v] = side[2 * v + 1] = 0.0f;
         if (left)
@@ -79,7 +79,7 @@ void polyc__find_sides(polyc__opt *o, const int32_t *list, int32_t n, float *lef
     for (int32_t j = 0; j < n; j++) {
         int32_t i = list ? list[j] : j;
         int32_t sg = o->d.pt_seg[i];
-        if (sg == POLYC__NONE || o->d.pt_cost[i] > reach2 * (double)o->d.pts[i].w)
+        if (sg == POLYC__NONE || o->d.pt_cost[i] > reach2 * (float)o->d.pts[i].w)
             continue;
         float vx = o->d.pt_view[2 * i], vy = o->d.pt_view[2 * i + 1];
         side[2 * sg] += vx;
@@ -308,23 +308,23 @@ static int longest_run(const polyc__opt *o, int32_t v, int band, float *t0, floa
 }
 
 /* The change of the BIC if stretch [t0, t1] of segment v goes. */
-static double drop_delta(polyc__opt *o, int32_t v, float t0, float t1)
+static float drop_delta(polyc__opt *o, int32_t v, float t0, float t1)
 {
     const polyc__vertex *V = o->s->v;
     int32_t w = V[v].next;
     float ax = V[v].x, ay = V[v].y, dx = V[w].x - ax, dy = V[w].y - ay;
     float xy[8];
     int n_new = 0;
-    double dk = 0.0, dangle = 0.0;
+    float dk = 0.0f, dangle = 0.0f;
     if (t0 > 0.0f) {
         xy[4 * n_new] = ax;
         xy[4 * n_new + 1] = ay;
         xy[4 * n_new + 2] = ax + t0 * dx;
         xy[4 * n_new + 3] = ay + t0 * dy;
         n_new++;
-        dk += V[w].next == POLYC__NONE && t1 >= 1.0f ? 0.0 : 1.0;
+        dk += V[w].next == POLYC__NONE && t1 >= 1.0f ? 0.0f : 1.0f;
     } else if (V[v].prev == POLYC__NONE) {
-        dk -= t1 >= 1.0f ? 1.0 : 0.0; /* the head goes, or moves to t1 */
+        dk -= t1 >= 1.0f ? 1.0f : 0.0f; /* the head goes, or moves to t1 */
     } else {
         dangle -= o->acost[v];        /* v becomes an end */
     }
@@ -334,14 +334,14 @@ static double drop_delta(polyc__opt *o, int32_t v, float t0, float t1)
         xy[4 * n_new + 2] = V[w].x;
         xy[4 * n_new + 3] = V[w].y;
         n_new++;
-        dk += V[v].prev == POLYC__NONE && t0 <= 0.0f ? 0.0 : 1.0;
+        dk += V[v].prev == POLYC__NONE && t0 <= 0.0f ? 0.0f : 1.0f;
     } else if (V[w].next == POLYC__NONE) {
-        dk -= t0 <= 0.0f ? 1.0 : 0.0;
+        dk -= t0 <= 0.0f ? 1.0f : 0.0f;
     } else {
         dangle -= o->acost[w];
     }
-    double derr = polyc__local_delta(o, &v, 1, xy, n_new, INFINITY);
-    return (double)o->cfg->alpha * (derr + (double)o->cfg->gamma * dangle) + dk * o->d.log_n;
+    float derr = polyc__local_delta(o, &v, 1, xy, n_new, INFINITY);
+    return (float)o->cfg->alpha * (derr + (float)o->cfg->gamma * dangle) + dk * o->d.log_n;
 }
 
 /* Cuts stretch [t0, t1] out of segment v; 0 if there was no room. */
@@ -490,7 +490,7 @@ static int zip_pass(polyc__opt *o, uint32_t since)
                 q = nearest_other(o, mx, my, v, w, &qd2);
             }
             float u0, u1;
-            double d_here = drop_delta(o, v, t0, t1);
+            float d_here = drop_delta(o, v, t0, t1);
             if (q != POLYC__NONE && longest_run(o, q, band, &u0, &u1) &&
                 drop_delta(o, q, u0, u1) < d_here) {
                 if (!drop_stretch(o, q, u0, u1))

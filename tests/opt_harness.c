@@ -132,8 +132,8 @@ void set_points_seen(fixture *f, const float *xy, const float *seen_xy, int n)
         h->pt_start[b] = h->pt_start[b - 1];
     h->pt_start[0] = 0;
     o->d.np = n;
-    o->d.n = (double)n;
-    o->d.log_n = log(o->d.n > 1.0 ? o->d.n : 1.0);
+    o->d.n = (float)n;
+    o->d.log_n = logf(o->d.n > 1.0f ? o->d.n : 1.0f);
 }
 
 void set_points(fixture *f, const float *xy, int n)
@@ -233,7 +233,7 @@ float nearest_vertex(const polyc__opt *o, float x, float y)
 void dump_map(const polyc__opt *o, const char *title)
 {
     printf("# %s: %d vertices, %d polylines, bic %.6f err %.9f\n", title, o->s->v_live,
-           live_lines(o), polyc__bic(o), o->err);
+           live_lines(o), (double)polyc__bic(o), (double)polyc__err(o));
     for (int32_t l = 0; l < o->s->l_high; l++) {
         const polyc__line *ln = &o->s->l[l];
         if (ln->closed == POLYC__NONE)
@@ -323,9 +323,9 @@ double scratch_bic(polyc__opt *o)
         err += brute_nearest(o, &o->d.pts[i], NULL);
     for (int32_t v = 0; v < o->s->v_high; v++)
         if (o->s->v[v].line != POLYC__NONE)
-            angle += polyc__vertex_angle_cost(o, v);
+            angle += (double)polyc__vertex_angle_cost(o, v);
     return (double)o->cfg->alpha * (err + (double)o->cfg->gamma * angle) +
-           (double)o->s->v_live * o->d.log_n;
+           (double)o->s->v_live * (double)o->d.log_n;
 }
 
 /* ---- random edits ---- */
@@ -376,16 +376,16 @@ const char *basic_edit(polyc__opt *o, polyc__rng *r)
     case 0:
         if ((v = pick_vertex(o, r, 0)) == POLYC__NONE)
             return "none";
-        polyc__op_move(o, v, o->s->v[v].x + (float)(0.04 * polyc__rng_normal(r)),
-                       o->s->v[v].y + (float)(0.04 * polyc__rng_normal(r)));
+        polyc__op_move(o, v, o->s->v[v].x + 0.04f * polyc__rng_normal(r),
+                       o->s->v[v].y + 0.04f * polyc__rng_normal(r));
         return "move";
     case 1: {
         if ((v = pick_vertex(o, r, 1)) == POLYC__NONE)
             return "none";
         const polyc__vertex *a = &o->s->v[v], *b = &o->s->v[a->next];
         float t = (float)urand(r);
-        polyc__op_insert_after(o, v, a->x + t * (b->x - a->x) + (float)(0.02 * polyc__rng_normal(r)),
-                               a->y + t * (b->y - a->y) + (float)(0.02 * polyc__rng_normal(r)));
+        polyc__op_insert_after(o, v, a->x + t * (b->x - a->x) + 0.02f * polyc__rng_normal(r),
+                               a->y + t * (b->y - a->y) + 0.02f * polyc__rng_normal(r));
         return "insert";
     }
     case 2:
@@ -443,7 +443,7 @@ const char *random_step(polyc__opt *o, polyc__rng *r)
         return "hill_climb";
     case 19: polyc__op_trim_ends(o); return "trim_ends";
     default:
-        polyc__op_noise(o, 0.02);
+        polyc__op_noise(o, 0.02f);
         rebuild(o);
         return "noise";
     }
@@ -487,8 +487,8 @@ void make_start_map(polyc__opt *o, polyc__rng *r)
             double t = piece[k][2] > 0.0 ? piece[k][1] - 0.08 * i : piece[k][0] + 0.08 * i;
             float x, y;
             perimeter_at(t, &x, &y);
-            x += (float)(0.01 * polyc__rng_normal(r));
-            y += (float)(0.01 * polyc__rng_normal(r));
+            x += 0.01f * polyc__rng_normal(r);
+            y += 0.01f * polyc__rng_normal(r);
             assert_true(polyc__vertex_append(o->s, l, x, y) != POLYC__NONE);
         }
     }
@@ -571,7 +571,7 @@ double longest_unsupported(const polyc__opt *o)
 
 /* Hand-made beams on the fixture's optimiser, as a single scan would set
  * them: `count` beams from (x, y), the first at `base` rad, `step` apart. */
-polyc__rays *set_rays(polyc__opt *o, double x, double y, double base, double step,
+polyc__rays *set_rays(polyc__opt *o, float x, float y, float base, float step,
                              const float *range, int32_t count)
 {
     polyc__rays *r = &o->rays;
@@ -581,14 +581,14 @@ polyc__rays *set_rays(polyc__opt *o, double x, double y, double base, double ste
     r->y = y;
     r->base = base;
     r->step = step;
-    r->step_cos = cos(step);
-    r->step_sin = sin(step);
+    r->step_cos = cosf(step);
+    r->step_sin = sinf(step);
     r->count = count;
-    r->turn = (int32_t)lround(2.0 * PI_D / step);
+    r->turn = (int32_t)lround(2.0 * PI_D / (double)step);
     r->range = range;
     r->min_m = 0.05f;
     r->max_m = 30.0f;
     r->tol_m = POLYC__RAY_TOLERANCE_M;
-    r->own_m = 0.15;
+    r->own_m = 0.15f;
     return r;
 }

@@ -113,6 +113,10 @@ int seg_live(const polyc__opt *o, int32_t v);
 double brute_nearest(const polyc__opt *o, const polyc__point *p, int32_t *seg);
 
 int close_rel(double a, double b, double rel);
+/* The library computes in float: two ways to one cost or BIC (incremental
+ * and from scratch, moments and points) agree to float's rounding, about
+ * 1e-7 of the value; 1e-5 leaves room for sums of thousands of terms. */
+#define FLOAT_REL 1e-5
 
 /* Linked lists, line ids, counts, ends, live counts. */
 void check_store(const polyc__opt *o, const char *where);
@@ -174,7 +178,7 @@ double longest_unsupported(const polyc__opt *o);
 
 /* Hand-made beams on the fixture's optimiser, as a single scan would set
  * them: `count` beams from (x, y), the first at `base` rad, `step` apart. */
-polyc__rays *set_rays(polyc__opt *o, double x, double y, double base, double step,
+polyc__rays *set_rays(polyc__opt *o, float x, float y, float base, float step,
                              const float *range, int32_t count);
 
 #endif

@@ -178,8 +178,7 @@ static void test_room_corners_and_walls(void **state)
     assert_int_equal(p->w, ctx->grid.tiles_x);
     assert_int_equal(p->h, ctx->grid.tiles_y);
     assert_float_equal(p->cell_m, ctx->grid.cell_m * 32.0f, 1e-6f);
-    assert_true(fabs(p->origin_x - (ctx->grid.origin_x_m - ctx->frame_x)) < 1e-9);
-    assert_true(fabs(p->origin_y - (ctx->grid.origin_y_m - ctx->frame_y)) < 1e-9);
+    assert_true(p->origin_x == ctx->grid.frame_ox && p->origin_y == ctx->grid.frame_oy);
     assert_true(ctx->arena.used - before <= polyc__prior_bytes(&ctx->lim));
     assert_true(p->corners >= 12);  /* every scan sees at least one corner */
     assert_true(p->straights > 100);
@@ -220,8 +219,8 @@ static void test_smoothed_table_same_values(void **state)
     size_t checked = 0;
     for (int32_t cy = -1; cy <= p->h; cy++)
         for (int32_t cx = -1; cx <= p->w; cx++) {
-            float x = (float)(p->origin_x + ((double)cx + 0.5) * (double)p->cell_m);
-            float y = (float)(p->origin_y + ((double)cy + 0.5) * (double)p->cell_m);
+            float x = p->origin_x + ((float)cx + 0.5f) * p->cell_m;
+            float y = p->origin_y + ((float)cy + 0.5f) * p->cell_m;
             for (int a = 0; a <= 180; a += 5) {
                 p->smooth = table;
                 float with = polyc__prior_p(p, x, y, (float)a * DEG);
@@ -251,8 +250,8 @@ static void test_histogram_bins(void **state)
     assert_int_equal(polyc__prior_build(f.ctx, &f.prior, SIZE_MAX), POLYC_OK);
     const polyc__prior *p = &f.prior;
     /* the cell of the lower-left corner: 90 degree turns in bin 9 only */
-    int32_t ix = (int32_t)floor(((double)fx(&f, ROOM.x0) - p->origin_x) / (double)p->cell_m);
-    int32_t iy = (int32_t)floor(((double)fy(&f, ROOM.y0) - p->origin_y) / (double)p->cell_m);
+    int32_t ix = (int32_t)floorf((fx(&f, ROOM.x0) - p->origin_x) / p->cell_m);
+    int32_t iy = (int32_t)floorf((fy(&f, ROOM.y0) - p->origin_y) / p->cell_m);
     const uint16_t *h = polyc__prior_counts(p, ix, iy);
     assert_non_null(h);
     assert_true(h[9] > 0);

@@ -708,7 +708,11 @@ static void test_callback_reentry(void **state)
 }
 
 /* A negative angle step is a clockwise scan: the same beams listed the
- * other way round give the same grid and the same data. */
+ * other way round give the same grid and the same data, and maps of the
+ * same quality. (Not the same map: the beam angles, start + i * step, round
+ * differently in float by an ulp, the cells' moments are summed in the
+ * other order, and the search ends in a neighbouring optimum: BIC 69.24
+ * with 2 polylines and 70.52 with 1 on this scene.) */
 static void test_clockwise_scans(void **state)
 {
     (void)state;
@@ -733,11 +737,15 @@ static void test_clockwise_scans(void **state)
     polyc_stats sa, sb;
     assert_int_equal(polyc_get_stats(a.ctx, &sa), POLYC_OK);
     assert_int_equal(polyc_get_stats(b.ctx, &sb), POLYC_OK);
+    print_message("counter-clockwise: %u polylines, %u vertices, BIC %.3f; clockwise: %u, %u, %.3f\n",
+                  (unsigned)sa.polylines, (unsigned)sa.vertices, sa.bic, (unsigned)sb.polylines,
+                  (unsigned)sb.vertices, sb.bic);
     assert_int_equal(sa.hits, sb.hits);
     assert_int_equal(sa.data_points, sb.data_points);
     assert_int_equal(sa.contour_cells, sb.contour_cells);
+    assert_int_equal(map_is_valid(a.ctx, 11.5, -2.0, 4.0), 0);
     assert_int_equal(map_is_valid(b.ctx, 11.5, -2.0, 4.0), 0);
-    assert_int_equal(sa.polylines, sb.polylines);
+    assert_true(fabs(sa.bic - sb.bic) <= 0.03 * fabs(sa.bic));
     fixture_close(&a);
     fixture_close(&b);
 }

@@ -79,9 +79,13 @@ static void scene_free(scene *s)
     scansim_scene_free(&s->sim);
 }
 
+/* added to the optimiser's seed of every configuration (0: the default) */
+static uint32_t seed_shift;
+
 static void config_of(polyc_config *c)
 {
     polyc_config_default(c);
+    c->seed += seed_shift;
     if (c->max_iterations == 0 || c->max_iterations > 1000)
         c->max_iterations = 1000;
 }
@@ -734,11 +738,12 @@ static void test_changes_forgotten(void **state)
     uint64_t client_at = 0, prev_at = 0;
     uint32_t refused = 0, applied = 0, a = 0, m = 0, rm = 0, unseen = 0;
     polyc_online_report r;
-    /* two passes: removals enough to go round the ring (thin walls: their
-     * faces' pieces come and go while both are seen; the office's walls,
-     * whose pieces the updates link before they are published, made 68
-     * removals in four passes) */
-    for (uint32_t i = 0; i < 2 * s.sim.scan_count; i++) {
+    /* passes until the removals have gone round the ring (thin walls: their
+     * faces' pieces come and go while both are seen, 80 or so removals in
+     * two passes; the office's walls, whose pieces the updates link before
+     * they are published, made 68 removals in four passes); at most six */
+    for (uint32_t i = 0; i < 6 * s.sim.scan_count && !(refused > 0 && i % s.sim.scan_count == 0);
+         i++) {
         add(&o, &s.sim.scans[i % s.sim.scan_count], 0);
         update(&o, POLYC_ONLINE_WORK_DEFAULT, &r);
         /* the copy of the update before: never forgotten here */
@@ -1132,8 +1137,17 @@ static void test_ten_passes(void **state)
     print_score("  online, one pass", &one);
     print_score("  batch, ten passes", &batch_ten);
     print_score("  online, ten passes", &ten);
-    assert_scores_like("ten passes", &ten, &batch_ten, FINISH_RMS_M, FINISH_COMPLETENESS,
+    /* Ten passes carry the information of one: the online map of ten is
+     * held to the online map of one. The batch map of ten is no vertex
+     * reference: to the BIC, k copies of a log are k-fold certainty about
+     * the same noise, and its search ends anywhere between 65 and 120
+     * vertices (office.log repeated 2, 3, 5, 10 times: 96, 65-100, 109,
+     * 68-120 over builds and seeds); its RMS and completeness still bound
+     * the online map's. */
+    assert_scores_like("ten passes", &ten, &one, FINISH_RMS_M, FINISH_COMPLETENESS,
                        FINISH_VERTICES);
+    assert_true(ten.precision_rms_m <= batch_ten.precision_rms_m + FINISH_RMS_M);
+    assert_true(ten.completeness >= batch_ten.completeness - FINISH_COMPLETENESS);
     assert_true(st.memory_size_bytes == o.size);
     assert_true(st.memory_used_bytes > 0 && st.memory_used_bytes <= o.size);
     online_close(&o);
@@ -1220,9 +1234,22 @@ static void check_correction(const char *name)
         free(block);
     }
     online_finished_score(&s, bad, &drift_fin, NULL, NULL);
+    /* the reference: the worst of three optimiser seeds' online maps of
+     * the true poses (the search's own spread: square 2.98, 3.53 mm ...) */
     gtscore_map_score truth_fin;
-    double truth_core;
-    online_finished_score(&s, s.sim.scans, &truth_fin, &truth_core, NULL);
+    double truth_core = 0.0, seed_core[3];
+    for (uint32_t k = 0; k < 3; k++) {
+        gtscore_map_score sc;
+        seed_shift = k;
+        online_finished_score(&s, s.sim.scans, &sc, &seed_core[k], NULL);
+        if (k == 0 || seed_core[k] > truth_core) {
+            truth_core = seed_core[k];
+            truth_fin = sc;
+        }
+    }
+    seed_shift = 0;
+    print_message("  online true poses, core RMS at optimiser seeds +0, +1, +2: %.2f, %.2f, "
+                  "%.2f mm\n", 1e3 * seed_core[0], 1e3 * seed_core[1], 1e3 * seed_core[2]);
     online o;
     polyc_online_report r;
     online_open(&o, &s, s.sim.scan_count);

@@ -12,7 +12,7 @@ static void test_books_after_setup(void **state)
     static fixture f;
     fx_open(&f, 0.02f, 0.002f, 0);
     check_books(&f.o, "setup");
-    assert_true(close_rel(polyc__bic(&f.o), scratch_bic(&f.o), 1e-9));
+    assert_true(close_rel((double)polyc__bic(&f.o), scratch_bic(&f.o), FLOAT_REL));
     fx_close(&f);
 }
 
@@ -46,7 +46,7 @@ static void test_move_eval_moments_match(void **state)
     polyc__rng r = {57};
     make_start_map(&f.o, &r);
     polyc__op_remove_vertices(&f.o, 0); /* long segments: points on them stay */
-    polyc__op_noise(&f.o, 0.01);
+    polyc__op_noise(&f.o, 0.01f);
     rebuild(&f.o);
     const float reach = 0.05f;
     int aggregated = 0;
@@ -82,7 +82,7 @@ static void test_move_eval_moments_match(void **state)
             polyc__local_prepare_move(&f.o, old, 2, xy, ns, reach, x0, y0);
             aggregated += f.o.ev.agg_n[0] + f.o.ev.agg_n[1];
             double agg = polyc__local_eval(&f.o, trial, ns), agg_cur = polyc__local_current(&f.o);
-            if (!close_rel(plain, agg, 1e-9) || !close_rel(plain_cur, agg_cur, 1e-9))
+            if (!close_rel(plain, agg, FLOAT_REL) || !close_rel(plain_cur, agg_cur, FLOAT_REL))
                 fail_msg("vertex %d trial %d: plain %.12f / %.12f, moments %.12f / %.12f", v, t, plain,
                          plain_cur, agg, agg_cur);
         }
@@ -155,7 +155,7 @@ static void test_move_eval_sees_neighbouring_buckets(void **state)
             }
             V[v].x = x0;
             V[v].y = y0;
-            if (!close_rel(local, brute, 1e-9))
+            if (!close_rel(local, brute, FLOAT_REL))
                 fail_msg("shift %d trial %d: local %.12f, brute force %.12f", k, t, local, brute);
         }
     }
@@ -174,7 +174,7 @@ static void test_trial_costs_by_field_match(void **state)
     assert_true(f.o.ev.lsoa_cap > 0); /* several scans: the copy is made */
     polyc__rng r = {91};
     make_start_map(&f.o, &r);
-    polyc__op_noise(&f.o, 0.02);
+    polyc__op_noise(&f.o, 0.02f);
     rebuild(&f.o);
     const float reach = 0.05f;
     int by_field = 0;
@@ -289,7 +289,7 @@ static void test_removal_delta_is_exact(void **state)
         fx_open(&f, gammas[g], 0.002f, 0);
         polyc__rng r = {31};
         make_start_map(&f.o, &r);
-        polyc__op_noise(&f.o, 0.01);
+        polyc__op_noise(&f.o, 0.01f);
         rebuild(&f.o);
         /* a closed triangle and a two-vertex line: the special cases */
         const float tri[6] = {-0.5f, -0.3f, 0.5f, -0.3f, 0.0f, 0.4f}, seg[4] = {-1.5f, 1.0f, -0.8f, 1.1f};
@@ -302,10 +302,11 @@ static void test_removal_delta_is_exact(void **state)
             rebuild(&f.o);
             if (f.o.s->v[v].line == POLYC__NONE)
                 continue;
-            double before = polyc__bic(&f.o), d = polyc__removal_delta_below(&f.o, v, INFINITY);
+            double before = (double)polyc__bic(&f.o), d = polyc__removal_delta_below(&f.o, v, INFINITY);
             /* bounded: exact below the bound, at least the bound above it */
             for (int b = 0; b < 3; b++) {
-                double bound = b == 0 ? 0.0 : (b == 1 ? f.o.d.log_n : d), db = polyc__removal_delta_below(&f.o, v, bound);
+                double bound = b == 0 ? 0.0 : (b == 1 ? (double)f.o.d.log_n : d);
+                double db = (double)polyc__removal_delta_below(&f.o, v, (float)bound);
                 if (d < bound ? fabs(db - d) > 1e-6 * (1.0 + fabs(before)) : db < bound - 1e-9 * (1.0 + fabs(before)))
                     fail_msg("vertex %d bound %.6f: exact %.9f, bounded %.9f", v, bound, d, db);
             }

@@ -99,13 +99,13 @@ static void test_merge_joins_ends_10cm_apart(void **state)
     const float a[4] = {-1.0f, 0.0f, -0.05f, 0.0f}, b[4] = {0.05f, 0.0f, 1.0f, 0.0f};
     const float joined[8] = {-1.0f, 0.0f, -0.05f, 0.0f, 0.05f, 0.0f, 1.0f, 0.0f};
     merge_case(&f, a, b, 2);
-    double before = polyc__bic(&f.o);
+    double before = (double)polyc__bic(&f.o);
     assert_int_equal(polyc__op_merge(&f.o), 1);
     check_books(&f.o, "merge tail-head");
     assert_int_equal(live_lines(&f.o), 1);
     assert_line_is(&f.o, line_with_end(&f.o, -1.0f, 0.0f), joined, 4);
     assert_int_equal(f.o.s->l[line_with_end(&f.o, -1.0f, 0.0f)].closed, 0);
-    assert_true(polyc__bic(&f.o) < before); /* the gap's points are explained */
+    assert_true((double)polyc__bic(&f.o) < before); /* the gap's points are explained */
     /* head to head and tail to tail: one polyline is turned round */
     const float ar[4] = {-0.05f, 0.0f, -1.0f, 0.0f}, br[4] = {1.0f, 0.0f, 0.05f, 0.0f};
     merge_case(&f, ar, b, 2);

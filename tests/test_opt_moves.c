@@ -27,13 +27,13 @@ static void test_hill_climb_returns_to_corner(void **state)
         const float xy[6] = {-1.0f, 0.0f, start[c][0], start[c][1], 0.0f, 1.0f};
         add_line(&f.o, xy, 3, 0);
         rebuild(&f.o);
-        double bic = polyc__bic(&f.o);
+        double bic = (double)polyc__bic(&f.o);
         for (int round = 0; round < 20; round++) {
             int moved = 0;
             for (int32_t v = 0; v < 3; v++) {
                 moved += polyc__hill_climb(&f.o, v);
-                double now = polyc__bic(&f.o);
-                if (now > bic + 1e-9 * fabs(bic))
+                double now = (double)polyc__bic(&f.o);
+                if (now > bic + FLOAT_REL * fabs(bic))
                     fail_msg("start %d: the BIC rose from %.9f to %.9f", c, bic, now);
                 bic = now;
             }
@@ -58,18 +58,18 @@ static void test_adjust_never_raises_bic(void **state)
     polyc__rng r = {5};
     make_start_map(&f.o, &r);
     for (int k = 0; k < 3; k++) {
-        polyc__op_noise(&f.o, 0.02);
+        polyc__op_noise(&f.o, 0.02f);
         rebuild(&f.o);
-        double before = polyc__bic(&f.o);
+        double before = (double)polyc__bic(&f.o);
         for (int round = 0; round < 6; round++) {
             polyc__op_adjust(&f.o, 1, 0);
-            double now = polyc__bic(&f.o);
-            if (now > before + 1e-9 * fabs(before))
+            double now = (double)polyc__bic(&f.o);
+            if (now > before + FLOAT_REL * fabs(before))
                 fail_msg("adjust raised the BIC from %.9f to %.9f", before, now);
             before = now;
         }
         check_books(&f.o, "adjust");
-        assert_true(close_rel(polyc__bic(&f.o), scratch_bic(&f.o), 1e-9));
+        assert_true(close_rel((double)polyc__bic(&f.o), scratch_bic(&f.o), FLOAT_REL));
     }
     fx_close(&f);
 }
@@ -86,11 +86,11 @@ static void test_bic_checked_operators_never_raise_bic(void **state)
         fx_open(&f, run % 2 ? 0.5f : 0.0f, 0.002f, 0);
         polyc__rng r = {(uint64_t)(100 + run)};
         make_start_map(&f.o, &r);
-        polyc__op_noise(&f.o, 0.03);
+        polyc__op_noise(&f.o, 0.03f);
         rebuild(&f.o);
         for (int round = 0; round < 4; round++) {
             for (int op = 0; op < 5; op++) {
-                double before = polyc__bic(&f.o);
+                double before = (double)polyc__bic(&f.o);
                 switch (op) {
                 case 0: polyc__op_adjust(&f.o, 3, 0); break;
                 case 1: polyc__op_zigzag(&f.o); break;
@@ -98,8 +98,8 @@ static void test_bic_checked_operators_never_raise_bic(void **state)
                 case 3: polyc__op_remove_vertices(&f.o, 0); break;
                 default: polyc__op_add_vertices(&f.o, 2); break;
                 }
-                double after = polyc__bic(&f.o);
-                if (after > before + 1e-9 * fabs(before))
+                double after = (double)polyc__bic(&f.o);
+                if (after > before + FLOAT_REL * fabs(before))
                     fail_msg("run %d round %d: %s raised the BIC from %.9f to %.9f", run, round,
                              names[op], before, after);
             }
@@ -238,7 +238,7 @@ static void test_noise_deterministic_and_sized(void **state)
     for (int run = 0; run < 3; run++) {
         check_st(polyc__store_from_flat(f.o.s, &f.o.best), f.ctx, "restore");
         f.o.rng.state = run < 2 ? 77 : 78;
-        polyc__op_noise(&f.o, sigma);
+        polyc__op_noise(&f.o, (float)sigma);
         double sx = 0.0, sxx = 0.0;
         int same = 1;
         for (int32_t v = 0; v < n; v++) {
@@ -280,8 +280,8 @@ static void test_remove_collinear_vertex(void **state)
     const float xy[6] = {-1.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f}, after[4] = {-1.0f, 0.0f, 1.0f, 0.0f};
     int32_t l = add_line(&f.o, xy, 3, 0);
     rebuild(&f.o);
-    double d = polyc__removal_delta_below(&f.o, 1, INFINITY);
-    assert_true(fabs(d + f.o.d.log_n) < 1e-9); /* no error change, one vertex less */
+    double d = (double)polyc__removal_delta_below(&f.o, 1, INFINITY);
+    assert_true(fabs(d + (double)f.o.d.log_n) < FLOAT_REL * (double)f.o.d.log_n); /* no error change, one vertex less */
     assert_int_equal(polyc__op_remove_vertices(&f.o, 0), 1);
     check_books(&f.o, "remove");
     assert_line_is(&f.o, l, after, 2);
@@ -298,7 +298,7 @@ static void test_remove_keeps_true_corner(void **state)
     const float xy[6] = {-1.0f, 0.0f, 0.0f, 0.0f, 0.0f, 1.0f};
     int32_t l = add_line(&f.o, xy, 3, 0);
     rebuild(&f.o);
-    assert_true(polyc__removal_delta_below(&f.o, 1, INFINITY) > 0.0);
+    assert_true(polyc__removal_delta_below(&f.o, 1, INFINITY) > 0.0f);
     assert_int_equal(polyc__op_remove_vertices(&f.o, 0), 0);
     assert_line_is(&f.o, l, xy, 3);
     fx_close(&f);
@@ -316,10 +316,10 @@ static void test_add_vertex_at_cut_corner(void **state)
     const float xy[8] = {-1.0f, 0.0f, -0.2f, 0.0f, 0.0f, 0.2f, 0.0f, 1.0f};
     add_line(&f.o, xy, 4, 0);
     rebuild(&f.o);
-    double before = polyc__bic(&f.o);
+    double before = (double)polyc__bic(&f.o);
     assert_true(polyc__op_add_vertices(&f.o, 1) >= 1);
     check_books(&f.o, "add");
-    assert_true(polyc__bic(&f.o) < before);
+    assert_true((double)polyc__bic(&f.o) < before);
     assert_int_equal(f.o.s->v_live, 5);
     float d = nearest_vertex(&f.o, 0.0f, 0.0f);
     if (d > 0.01f)
@@ -349,12 +349,12 @@ static void test_corner_replaces_spike(void **state)
     const float after[10] = {-1.0f, 0.0f, -0.5f, 0.0f, 0.0f, 0.0f, 0.0f, 0.5f, 0.0f, 1.0f};
     int32_t l = add_line(&f.o, xy, 7, 0);
     rebuild(&f.o);
-    double before = polyc__bic(&f.o);
+    double before = (double)polyc__bic(&f.o);
     int changed = polyc__op_corners(&f.o, 0);
     check_books(&f.o, "corner");
     assert_line_near(&f.o, l, after, 5, 1e-6f);
     assert_int_equal(changed, 1);
-    assert_true(polyc__bic(&f.o) < before);
+    assert_true((double)polyc__bic(&f.o) < before);
     fx_close(&f);
 }
 
@@ -398,7 +398,7 @@ static void test_vertex_blocks_only_new_beams(void **state)
     int32_t l = add_line(&f.o, xy, 2, 0);
     rebuild(&f.o);
     /* three beams from the origin, at -0.2, 0 and 0.2 rad */
-    polyc__rays *r = set_rays(&f.o, 0.0, 0.0, -0.2, 0.2, range, 3);
+    polyc__rays *r = set_rays(&f.o, 0.0f, 0.0f, -0.2f, 0.2f, range, 3);
     int32_t v = f.o.s->l[l].tail;
     const polyc__vertex *t = &f.o.s->v[v];
     assert_true(polyc__blocks_beams(r, f.o.s->v[f.o.s->l[l].head].x, f.o.s->v[f.o.s->l[l].head].y,

@@ -165,7 +165,7 @@ static void test_trim_keeps_grazing_return(void **state)
     rebuild(&f.o);
     /* one beam, from (-1, 0.05) through the last point (0.6, 0.002) */
     range[0] = (float)hypot(1.6, 0.048);
-    polyc__rays *r = set_rays(&f.o, -1.0, 0.05, atan2(0.002 - 0.05, 1.6), 0.001, range, 1);
+    polyc__rays *r = set_rays(&f.o, -1.0f, 0.05f, atan2f(0.002f - 0.05f, 1.6f), 0.001f, range, 1);
     const polyc__vertex *h = &f.o.s->v[f.o.s->l[l].head], *t = &f.o.s->v[f.o.s->l[l].tail];
     assert_true(polyc__holds_returns(r, h->x, h->y, t->x, t->y));
     polyc__op_trim_ends(&f.o);

@@ -20,6 +20,7 @@
 #include "scansim.h"
 
 #define PI 3.14159265358979
+#define PIF 3.14159265f
 
 typedef struct one_map {
     scansim_scene scene;
@@ -174,7 +175,7 @@ static void test_near_returns_leave_gaps(void **state)
     done(&m);
     scene_map(&m, posts, UINT32_MAX, 0);
     assert_true(m.score.f >= 0.95);
-    assert_true(m.worst_short_m > -POLYC__RAY_TOLERANCE_M - 0.03);
+    assert_true(m.worst_short_m > -(double)POLYC__RAY_TOLERANCE_M - 0.03);
     assert_true(m.score.ray_rmse_m <= 0.04);
     done(&m);
 }
@@ -322,7 +323,7 @@ static void test_chain_end_along_beams(void **state)
             double a = scan.pose_theta_rad + (double)scan.start_angle_rad +
                        (double)i * (double)scan.angle_step_rad;
             double r = gtscore_index_ray(&map, 0.0, 0.0, a, 50.0);
-            if (!(fabs(r - (double)range[i]) <= POLYC__RAY_TOLERANCE_M))
+            if (!(fabs(r - (double)range[i]) <= (double)POLYC__RAY_TOLERANCE_M))
                 fail_msg("%s: beam %d meets the map at %.3f m, its return at %.3f m",
                          pass ? "optimised" : "traced", i, r, (double)range[i]);
         }
@@ -347,12 +348,12 @@ static void test_chains_drop_noise_vertices(void **state)
     assert_int_equal(m.stats.initial_polylines, 2);
     assert_int_equal(m.stats.initial_vertices, 4);
     assert_true(m.score.f >= 0.99);
-    assert_true(m.worst_short_m > -POLYC__RAY_TOLERANCE_M);
+    assert_true(m.worst_short_m > -(double)POLYC__RAY_TOLERANCE_M);
     done(&m);
     scene_map(&m, room_with_box, 0, 0);
     assert_in_range(m.stats.initial_vertices, 9, 10);
     assert_true(m.score.f >= 0.99);
-    assert_true(m.worst_short_m > -POLYC__RAY_TOLERANCE_M);
+    assert_true(m.worst_short_m > -(double)POLYC__RAY_TOLERANCE_M);
     done(&m);
 }
 
@@ -370,9 +371,9 @@ static void check_optimised(void (*scene)(scansim_scene *), uint32_t most)
     assert_true(m.stats.vertices <= most);
     assert_true(m.score.f >= 0.95);
     assert_true(m.score.ray_rmse_m <= 0.04);
-    assert_true(m.worst_short_m > -POLYC__RAY_TOLERANCE_M - 0.03);
+    assert_true(m.worst_short_m > -(double)POLYC__RAY_TOLERANCE_M - 0.03);
     /* nor does any beam pass its return to meet the map farther on */
-    assert_true(m.worst_long_m < POLYC__RAY_TOLERANCE_M + 0.03);
+    assert_true(m.worst_long_m < (double)POLYC__RAY_TOLERANCE_M + 0.03);
     assert_true(m.score.f >= 0.99);
     done(&m);
 }
@@ -454,16 +455,16 @@ static void full_turn(polyc__rays *r, float *range)
     memset(r, 0, sizeof *r);
     r->on = 1;
     r->base = 0.0;
-    r->step = 2.0 * PI / 360.0;
-    r->step_cos = cos(r->step);
-    r->step_sin = sin(r->step);
+    r->step = 2.0f * PIF / 360.0f;
+    r->step_cos = cosf(r->step);
+    r->step_sin = sinf(r->step);
     r->count = 360;
     r->turn = 360;
     r->range = range;
     r->min_m = 0.1f;
     r->max_m = 30.0f;
     r->tol_m = POLYC__RAY_TOLERANCE_M;
-    r->own_m = 0.15;
+    r->own_m = 0.15f;
 }
 
 static void test_blocks_beams(void **state)
@@ -495,15 +496,15 @@ static void test_blocks_beams(void **state)
     assert_true(polyc__blocks_beams(&r, 1.0f, 0.05f, 1.0f, -0.05f, NULL, 0));
     assert_true(polyc__blocks_beams(&r, -1.0f, 0.1f, -1.0f, -0.1f, NULL, 0));
     /* only the no-return beam crosses it: nothing proven */
-    float a = (float)(10.0 * r.step);
+    float a = 10.0f * r.step;
     assert_false(polyc__blocks_beams(&r, cosf(a) - 0.01f * sinf(a), sinf(a) + 0.01f * cosf(a),
                                      cosf(a) + 0.01f * sinf(a), sinf(a) - 0.01f * cosf(a), NULL, 0));
     /* a 180-degree scan sees nothing behind it */
-    r.base = -0.5 * PI;
+    r.base = -0.5f * PIF;
     r.count = 181;
-    r.step = PI / 180.0;
-    r.step_cos = cos(r.step);
-    r.step_sin = sin(r.step);
+    r.step = PIF / 180.0f;
+    r.step_cos = cosf(r.step);
+    r.step_sin = sinf(r.step);
     assert_false(polyc__blocks_beams(&r, -1.0f, 0.1f, -1.0f, -0.1f, NULL, 0));
     assert_true(polyc__blocks_beams(&r, 1.0f, -0.2f, 1.0f, 0.2f, NULL, 0));
     r.on = 0;
@@ -528,7 +529,7 @@ static void test_holds_returns(void **state)
     /* along a beam through its return: held too */
     assert_true(polyc__holds_returns(&r, 1.95f, 0.0f, 2.05f, 0.0001f));
     /* a no-return beam holds nothing; a far return is held */
-    float a = (float)(5.0 * r.step), e = (float)(90.0 * r.step);
+    float a = 5.0f * r.step, e = 90.0f * r.step;
     assert_false(polyc__holds_returns(&r, 2.0f * cosf(a) - 0.005f * sinf(a),
                                       2.0f * sinf(a) + 0.005f * cosf(a),
                                       2.0f * cosf(a) + 0.005f * sinf(a),
