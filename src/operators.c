@@ -170,8 +170,31 @@ static int would_fold(const polyc__opt *o, int32_t e, int32_t f)
     return ax * bx + ay * by > 0.866f * la * lb;
 }
 
+/* The change of the BIC if ends e and f are linked by a segment: the
+ * error it explains (the points between them) and the turn costs of the
+ * two ends that become corners; the vertex count stays. */
+static float link_delta(polyc__opt *o, int32_t e, int32_t f)
+{
+    const polyc__vertex *E = &o->s->v[e], *F = &o->s->v[f];
+    const float xy[4] = {E->x, E->y, F->x, F->y};
+    float derr = polyc__local_delta(o, NULL, 0, xy, 1, 0.0f);
+    if (derr >= 0.0f)
+        return derr; /* (nothing explained: no gain whatever the turns) */
+    int32_t pe = E->prev != POLYC__NONE ? E->prev : E->next;
+    int32_t pf = F->prev != POLYC__NONE ? F->prev : F->next;
+    float dangle = 0.0f;
+    if (pe != POLYC__NONE)
+        dangle += polyc__turn_cost(o, o->s->v[pe].x, o->s->v[pe].y, E->x, E->y, F->x, F->y);
+    if (pf != POLYC__NONE)
+        dangle += polyc__turn_cost(o, E->x, E->y, F->x, F->y, o->s->v[pf].x, o->s->v[pf].y);
+    return o->cfg->alpha * (derr + o->cfg->gamma * dangle);
+}
+
 /* Ends closer than merge_dist_m are linked by a segment; the vertex
- * removal operator later fuses the two ends when that lowers the BIC. */
+ * removal operator later fuses the two ends when that lowers the BIC.
+ * Ends up to twice that apart are linked when the link lowers the BIC
+ * (data between them that the link explains): a ring whose ends the
+ * search has pulled 18 cm apart on a circle stays open otherwise. */
 int polyc__op_merge(polyc__opt *o)
 {
     return polyc__op_merge_folds(o, 1);
@@ -180,7 +203,7 @@ int polyc__op_merge(polyc__opt *o)
 int polyc__op_merge_folds(polyc__opt *o, int folds)
 {
     polyc__store *s = o->s;
-    float lim2 = o->cfg->merge_dist_m * o->cfg->merge_dist_m;
+    float lim2 = o->cfg->merge_dist_m * o->cfg->merge_dist_m, bridge2 = 4.0f * lim2;
     int changed = 0;
     for (int32_t l = 0; l < s->l_high; l++) {
         for (int side = 0; side < 2; side++) {
@@ -191,8 +214,13 @@ int polyc__op_merge_folds(polyc__opt *o, int folds)
             if (!in_region(o, e))
                 continue;
             int32_t f = nearest_end(o, e, lim2);
+            int bridge = f == POLYC__NONE;
+            if (bridge)
+                f = nearest_end(o, e, bridge2);
             if (f == POLYC__NONE || polyc__link_crosses(o, e, f) || (!folds && would_fold(o, e, f)))
                 continue; /* (a link through a wall would be cut again) */
+            if (bridge && link_delta(o, e, f) >= 0.0f)
+                continue;
             polyc__chg_begin(o);
             int32_t le = s->v[e].line, lf = s->v[f].line;
             if (le == lf) {
