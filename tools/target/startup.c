@@ -6,7 +6,8 @@
  * Takes: main() of an example, run with -icount shift=0.
  * Gives: the example's own output, then "instructions WHAT INDEX N" lines,
  * "instructions total N", a calibration line and, when profiling, the PC
- * samples in target-pcs.bin (little-endian 32-bit words). */
+ * samples in target-pcs.bin (little-endian 32-bit words, PC and LR of
+ * each sample). */
 #include <stddef.h>
 #include <stdint.h>
 
@@ -169,8 +170,10 @@ void target_systick_c(const uint32_t *frame)
 {
     wraps++;
 #ifdef TARGET_PROFILE
-    if (sampling && sample_count < MAX_SAMPLES)
+    if (sampling && sample_count + 2u <= MAX_SAMPLES) {
         samples[sample_count++] = frame[6]; /* the stacked PC */
+        samples[sample_count++] = frame[5]; /* and LR: the caller of a leaf routine */
+    }
 #else
     (void)frame;
 #endif
