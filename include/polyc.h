@@ -73,7 +73,9 @@ typedef struct polyc_config {
                                   this range (0: such beams are ignored) */
     float grazing_cells;       /* skip misses in the last grazing_cells/sin(incidence)
                                   cells before a hit (0 = off) */
-    float max_extent_m;        /* refuse data spanning more than this, either axis */
+    float max_extent_m;        /* refuse data spanning more than this, either axis;
+                                  at most 10,000 (coordinates are floats relative
+                                  to the first pose: their step stays below 1 mm) */
     /* Optimiser (paper section IV) */
     float alpha;               /* BIC weight of the error; paper 500 */
     float gamma;               /* weight of the angle prior; 0 = uniform prior */

@@ -95,7 +95,8 @@ polyc_status polyc_config_check(const polyc_config *c, const char **why)
     else if (!in(c->data_min_m, 0.0f, 1.0f)) w = "data_min_m must be in [0, 1]";
     else if (!in(c->free_range_m, 0.0f, 1e4f)) w = "free_range_m must be in [0, 10000]";
     else if (!in(c->grazing_cells, 0.0f, 100.0f)) w = "grazing_cells must be in [0, 100]";
-    else if (!in(c->max_extent_m, 0.01f, 1e6f)) w = "max_extent_m must be in [0.01, 1e6]";
+    else if (!in(c->max_extent_m, 0.01f, 1e4f)) /* float's step within 1e4 m: < 1 mm */
+        w = "max_extent_m must be in [0.01, 10000]";
     else if (!in(c->alpha, 1e-6f, 1e12f)) w = "alpha must be positive";
     else if (!in(c->gamma, 0.0f, 1e6f)) w = "gamma must be in [0, 1e6]";
     else if (!in(c->merge_dist_m, 0.0f, 100.0f)) w = "merge_dist_m must be in [0, 100]";

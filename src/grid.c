@@ -308,7 +308,7 @@ static void take_pre_misses(polyc__grid *g, polyc__tile *t, size_t d)
  * again, where the count is exact). As count_beam's loop: a cell counts
  * when the walk enters it before miss_end. Returns polyc__walk_step's
  * last result (1: the walk left the tile). */
-static int pre_walk(polyc__grid *g, size_t d, polyc__walk *w, float miss_end, int take_back)
+static int pre_walk(polyc__grid *g, size_t d, polyc__walk *w, int64_t miss_key, int take_back)
 {
     int64_t r = pre_record(g, d, !take_back);
     int left = 0;
@@ -321,7 +321,7 @@ static int pre_walk(polyc__grid *g, size_t d, polyc__walk *w, float miss_end, in
     uint8_t *nib = g->pre_cells + (size_t)r * (POLYC__TILE_CELLS / 2);
     uint16_t *sum = g->pre_miss + (size_t)r * POLYC__PRE_BLOCKS;
     do {
-        if (polyc__walk_t(w) < miss_end) {
+        if (w->t_key < miss_key) {
             uint16_t *s = &sum[pre_block(w->idx)];
             unsigned c = pre_cell(nib, w->idx), shift = (unsigned)(w->idx & 1) * 4;
             if (take_back) {
@@ -385,14 +385,14 @@ static inline void count_beam(const count_pass *p, const polyc__beam *b, int tak
     polyc__grid *g = p->g;
     polyc__walk w;
     polyc__walk_start(&w, b);
-    const float miss_end = b->miss_end;
+    const int64_t miss_key = polyc__walk_key_at(&w, b->miss_end);
     polyc__tile *t = NULL;
     if (w.n > 0 && (!polyc__walk_enter(&w, g->width, g->height) || !(t = tile_get(p, w.ix, w.iy))))
         return;
     while (w.n > 0) {
         if (t == p->spill && p->records) {
             /* online: into the record of this tile not stored */
-            int left = pre_walk(g, dir_index(g, w.ix, w.iy), &w, miss_end, take_back);
+            int left = pre_walk(g, dir_index(g, w.ix, w.iy), &w, miss_key, take_back);
             if (left && w.n > 0 &&
                 (!polyc__walk_enter(&w, g->width, g->height) || !(t = tile_get(p, w.ix, w.iy))))
                 return;
@@ -414,7 +414,7 @@ static inline void count_beam(const count_pass *p, const polyc__beam *b, int tak
         /* a stored tile: counted up to its edge (or the end cell) */
         int left;
         do {
-            if (polyc__walk_t(&w) < miss_end) {
+            if (w.t_key < miss_key) {
                 count_one(take_back, &t->misses[w.idx], &t->hits[w.idx]);
                 if (on_hits && t->hits[w.idx])
                     on_hits[t - g->tiles]++;
@@ -432,7 +432,7 @@ static inline void count_beam(const count_pass *p, const polyc__beam *b, int tak
     int idx = polyc__cell_index(w.ex, w.ey);
     if (b->hit)
         count_one(take_back, &t->hits[idx], &t->misses[idx]);
-    else if (polyc__walk_t(&w) < miss_end)
+    else if (w.t_key < miss_key)
         count_one(take_back, &t->misses[idx], &t->hits[idx]);
 }
 
@@ -560,7 +560,7 @@ static void redo_beam(polyc__grid *g, const polyc__beam *b, uint32_t *on_hits)
 {
     polyc__walk w;
     polyc__walk_start(&w, b);
-    const float miss_end = b->miss_end;
+    const int64_t miss_key = polyc__walk_key_at(&w, b->miss_end);
     if (w.n > 0 && !polyc__walk_enter(&w, g->width, g->height))
         return;
     while (w.n > 0) {
@@ -577,11 +577,11 @@ static void redo_beam(polyc__grid *g, const polyc__beam *b, uint32_t *on_hits)
         }
         int left;
         if (g->dir[d] == 0) {
-            left = pre_walk(g, d, &w, miss_end, 0);
+            left = pre_walk(g, d, &w, miss_key, 0);
         } else {
             polyc__tile *t = &g->tiles[g->dir[d] - 1];
             do {
-                if (polyc__walk_t(&w) < miss_end) {
+                if (w.t_key < miss_key) {
                     count_one(0, &t->misses[w.idx], &t->hits[w.idx]);
                     if (on_hits && t->hits[w.idx])
                         on_hits[t - g->tiles]++;
@@ -595,7 +595,7 @@ static void redo_beam(polyc__grid *g, const polyc__beam *b, uint32_t *on_hits)
     /* the end cell: a miss past the last reflection's reach, counted only
      * in a stored tile (as count_beam) */
     if (b->hit || w.ex < 0 || w.ey < 0 || w.ex >= g->width || w.ey >= g->height ||
-        polyc__walk_t(&w) >= miss_end)
+        w.t_key >= miss_key)
         return;
     size_t d = dir_index(g, w.ex, w.ey);
     if (redo_needs(g, d) && g->dir[d] != 0) {

@@ -14,6 +14,8 @@ int polyc__size_carve(polyc__arena *a, polyc__size_scratch *sz, int32_t V)
     POLYC__CARVE(ok, a, sz->seg_w, V);
     POLYC__CARVE(ok, a, sz->seg_far_d, V);
     POLYC__CARVE(ok, a, sz->seg_far, V);
+    POLYC__CARVE_ZERO(ok, a, sz->add_failed, V);
+    POLYC__CARVE(ok, a, sz->add_failed_end, V);
     /* A pass pushes each live vertex once, and each removal pops one
      * candidate and pushes at most its two neighbours: the heap never holds
      * more than twice the vertices, so a small store's spare is V. A
@@ -197,6 +199,29 @@ static void segment_stats(polyc__opt *o)
 
 #define ADD_CANDIDATES 8
 
+void polyc__size_forget(polyc__opt *o)
+{
+    for (int32_t v = 0; v < o->s->v_high; v++)
+        o->size.add_failed[v] = 0;
+}
+
+/* Whether the addition on segment u-w failed before and nothing it
+ * depends on moved since: its ends and their neighbours untouched (the
+ * trial climbs u, w and the new vertex; without noise it is a function of
+ * them and of the data, which stay put during a search). */
+static int failed_before(const polyc__opt *o, int32_t u, int32_t w)
+{
+    uint32_t failed = o->size.add_failed[u];
+    if (failed == 0 || o->size.add_failed_end[u] != w)
+        return 0;
+    const polyc__vertex *V = o->s->v;
+    int32_t near[4] = {V[u].prev, u, w, V[w].next};
+    for (int k = 0; k < 4; k++)
+        if (near[k] != POLYC__NONE && o->v_touch[near[k]] >= failed)
+            return 0;
+    return 1;
+}
+
 /* Tries a vertex at the farthest point of the worst segments (largest mean
  * squared distance); each is adjusted with its neighbours and kept only if
  * the BIC falls. */
@@ -234,6 +259,8 @@ int polyc__op_add_vertices(polyc__opt *o, int max_tries)
             int32_t far = o->size.seg_far[u];
             if (o->d.pt_seg[far] != u)
                 continue; /* stale after an earlier addition */
+            if (failed_before(o, u, w))
+                continue; /* (the same trial would fail the same way) */
             float old_xy[4 * POLYC__EDIT_SEGS];
             int n_xy = o->rays.on ? polyc__edit_segments(o, &u, 1, old_xy) : 0;
             if (o->rays.on &&
@@ -265,6 +292,8 @@ int polyc__op_add_vertices(polyc__opt *o, int max_tries)
             polyc__op_move(o, u, ux, uy);
             polyc__op_move(o, w, wx, wy);
             polyc__chg_commit(o);
+            o->size.add_failed[u] = ++o->touch_stamp; /* (after the undo's touches) */
+            o->size.add_failed_end[u] = w;
         }
         if (!any)
             break;

@@ -135,6 +135,7 @@ polyc_status polyc__search(polyc__opt *o, polyc_progress_fn progress, void *user
     polyc_status st;
     const polyc_config *cfg = o->cfg;
     polyc__flat_from_store(&o->best, o->s);
+    polyc__size_forget(o);
     float best = polyc__bic(o);
     float sigma = (float)cfg->noise_m;
     for (uint8_t k = 0; k < o->pol.noise_skip; k++)
@@ -154,6 +155,7 @@ polyc_status polyc__search(polyc__opt *o, polyc_progress_fn progress, void *user
             noise = 0.0f;
         if (noise > 0.0f) {
             polyc__op_noise(o, noise);
+            polyc__size_forget(o); /* (the noise moves vertices without touching them) */
             o->untangle_mark = o->zip_mark = 0; /* every segment moved */
             if ((st = polyc__rebuild(o)) != POLYC_OK)
                 return restore_best(o, st);

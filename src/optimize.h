@@ -108,6 +108,11 @@ typedef struct polyc__split_scratch {
 typedef struct polyc__size_scratch {
     float *seg_sum, *seg_w, *seg_far_d;
     int32_t *seg_far;
+    /* per segment (its first vertex): the touch stamp just after an
+     * addition on it failed, and its other end then (0: none since the
+     * search began) */
+    uint32_t *add_failed;
+    int32_t *add_failed_end;
     polyc__heap_entry *heap;
     int32_t heap_n, heap_cap;
 } polyc__size_scratch;
@@ -451,6 +456,9 @@ int polyc__holds_returns(const polyc__rays *rays, float ax, float ay, float bx, 
 float polyc__ray_position(const polyc__rays *rays, float ax, float ay, float bx, float by,
                           float px, float py, float projection);
 int polyc__op_add_vertices(polyc__opt *o, int max_tries);
+/* model_size.c: additions that failed are tried again (a new search, or
+ * data that changed) */
+void polyc__size_forget(polyc__opt *o);
 int polyc__hill_climb(polyc__opt *o, int32_t v);
 float polyc__turn_cost(const polyc__opt *o, float ax, float ay, float bx, float by, float cx,
                         float cy);

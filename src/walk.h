@@ -104,6 +104,23 @@ static inline float polyc__walk_t(const polyc__walk *w)
     return (float)w->t_key * w->per_key;
 }
 
+/* The key of beam parameter t: the steps with t_key below it are those
+ * whose polyc__walk_t is below t (up to float's rounding of either). Once
+ * per beam, so that the cells compare integers: a 64-bit key to float is a
+ * library call per cell on the target. t in 24-bit fixed point, times
+ * end_key (the key of t = 1) in two halves: below 2^62, no overflow. */
+static inline int64_t polyc__walk_key_at(const polyc__walk *w, float t)
+{
+    if (w->end_key == 0) /* (no extent: every step is at t = 0) */
+        return t > 0.0f ? INT64_MAX : 0;
+    if (!(t < 1.0f)) /* (t = 1: the steps before the end point; NaN: none) */
+        return t == 1.0f ? w->end_key : (t > 1.0f ? INT64_MAX : 0);
+    if (t <= 0.0f)
+        return 0;
+    int64_t m = (int64_t)(uint32_t)(t * 16777216.0f), e = w->end_key;
+    return (e >> 24) * m + (((e & 0xffffff) * m) >> 24);
+}
+
 /* To the next cell. Returns 1 when it left the tile (or the grid): then
  * polyc__walk_enter must run before idx is used again. */
 static inline int polyc__walk_step(polyc__walk *w)

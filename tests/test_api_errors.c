@@ -276,6 +276,7 @@ static void test_config_out_of_range(void **state)
         BAD(contour_threshold, nan), BAD(data_min_m, -1.0f),      BAD(data_min_m, nan),
         BAD(free_range_m, -1.0f),    BAD(free_range_m, inf),      BAD(grazing_cells, -1.0f),
         BAD(max_extent_m, 0.0f),     BAD(max_extent_m, -5.0f),    BAD(max_extent_m, inf),
+        BAD(max_extent_m, 1.5e4f),
         BAD(alpha, 0.0f),            BAD(alpha, -500.0f),         BAD(alpha, nan),
         BAD(gamma, -0.1f),           BAD(gamma, nan),             BAD(merge_dist_m, -0.1f),
         BAD(split_gap_m, 0.0f),      BAD(step_m, 0.0f),           BAD(step_m, -0.01f),
