@@ -127,7 +127,7 @@ polyc_status polyc_reset(polyc_ctx *ctx)
 const char *polyc__scan_problem(const polyc_scan *s)
 {
     if (!polyc__pose_ok(s->pose_x_m, s->pose_y_m, s->pose_theta_rad))
-        return "scan pose is not finite or beyond 1e7 m";
+        return "scan pose is not finite, beyond 1e7 m or turned beyond 1e4 rad";
     if (!isfinite(s->start_angle_rad) || !isfinite(s->angle_step_rad) ||
         fabsf(s->angle_step_rad) > 6.2832f || fabsf(s->start_angle_rad) > 100.0f)
         return "scan angles are not finite or out of range";

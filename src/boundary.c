@@ -11,6 +11,7 @@
 #include <math.h>
 
 #define TWO_PI 6.283185307179586
+#define PI 3.141592653589793
 
 float polyc__narrow(double v)
 {
@@ -26,9 +27,14 @@ void polyc__frame_set(polyc_ctx *ctx, double x_m, double y_m)
 
 float polyc__heading(double theta_rad)
 {
-    /* theta - 2 pi k, k the nearest whole number of turns: [-pi, pi] up to
-     * rounding (libm's remainder() brings in fmod, 750 bytes of flash) */
-    return (float)(theta_rad - TWO_PI * floor(theta_rad * (1.0 / TWO_PI) + 0.5));
+    /* whole turns off, by additions (|theta| <= 1e4 rad, polyc__pose_ok:
+     * at most 1,592 of them): libm's remainder() and a multiply would
+     * bring 1.3 KB of software double into every firmware */
+    while (theta_rad > PI)
+        theta_rad -= TWO_PI;
+    while (theta_rad < -PI)
+        theta_rad += TWO_PI;
+    return (float)theta_rad;
 }
 
 void polyc__frame_scan(const polyc_ctx *ctx, const polyc_scan *s, polyc__scan *d)
@@ -66,10 +72,11 @@ void polyc__frame_box(const polyc_ctx *ctx, float box[4])
 void polyc__frame_export(polyc_ctx *ctx)
 {
     for (uint32_t i = 0; ctx->from_grid && i < ctx->flat.points; i++) {
-        double x = (double)ctx->flat.xy[2 * i], y = (double)ctx->flat.xy[2 * i + 1];
-        double c = (double)ctx->frame_dir.cos, s = (double)ctx->frame_dir.sin;
-        ctx->flat.xy[2 * i] = (float)(ctx->frame_x + c * x - s * y);
-        ctx->flat.xy[2 * i + 1] = (float)(ctx->frame_y + s * x + c * y);
+        /* turned in float (offsets from the grid's corner), placed in double */
+        float x = ctx->flat.xy[2 * i], y = ctx->flat.xy[2 * i + 1];
+        float c = ctx->frame_dir.cos, s = ctx->frame_dir.sin;
+        ctx->flat.xy[2 * i] = (float)(ctx->frame_x + (double)(c * x - s * y));
+        ctx->flat.xy[2 * i + 1] = (float)(ctx->frame_y + (double)(s * x + c * y));
     }
     for (uint32_t i = 0; !ctx->from_grid && i < ctx->flat.points; i++) {
         ctx->flat.xy[2 * i] = (float)((double)ctx->flat.xy[2 * i] + ctx->frame_x);

@@ -122,7 +122,8 @@ polyc_status polyc_config_check(const polyc_config *c, const char **why)
 
 int polyc__pose_ok(double x, double y, double th)
 {
-    return isfinite(x) && isfinite(y) && isfinite(th) && fabs(x) < 1e7 && fabs(y) < 1e7;
+    return isfinite(x) && isfinite(y) && isfinite(th) && fabs(x) < 1e7 && fabs(y) < 1e7 &&
+           fabs(th) <= 1e4;
 }
 
 /* Extent rule: the poses and every reflected endpoint. Free-space beams do

@@ -339,12 +339,14 @@ static void test_bad_scans(void **state)
     fixture_open(&f, NULL, 8, 512);
     polyc_ctx *ctx = f.ctx;
     float r[4] = {1.0f, 1.1f, 1.2f, 1.3f};
-    polyc_scan bad[12];
+    polyc_scan bad[14];
     int nb = 0;
     bad[nb] = one_scan((double)NAN, 0, 4, r), nb++;
     bad[nb] = one_scan(0, (double)INFINITY, 4, r), nb++;
     bad[nb] = one_scan(1e30, 0, 4, r), nb++;
     bad[nb] = one_scan(0, 0, 4, r), bad[nb].pose_theta_rad = (double)NAN, nb++;
+    bad[nb] = one_scan(0, 0, 4, r), bad[nb].pose_theta_rad = 1.0001e4, nb++;
+    bad[nb] = one_scan(0, 0, 4, r), bad[nb].pose_theta_rad = -1e300, nb++;
     bad[nb] = one_scan(0, 0, 4, r), bad[nb].angle_step_rad = 0.0f, nb++;
     bad[nb] = one_scan(0, 0, 4, r), bad[nb].angle_step_rad = NAN, nb++;
     bad[nb] = one_scan(0, 0, 4, r), bad[nb].start_angle_rad = 1e6f, nb++;
@@ -364,6 +366,13 @@ static void test_bad_scans(void **state)
         assert_int_equal(before.beams, after.beams);
     }
     still_works(&f);
+
+    /* a heading of many turns is a heading: 9,999.5 rad is the scan at
+     * 9,999.5 - 1,591 turns */
+    assert_int_equal(polyc_reset(ctx), POLYC_OK);
+    polyc_scan turned = one_scan(0, 0, 4, r);
+    turned.pose_theta_rad = 9999.5;
+    assert_int_equal(polyc_add_scan(ctx, &turned), POLYC_OK);
 
     /* zero beams: allowed, adds no beams; a map of nothing */
     assert_int_equal(polyc_reset(ctx), POLYC_OK);
