@@ -84,10 +84,12 @@ polyc_status polyc_online_limits_for_area(const polyc_config *config, double are
         return POLYC_ERR_CONFIG;
     memset(out, 0, sizeof *out);
     float area = polyc__narrow(area_m);
-    if (!(area > 1.0f && area <= 1e5f) || max_scan_beams == 0)
-        return POLYC_ERR_CONFIG;
+    /* a side too wide for the grid is the data's extent (any side over 1e5
+     * is: max_extent_m is at most 1e4), not a bad argument */
     if (area > 2.0f * config->max_extent_m)
         return POLYC_ERR_EXTENT;
+    if (!(area > 1.0f && area <= 1e5f) || max_scan_beams == 0)
+        return POLYC_ERR_CONFIG;
     float side = ceilf(area / config->cell_m / POLYC__TILE_SIDE);
     float tiles = side * side;
     /* the tiles a building's walls reach: intel 851 of its 50 m square's

@@ -145,5 +145,24 @@ run grid -o room "$LOG"
 refused online-map '^polyc: --online does not apply to a map YAML' --online -o m.svg room.yaml
 [ -e m.svg ] && bad "m.svg written"
 
+# a log whose only scan has no beam: an empty map, as a batch run gives
+name=online-no-beams
+printf 'SCAN 0 0 0 0 0.1 0.02 30 0\n' > nobeam.log
+run --online --format json -o nobeam.json nobeam.log
+[ $rc -eq 0 ] && grep -q '"polylines": \[\]' nobeam.json || bad "exit $rc, or not an empty map"
+run --format json -o nobeam-batch.json nobeam.log
+[ $rc -eq 0 ] && grep -q '"polylines": \[\]' nobeam-batch.json || bad "batch: exit $rc"
+
+# scans 1e4 to 1e6 m apart: too wide for the grid, said with the file and the reach
+for far in 1e4 1e5 5e5 1e6; do
+    name=online-far-$far
+    printf 'SCAN 0 0 0 0 0.1 0.02 30 3 1 1 1\nSCAN %s 0 0 0 0.1 0.02 30 3 1 1 1\n' $far > far.log
+    run --online -o far.svg far.log
+    [ $rc -eq 1 ] && [ "$(wc -l < err.txt)" -eq 1 ] &&
+        grep -qE '^polyc: far\.log: the log reaches [0-9]+ m from its first pose: an online map of [0-9]+ m square is more than the grid.s limit of 2000 m$' err.txt ||
+        bad "exit $rc, or not the extent message"
+    [ -e far.svg ] && bad "far.svg written"
+done
+
 echo "cli_online: $count runs, $failed failed"
 [ $failed -eq 0 ]

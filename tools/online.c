@@ -43,6 +43,8 @@ static double log_area(const polyc_config *cfg, const scanlog *log, polyc_box *b
         if (log->scans[i].beam_count > *max_beams)
             *max_beams = log->scans[i].beam_count;
     }
+    if (*max_beams == 0)
+        *max_beams = 1;            /* scans of no beams: the library sizes for one */
     double reach = fmax(fmax(x0 - box->min_x_m, box->max_x_m - x0),
                         fmax(y0 - box->min_y_m, box->max_y_m - y0));
     return 2.0 * (reach + ONLINE_EDGE_M + ONLINE_AIR_CELLS * (double)cfg->cell_m);
@@ -271,7 +273,9 @@ int online_map(const options *o, run *r, double t_start, mapout_times *t)
                                     " map of %.0f m square is more than the grid's limit of %g m",
                         input_name(o), rp.area_m / 2, rp.area_m, (double)cfg.max_extent_m);
     if (st != POLYC_OK)
-        return library_fail("sizing", st, NULL, 0);
+        return complain(EXIT_INPUT, "%s: an online map of %g m square for scans of up to %u"
+                                    " beams: %s", input_name(o), rp.area_m, (unsigned)max_beams,
+                        polyc_status_str(st));
     if (o->frames && (rc = frames_clash(o, r->log.count)) != 0)
         return rc;
     if (o->frames && make_frames_dir(o->frames))
