@@ -23,6 +23,9 @@ import random
 import re
 import signal
 import struct
+import subprocess
+import sys
+import tempfile
 import unittest
 from array import array
 
@@ -30,7 +33,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(os.path.dirname(HERE))
 os.environ.setdefault("POLYC_LIB", os.path.join(REPO, "build", "py", "libpolyc.so"))
 import polyc  # noqa: E402
-from test_polyc import cast as room_cast, f32  # noqa: E402
+from test_polyc import cast as room_cast, f32, write_plain  # noqa: E402
 
 try:
     import numpy
@@ -379,17 +382,65 @@ class Online(unittest.TestCase):
         self.assertEqual(len(m.changes_since(0)), len(m.polyline_ids))
 
     def test_the_readme_example(self):
-        # the README's online example, fed the room: robot gives (pose, ranges)
+        # the README's online example as written, run on a log written here:
+        # a 60 m corridor driven in 150 scans, wider than a 40 m square and
+        # more scans than 100 kept, which a fixed area or keep_scans refuse
         with open(os.path.join(HERE, "README.md")) as f:
             text = f.read()
         examples = re.findall(r"```python\n(.*?)```", text, re.S)
         example = [e for e in examples if "OnlineMap" in e]
         self.assertEqual(len(example), 1)
-        robot = [(s.pose, s.ranges_m) for s in room_scans(6)]
-        printed = io.StringIO()
-        with contextlib.redirect_stdout(printed):
-            exec(example[0], {"polyc": polyc, "math": math, "robot": robot})
-        self.assertIn("added", printed.getvalue())
+        walls = [(0, 0, 60, 0), (60, 0, 60, 3), (60, 3, 0, 3), (0, 3, 0, 0)]
+        rng = random.Random(3)
+        start, step = f32(-math.pi / 2), f32(math.pi / 180)
+        scans = []
+        for k in range(150):
+            x, y, th = 1.0 + 58.0 * k / 149, 1.5, 0.0 if k < 75 else math.pi
+            ranges = [f32(room_cast(x, y, th + start + i * step, 30.0, walls) +
+                          rng.gauss(0, 0.005)) for i in range(181)]
+            scans.append(polyc.Scan((x, y, th), start, step, f32(0.02), f32(30.0), ranges))
+        with tempfile.TemporaryDirectory() as tmp:
+            log = os.path.join(tmp, "corridor.log")
+            write_plain(log, scans)
+            area_m, beams = polyc.online_area(polyc.read_log(log), {"cell_m": 0.05})
+            self.assertGreater(area_m, 100.0)          # the corridor from its first pose
+            self.assertEqual(beams, 181)
+            env = dict(os.environ, PYTHONPATH=HERE)    # this package, POLYC_LIB's library
+            got = subprocess.run([sys.executable, "-c", example[0], log], capture_output=True,
+                                 text=True, timeout=600, env=env)
+        self.assertEqual(got.returncode, 0, got.stderr)
+        m = re.fullmatch(r"(\d+) polylines, (\d+) vertices, (\d+) changes sent\n", got.stdout)
+        self.assertIsNotNone(m, got.stdout)
+        self.assertGreater(int(m.group(1)), 0)
+        self.assertGreater(int(m.group(3)), 0)
+
+    def test_online_area(self):
+        # the tool's sizing: the square round the first pose that holds every
+        # pose and endpoint, 1 m of edge and 32 cells of air
+        scans = room_scans(6)
+        area_m, beams = polyc.online_area(scans, {"cell_m": CELL_M})
+        self.assertEqual(beams, BEAMS)
+        x0, y0, _ = scans[0].pose
+        reach = max(max(abs(x0 - 0.0), abs(ROOM_W - x0)), max(abs(y0 - 0.0), abs(ROOM_H - y0)))
+        self.assertAlmostEqual(area_m, 2 * (reach + 1.0 + 32 * f32(CELL_M)), delta=0.05)
+        m = polyc.OnlineMap(area_m, beams, config={"cell_m": CELL_M})
+        for s in scans:
+            m.add_scan(*s)
+        m.update()
+        with self.assertRaises(ValueError):
+            polyc.online_area([])
+        nobeam = polyc.Scan((0.0, 0.0, 0.0), 0.0, 0.1, 0.02, 30.0, [])
+        self.assertEqual(polyc.online_area([nobeam]).max_scan_beams, 1)
+
+    def test_far_area_is_extent(self):
+        # a side over twice max_extent_m is POLYC_ERR_EXTENT, even beyond 1e5 m
+        for area in (5000.0, 2e5, 2e6, float("inf")):
+            with self.assertRaises(polyc.PolycError) as e:
+                polyc.OnlineMap(area, BEAMS)
+            self.assertEqual(e.exception.status, polyc.ERR_EXTENT, area)
+        with self.assertRaises(polyc.PolycError) as e:
+            polyc.OnlineMap(float("nan"), BEAMS)
+        self.assertEqual(e.exception.status, polyc.ERR_CONFIG)
 
     def test_struct_sizes(self):
         # in the import's check (test_polyc tests every struct of _STRUCTS)

@@ -238,6 +238,40 @@ class Binding(unittest.TestCase):
             ctx.optimize(progress=lambda it: True)
         self.assertEqual(e.exception.status, polyc.ERR_STOPPED)
 
+    def test_a_deadline_keeps_the_best_map(self):
+        # progress stops after 2 iterations: POLYC_ERR_STOPPED with the best
+        # map so far attached, the map a Context stopped the same way keeps
+        scans = scene()
+
+        def deadline(it):
+            return it["iteration"] >= 1
+
+        with self.assertRaises(polyc.PolycError) as e:
+            polyc.build_map(scans, cell_m=0.05, progress=deadline)
+        self.assertEqual(e.exception.status, polyc.ERR_STOPPED)
+        got = e.exception.result
+        self.assertIsInstance(got, polyc.Result)
+        self.assertGreater(len(got.polylines), 0)
+        self.assertEqual(got.stats["vertices"], sum(len(p.points) for p in got.polylines))
+        whole = polyc.build_map(scans, cell_m=0.05)
+        self.assertLess(got.stats["iterations"], whole.stats["iterations"])
+        ctx = polyc.Context((whole.stats["scans"], whole.stats["beams"],
+                             polyc_grid_cells(scans, 0.05), 0), cell_m=0.05)
+        for s in scans:
+            ctx.add_scan(*s)
+        with self.assertRaises(polyc.PolycError):
+            ctx.build(progress=deadline)
+        self.assertEqual(ctx.polylines(), got.polylines)
+        cells, width, height, origin = room_grid()
+        with self.assertRaises(polyc.PolycError) as e:
+            polyc.build_map_from_grid(cells, width, height, 0.05, origin=origin,
+                                      progress=lambda it: True)
+        self.assertEqual(e.exception.status, polyc.ERR_STOPPED)
+        self.assertGreater(len(e.exception.result.polylines), 0)
+        with self.assertRaises(polyc.PolycError) as e:     # other errors carry none
+            polyc.Context((1, 1, 1024, 0)).score()
+        self.assertIsNone(e.exception.result)
+
 
 def room_grid(yaw=0.3, res=0.05):
     """The room of WALLS rasterised into an occupancy grid turned by yaw:

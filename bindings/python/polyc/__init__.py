@@ -58,8 +58,8 @@ from array import array
 from typing import NamedTuple, Sequence, Tuple
 
 __all__ = ["PolycError", "ResyncError", "Scan", "Points", "Polyline", "Result", "Context",
-           "OnlineMap", "OnlineReport", "Change", "Map", "GridImage",
-           "build_map", "build_map_from_grid", "grid_image", "read_log", "read_map",
+           "OnlineMap", "OnlineReport", "OnlineArea", "Change", "Map", "GridImage",
+           "build_map", "build_map_from_grid", "grid_image", "read_log", "read_map", "online_area",
            "default_config",
            "version", "STATUS", "FLAG_EXACT_POINTS", "FLAG_NO_GRAZING", "FLAG_GRID_TRACE",
            "ONLINE_WORK_DEFAULT", "CHANGE_KINDS"]
@@ -82,10 +82,14 @@ _RANGE = {_u32: (0, 2 ** 32 - 1), _u64: (0, 2 ** 64 - 1)}
 
 class PolycError(Exception):
     """A libpolyc call failed: .status (int), .name ('POLYC_ERR_NOMEM'),
-    .what (the operation), .detail (polyc_last_error, may be empty)."""
+    .what (the operation), .detail (polyc_last_error, may be empty).
+    .result: for POLYC_ERR_STOPPED from build_map or build_map_from_grid
+    (the progress callback stopped the optimiser), the best map so far as
+    a Result, as the C API keeps it; None otherwise."""
 
     def __init__(self, status, what, detail=""):
         self.status, self.what, self.detail = status, what, detail
+        self.result = None
         self.name = STATUS.get(status, "status %d" % status)
         text = _lib.polyc_status_str(status).decode() if _lib else self.name
         super().__init__("%s: %s%s (%s)" % (what, text, ": " + detail if detail else "", self.name))
@@ -214,6 +218,7 @@ def _load():
         "polyc_config_check": (st, [P(_Config), P(ctypes.c_char_p)]),
         "polyc_limits_for_scans": (st, [P(_Config), P(_Scan), _u32, P(_Limits)]),
         "polyc_limits_for_grid": (st, [P(_Config), P(_OccupancyGrid), P(_Limits)]),
+        "polyc_scan_extent": (None, [P(_Config), P(_Scan), P(_Box)]),
         "polyc_memory_size": (sz, [P(_Config), P(_Limits)]),
         "polyc_init": (st, [ctypes.c_void_p, sz, P(_Config), P(_Limits), P(ctx)]),
         "polyc_reset": (st, [ctx]),
@@ -983,6 +988,39 @@ class OnlineMap(_Block):
             return self._get_stats()
 
 
+class OnlineArea(NamedTuple):
+    """What an OnlineMap needs for a set of scans (online_area)."""
+    area_m: float              # side of the square round the first pose
+    max_scan_beams: int        # beams of the largest scan (at least 1)
+
+
+def online_area(scans, config=None):
+    """The area and the beams an OnlineMap needs for these scans (a log
+    read with read_log, say), as `polyc --online` sizes its map: the side
+    of the square centred on the first scan's pose that holds every
+    scan's pose and endpoints, with the 1 m the library keeps clear at its
+    edge and 32 cells of air, and the beams of the largest scan. config:
+    the dict of polyc_config fields the map will use (cell_m and
+    max_range_m change the extent). Returns an OnlineArea(area_m,
+    max_scan_beams): OnlineMap(*online_area(scans, cfg), config=cfg).
+    No scans is a ValueError."""
+    cfg = _config(dict(config or {}))
+    box, first, beams = _Box(), None, 1
+    for s in scans:
+        rec, _buf = _scan(s)
+        if first is None:
+            first = (rec.pose_x_m, rec.pose_y_m)
+            box.min_x_m = box.max_x_m = first[0]
+            box.min_y_m = box.max_y_m = first[1]
+        _lib.polyc_scan_extent(ctypes.byref(cfg), ctypes.byref(rec), ctypes.byref(box))
+        beams = max(beams, rec.beam_count)
+    if first is None:
+        raise ValueError("no scans found: online_area was given none")
+    x0, y0 = first
+    reach = max(x0 - box.min_x_m, box.max_x_m - x0, y0 - box.min_y_m, box.max_y_m - y0)
+    return OnlineArea(2.0 * (reach + 1.0 + 32.0 * _f32_of(cfg.cell_m)), beams)
+
+
 def _scans_and_limits(cfg, scans, what):
     """The scans as held ctypes records (with the buffers they point into)
     and the limits polyc_limits_for_scans gives for them; no scans is a
@@ -1001,13 +1039,22 @@ def _scans_and_limits(cfg, scans, what):
     return held, lim
 
 
+def _attach_best(error, ctx):
+    """A stop by the progress callback (a deadline) keeps the best map so
+    far in the context, as the C API says: it goes out with the error."""
+    if error.status == ERR_STOPPED:
+        error.result = Result(ctx.polylines(), ctx.stats())
+
+
 def build_map(scans, memory_bytes=None, max_vertices=0, progress=None, **config):
     """Maps a sequence of scans (Scan or plain 6-sequences) as the polyc tool
     does: limits from the scans (polyc_limits_for_scans), one block, build;
     if the map needs more vertices or data points than those limits hold
     (POLYC_ERR_NOMEM after the grid), once more with the worst-case bound
     (max_vertices and max_points 0), as the tool does. progress is called
-    again from the first iteration then. Returns a Result."""
+    again from the first iteration then. Returns a Result. A true value
+    from progress stops the optimiser: PolycError POLYC_ERR_STOPPED whose
+    .result is the best map so far (a Result)."""
     cfg = _config(config)
     if progress is not None and not callable(progress):
         raise TypeError("progress must be callable or None, not %s" % type(progress).__name__)
@@ -1029,6 +1076,7 @@ def build_map(scans, memory_bytes=None, max_vertices=0, progress=None, **config)
                 lim.max_points = 0
                 lim.max_vertices = max_vertices
                 continue
+            _attach_best(e, ctx)
             raise
         return Result(ctx.polylines(), ctx.stats())
 
@@ -1053,7 +1101,9 @@ def build_map_from_grid(cells, width, height, resolution, origin=(0.0, 0.0, 0.0)
     (occupied from occupied_thresh * 100, free up to free_thresh * 100);
     origin = (x, y, yaw) of cell (0, 0)'s outer corner, resolution in metres.
     cells: bytes, bytearray, array('b'), a numpy int8 array (any buffer of
-    int8) or a list of ints. Returns a Result, polylines in the map frame."""
+    int8) or a list of ints. Returns a Result, polylines in the map frame.
+    progress as for build_map (a stop: PolycError POLYC_ERR_STOPPED with
+    .result, the best map so far)."""
     cfg = _config(config)
     if progress is not None and not callable(progress):
         raise TypeError("progress must be callable or None, not %s" % type(progress).__name__)
@@ -1069,7 +1119,11 @@ def build_map_from_grid(cells, width, height, resolution, origin=(0.0, 0.0, 0.0)
     ctx = Context((lim.max_scans, lim.max_beams, lim.max_grid_cells, lim.max_vertices,
                    lim.max_points), memory_bytes, **config)
     ctx._check(_lib.polyc_add_grid(ctx._ctx, ctypes.byref(g)), "add grid")
-    ctx.build(progress)
+    try:
+        ctx.build(progress)
+    except PolycError as e:
+        _attach_best(e, ctx)
+        raise
     return Result(ctx.polylines(), ctx.stats())
 
 
