@@ -195,7 +195,8 @@ $(BUILD)/footprint8: examples/footprint.c $(EMB_OBJ)
 
 # Robustness (docs/security.md). test-cli: every bad input of the tool
 # (tests/cli_bad_input.sh), where it writes (tests/cli_output.sh: as root,
-# also as an ordinary user) and --online (tests/cli_online.sh).
+# also as an ordinary user), --online (tests/cli_online.sh) and the README's
+# C example compiled as written (tests/cli_readme.sh).
 # test-fuzz-replay: the committed fuzz corpus through the fuzz targets, built
 # with $(CC). test-asan: unit tests, corpus replay and
 # the quick bad-input tests again in build-asan/ under ASan and UBSan.
@@ -213,6 +214,7 @@ test-cli: $(BUILD)/polyc
 	tests/cli_bad_input.sh $(CLI_TEST_ARGS) $(BUILD)/polyc
 	tests/cli_output.sh $(BUILD)/polyc
 	tests/cli_online.sh $(BUILD)/polyc
+	tests/cli_readme.sh "$(CC) $(OPT) $(CFLAGS)" $(BUILD)/polyc
 SAN_LIST  = address,undefined,float-cast-overflow
 SAN_FLAGS = -fsanitize=$(SAN_LIST) -fno-sanitize-recover=all
 test-asan:
