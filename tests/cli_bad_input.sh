@@ -300,6 +300,43 @@ printf 'image: room.pgm\nresolution: 0.05\norigin: [1.0, 0.0, 1.5707963268]\nneg
 run --format txt yaw.yaml
 # turned by 90 degrees about (1, 0): (x, y) in the grid -> (1 - y, x)
 [ $rc -eq 0 ] && inside 0.3 0.75 0.1 0.9 || bad "exit $rc, or the yaw is not applied: $(head -c 300 out.txt)"
+# --memory-mb bounds the image's decoding: a 255 KB PNG that unpacks to
+# 16384 x 16383 pixels (512 MiB with its cells) is refused from its header,
+# before anything is allocated (within 100 MB of address space)
+if [ $quick = 0 ]; then
+    name=map-png-memory-budget
+    python3 - << 'EOF2'
+import struct, zlib
+w, h = 16384, 16383
+def chunk(t, d):
+    return struct.pack(">I", len(d)) + t + d + struct.pack(">I", zlib.crc32(t + d) & 0xffffffff)
+c = zlib.compressobj(9)
+row = bytes(w + 1)
+z = b"".join(c.compress(row) for _ in range(h)) + c.flush()
+with open("huge.png", "wb") as f:
+    f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 0, 0, 0, 0))
+            + chunk(b"IDAT", z) + chunk(b"IEND", b""))
+EOF2
+    printf 'image: huge.png\nresolution: 0.05\n%s\n' "$REST" > huge.yaml
+    count=$((count + 1))
+    (ulimit -v 100000 && exec timeout $LIMIT_S "$POLYC" --memory-mb 1 -o huge.svg huge.yaml) \
+        > out.txt 2> err.txt
+    rc=$?
+    [ $rc -eq 3 ] && grep -qE '^polyc: memory budget too small: image huge.png needs 537[0-9]{6} bytes \(512.5 MiB\) to read \(16384 x 16383 pixels\), --memory-mb 1 allows 1 MiB: give --memory-mb 513 or more$' err.txt \
+        || bad "exit $rc, or not refused by --memory-mb before decoding"
+    [ -e huge.svg ] && bad "huge.svg written"
+    rm -f huge.png huge.yaml huge.svg
+fi
+name=map-memory-budget-pgm
+run --memory-mb 1 -o map.svg room.yaml
+[ $rc -eq 0 ] || bad "exit $rc: a 20 x 16 map within --memory-mb 1"
+printf 'P5\n1000 1000\n255\n' > wide.pgm
+head -c 1000000 /dev/zero >> wide.pgm
+printf 'image: wide.pgm\nresolution: 0.05\n%s\n' "$REST" > wide.yaml
+run --memory-mb 1 -o map.svg wide.yaml
+[ $rc -eq 3 ] && grep -q '^polyc: memory budget too small: image wide.pgm needs 4000017 bytes' err.txt \
+    || bad "exit $rc: a 1000 x 1000 PGM read within --memory-mb 1"
+rm -f map.svg wide.pgm wide.yaml
 name=map-stats
 run --stats -o map.svg room.yaml
 [ $rc -eq 0 ] && tail -c 7 map.svg | grep -q '</svg>' || bad "exit $rc, no complete SVG"

@@ -3,6 +3,7 @@
  * image), the log's scans (scanlog.h) or the map's cells as an occupancy
  * grid (mapfile.h), and the --stats lines that describe them. */
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -101,8 +102,23 @@ int load_map(const options *o, map_input *m)
         free(shown);
         return rc;
     }
-    bad = mapfile_image_read(&m->image, (const uint8_t *)text, len, shown, &m->yaml);
+    /* --memory-mb bounds the decoding too (the file, its pixels, the cells):
+     * refused from the header, before the pixels are allocated */
+    double cap = o->memory_mb * 1048576.0;
+    size_t budget = cap <= 0 ? 0 : (double)len >= cap ? 1 : (size_t)(cap - (double)len);
+    bad = mapfile_image_read_capped(&m->image, (const uint8_t *)text, len, shown, &m->yaml,
+                                    budget);
     free(text);
+    if (bad && m->image.need_bytes) {
+        double need = (double)len + (double)m->image.need_bytes;
+        int rc = complain(EXIT_MEMORY, "memory budget too small: image %s needs %.0f bytes (%.1f"
+                                       " MiB) to read (%u x %u pixels), --memory-mb %g allows %g"
+                                       " MiB: give --memory-mb %.0f or more", shown, need,
+                          need / 1048576.0, (unsigned)m->image.width, (unsigned)m->image.height,
+                          o->memory_mb, o->memory_mb, ceil(need / 1048576.0));
+        free(shown);
+        return rc;
+    }
     free(shown);
     if (bad)
         return complain(m->image.no_memory ? EXIT_MEMORY : EXIT_INPUT, "%s", m->image.error);

@@ -68,6 +68,7 @@ typedef struct mapfile_pgm {
     uint32_t maxval;           /* 1..65535 */
     int plain;                 /* 1: P2 (ASCII), 0: P5 (binary) */
     uint16_t *samples;         /* width * height values in 0..maxval, owned */
+    size_t need_bytes;         /* over the budget: pixels and cells' bytes; else 0 */
     char error[512];           /* "NAME: byte N: what is wrong" after a failure */
 } mapfile_pgm;
 
@@ -75,6 +76,11 @@ typedef struct mapfile_pgm {
  * p->error set (byte N is a 0-based offset into the file); either way call
  * mapfile_pgm_free. */
 int mapfile_pgm_parse(mapfile_pgm *p, const uint8_t *data, size_t len, const char *name);
+/* The same with a memory budget: a PGM whose pixels (2 bytes each) and
+ * cells (1 byte each) would take more than max_bytes (0: no budget) is
+ * refused before its pixels are allocated, with p->need_bytes set. */
+int mapfile_pgm_parse_capped(mapfile_pgm *p, const uint8_t *data, size_t len, const char *name,
+                             size_t max_bytes);
 void mapfile_pgm_free(mapfile_pgm *p);
 
 /* One pixel's OccupancyGrid value (-1 unknown, 0..100) under the YAML's
@@ -97,6 +103,7 @@ typedef struct mapfile_png {
     int interlaced;            /* 1: Adam7 */
     int alpha;                 /* an alpha channel or a tRNS chunk (map_server's "matte") */
     int no_memory;             /* the failure was an allocation's */
+    size_t need_bytes;         /* over the budget: the bytes decoding needs; else 0 */
     char error[512];           /* "NAME: byte N: what is wrong" after a failure */
 } mapfile_png;
 
@@ -112,6 +119,12 @@ const char *mapfile_png_color_name(unsigned type);
  * too) and *cells NULL. */
 int mapfile_png_read(mapfile_png *p, const uint8_t *data, size_t len, const char *name,
                      const mapfile_yaml *y, int8_t **cells);
+/* The same with a memory budget: an image whose decoding (its compressed
+ * data, the unpacked rows and the cells) would take more than max_bytes
+ * (0: no budget) is refused before anything is allocated, with
+ * p->need_bytes set. */
+int mapfile_png_read_capped(mapfile_png *p, const uint8_t *data, size_t len, const char *name,
+                            const mapfile_yaml *y, int8_t **cells, size_t max_bytes);
 
 /* The image, PGM or PNG (told by its first bytes), converted under the
  * YAML (mapfile_image.c): cells malloc'd (the caller frees them), its size
@@ -122,10 +135,15 @@ typedef struct mapfile_image {
     int8_t *cells;
     char kind[64];
     int no_memory;             /* the failure was an allocation's */
+    size_t need_bytes;         /* over the budget: the bytes decoding needs; else 0 */
     char error[512];
 } mapfile_image;
 int mapfile_image_read(mapfile_image *m, const uint8_t *data, size_t len, const char *name,
                        const mapfile_yaml *y);
+/* The same within max_bytes for the decoding (0: no budget): over it, -1
+ * with need_bytes set (the bytes it would take) and nothing allocated. */
+int mapfile_image_read_capped(mapfile_image *m, const uint8_t *data, size_t len,
+                              const char *name, const mapfile_yaml *y, size_t max_bytes);
 
 /* Every pixel converted: cells[(height - 1 - row) * width + column], i.e.
  * OccupancyGrid order with row 0 at the bottom. cells: width * height. */

@@ -11,12 +11,21 @@
 int mapfile_image_read(mapfile_image *m, const uint8_t *data, size_t len, const char *name,
                        const mapfile_yaml *y)
 {
+    return mapfile_image_read_capped(m, data, len, name, y, 0);
+}
+
+int mapfile_image_read_capped(mapfile_image *m, const uint8_t *data, size_t len,
+                              const char *name, const mapfile_yaml *y, size_t max_bytes)
+{
     memset(m, 0, sizeof *m);
     if (mapfile_is_png(data, len)) {
         /* (read and converted in one go: its pixels are not kept) */
         mapfile_png p;
-        if (mapfile_png_read(&p, data, len, name, y, &m->cells)) {
+        if (mapfile_png_read_capped(&p, data, len, name, y, &m->cells, max_bytes)) {
             m->no_memory = p.no_memory;
+            m->need_bytes = p.need_bytes;
+            m->width = p.width;
+            m->height = p.height;
             memcpy(m->error, p.error, sizeof m->error);
             return -1;
         }
@@ -29,7 +38,12 @@ int mapfile_image_read(mapfile_image *m, const uint8_t *data, size_t len, const 
         return 0;
     }
     mapfile_pgm p;
-    int bad = mapfile_pgm_parse(&p, data, len, name);
+    int bad = mapfile_pgm_parse_capped(&p, data, len, name, max_bytes);
+    m->need_bytes = p.need_bytes;
+    if (p.need_bytes) {
+        m->width = p.width;
+        m->height = p.height;
+    }
     if (!bad && !(m->cells = malloc((size_t)p.width * p.height))) {
         m->no_memory = 1;
         snprintf(p.error, sizeof p.error, "%s: out of memory: %zu bytes for the map's cells", name,

@@ -92,6 +92,12 @@ static int pgm_number(pgm_reader *r, const char *what, uint64_t max, uint64_t *o
 
 int mapfile_pgm_parse(mapfile_pgm *p, const uint8_t *data, size_t len, const char *name)
 {
+    return mapfile_pgm_parse_capped(p, data, len, name, 0);
+}
+
+int mapfile_pgm_parse_capped(mapfile_pgm *p, const uint8_t *data, size_t len, const char *name,
+                             size_t max_bytes)
+{
     pgm_reader r = {p, name, data, len, 0};
     textesc_excerpt e;
     memset(p, 0, sizeof *p);
@@ -122,6 +128,12 @@ int mapfile_pgm_parse(mapfile_pgm *p, const uint8_t *data, size_t len, const cha
     p->height = (uint32_t)h;
     p->maxval = (uint32_t)maxval;
     size_t cells = (size_t)(w * h);
+    if (max_bytes && 3 * cells > max_bytes) {  /* the pixels, then the cells */
+        p->need_bytes = 3 * cells;
+        return pfail(&r, at_w, "%llu x %llu pixels take %zu bytes to read, more than the memory"
+                               " budget of %zu", (unsigned long long)w, (unsigned long long)h,
+                     3 * cells, max_bytes);
+    }
     if (!p->plain) {
         if (r.pos >= len)
             return pfail(&r, r.pos, "the file ends after maxval: no pixel data (truncated)");

@@ -342,6 +342,12 @@ static int pixel_value(png_reader *r, const uint8_t *row, uint32_t i, const mapf
 int mapfile_png_read(mapfile_png *p, const uint8_t *data, size_t len, const char *name,
                      const mapfile_yaml *y, int8_t **cells)
 {
+    return mapfile_png_read_capped(p, data, len, name, y, cells, 0);
+}
+
+int mapfile_png_read_capped(mapfile_png *p, const uint8_t *data, size_t len, const char *name,
+                            const mapfile_yaml *y, int8_t **cells, size_t max_bytes)
+{
     png_reader r;
     memset(&r, 0, sizeof r);
     memset(p, 0, sizeof *p);
@@ -367,6 +373,13 @@ int mapfile_png_read(mapfile_png *p, const uint8_t *data, size_t len, const char
     if (raw_n > MAPFILE_MAX_PGM_BYTES)
         return pfail(&r, r.idat_at, "the image unpacks to %zu bytes, more than %u", raw_n,
                      MAPFILE_MAX_PGM_BYTES);
+    size_t need = r.idat_bytes + raw_n + (size_t)p->width * p->height;
+    if (max_bytes && need > max_bytes) {
+        p->need_bytes = need;
+        return pfail(&r, r.idat_at, "%u x %u pixels take %zu bytes to decode, more than the"
+                                    " memory budget of %zu", (unsigned)p->width,
+                     (unsigned)p->height, need, max_bytes);
+    }
     uint8_t *z = malloc(r.idat_bytes ? r.idat_bytes : 1), *raw = malloc(raw_n);
     int8_t *out = malloc((size_t)p->width * p->height);
     int rc = 0;
