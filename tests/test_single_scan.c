@@ -567,6 +567,66 @@ static void test_loses_returns(void **state)
     assert_false(polyc__loses_returns(&r, old_xy, 1, NULL, 0));
 }
 
+/* One dense scan close to its walls: 100,000 beams over a full turn, every
+ * range the same (a robot in a round tank of 1 m and of 2 m radius): more
+ * returns than the grid has cells, so the one-scan path sums them by cell.
+ * With the limits polyc_limits_for_scans gives, the map is made (it ran out
+ * of points at any block size) and lies on the circle. */
+static void test_dense_scan_maps(void **state)
+{
+    (void)state;
+    const uint32_t n = 100000;
+    float *r = malloc(n * sizeof *r);
+    assert_non_null(r);
+    for (int k = 0; k < 2; k++) {
+        float radius = k == 0 ? 1.0f : 2.0f;
+        for (uint32_t i = 0; i < n; i++)
+            r[i] = radius;
+        polyc_scan s;
+        memset(&s, 0, sizeof s);
+        s.start_angle_rad = -PIF;
+        s.angle_step_rad = 2.0f * PIF / (float)n;
+        s.min_range_m = 0.02f;
+        s.max_range_m = 30.0f;
+        s.beam_count = n;
+        s.range_m = r;
+        polyc_config c;
+        polyc_limits lim;
+        polyc_config_default(&c);
+        assert_int_equal(polyc_limits_for_scans(&c, &s, 1, &lim), POLYC_OK);
+        size_t size = polyc_memory_size(&c, &lim);
+        void *block = malloc(size);
+        assert_non_null(block);
+        polyc_ctx *ctx;
+        assert_int_equal(polyc_init(block, size, &c, &lim, &ctx), POLYC_OK);
+        assert_int_equal(polyc_add_scan(ctx, &s), POLYC_OK);
+        polyc_status st = polyc_build(ctx, NULL, NULL);
+        if (st != POLYC_OK)
+            fail_msg("radius %.0f m: %s (%s)", (double)radius, polyc_status_str(st),
+                     polyc_last_error(ctx));
+        uint32_t lines = polyc_polyline_count(ctx), verts = 0;
+        double worst = 0.0;
+        for (uint32_t l = 0; l < lines; l++) {
+            polyc_polyline pl;
+            assert_int_equal(polyc_get_polyline(ctx, l, &pl), POLYC_OK);
+            for (uint32_t v = 0; v < pl.point_count; v++) {
+                double d = fabs(hypot((double)pl.xy_m[2 * v], (double)pl.xy_m[2 * v + 1]) - (double)radius);
+                worst = d > worst ? d : worst;
+                verts++;
+            }
+        }
+        print_message("radius %.0f m, 100,000 beams: %u polylines, %u vertices, within %.1f mm "
+                      "of the circle\n",
+                      (double)radius, lines, verts, 1e3 * worst);
+        assert_true(lines >= 1 && verts >= 8);
+        /* vertices outside the circle by the chords' sag: a 16-gon's at 1 m
+         * is 19 mm; the wall's cells are 2.5 cm */
+        assert_true(worst < 0.025);
+        free(block);
+    }
+    free(r);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -584,6 +644,7 @@ int main(void)
         cmocka_unit_test(test_optimised_corridor),
         cmocka_unit_test(test_grid_trace_flag),
         cmocka_unit_test(test_chains_take_the_contour_room),
+        cmocka_unit_test(test_dense_scan_maps),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
