@@ -164,5 +164,19 @@ for far in 1e4 1e5 5e5 1e6; do
     [ -e far.svg ] && bad "far.svg written"
 done
 
+# a log whose returns fall in more tiles than a usual building's: posts seen
+# from 900 poses over a 96 m square (about 2,000 tiles against the area's
+# estimate of 1,024): sized from the log, mapped in one replay
+name=online-sized-from-log
+awk 'BEGIN {
+    for (i = 0; i < 30; i++) for (j = 0; j < 30; j++) {
+        printf "SCAN %d %d 0 -3.14159 0.0872665 0.02 30 72", 3.3 * i, 3.3 * j
+        for (k = 0; k < 72; k++) printf " %.2f", 0.5 + 0.3 * (k % 2)
+        printf "\n"
+    } }' > posts.log
+run --online --stats -o posts.svg posts.log
+[ $rc -eq 0 ] && is_svg posts.svg && grep -q '^online .* block [0-9]* bytes$' err.txt ||
+    bad "exit $rc, or the replay ran again with a larger block: $(grep '^online ' err.txt)"
+
 echo "cli_online: $count runs, $failed failed"
 [ $failed -eq 0 ]

@@ -50,6 +50,90 @@ static double log_area(const polyc_config *cfg, const scanlog *log, polyc_box *b
     return 2.0 * (reach + ONLINE_EDGE_M + ONLINE_AIR_CELLS * (double)cfg->cell_m);
 }
 
+/* The grid's tiles (32 x 32 cells) and cells that the log's returns fall
+ * in, the grid laid out as the library lays an online one: a square of
+ * side area_m centred on the first pose. 0, or -1 if out of memory. */
+#define TILE_SIDE 32
+static int count_hit_cells(const polyc_config *cfg, const scanlog *log, double area_m,
+                           uint64_t *tiles_hit, uint64_t *cells_hit)
+{
+    double cell = (double)cfg->cell_m, half = 0.5 * area_m;
+    double x0 = log->scans[0].pose_x_m, y0 = log->scans[0].pose_y_m;
+    uint64_t side = (uint64_t)ceil(area_m / cell / TILE_SIDE);
+    if (side == 0 || side > 1u << 15)
+        return -1;
+    /* per tile: the index of its cell bitmap (0: none yet), bitmaps on demand */
+    uint32_t *slot = calloc(side * side, sizeof *slot);
+    uint8_t *bits = NULL;
+    uint32_t used = 0, cap = 0;
+    *tiles_hit = *cells_hit = 0;
+    if (!slot)
+        return -1;
+    for (uint32_t s = 0; s < log->count; s++) {
+        const polyc_scan *sc = &log->scans[s];
+        for (uint32_t i = 0; i < sc->beam_count; i++) {
+            float r = sc->range_m[i];
+            if (!(r >= sc->min_range_m && r < sc->max_range_m))
+                continue;
+            double a = sc->pose_theta_rad + (double)sc->start_angle_rad + (double)i * (double)sc->angle_step_rad;
+            double fx = (sc->pose_x_m + (double)r * cos(a) - x0 + half) / cell;
+            double fy = (sc->pose_y_m + (double)r * sin(a) - y0 + half) / cell;
+            if (!(fx >= 0.0 && fy >= 0.0 && fx < (double)(side * TILE_SIDE) &&
+                  fy < (double)(side * TILE_SIDE)))
+                continue;
+            uint64_t ix = (uint64_t)fx, iy = (uint64_t)fy;
+            uint64_t t = (iy / TILE_SIDE) * side + ix / TILE_SIDE;
+            if (slot[t] == 0) {
+                if (used == cap) {
+                    cap = cap ? 2 * cap : 256;
+                    uint8_t *more = realloc(bits, (size_t)cap * (TILE_SIDE * TILE_SIDE / 8));
+                    if (!more) {
+                        free(bits);
+                        free(slot);
+                        return -1;
+                    }
+                    bits = more;
+                }
+                memset(bits + (size_t)used * (TILE_SIDE * TILE_SIDE / 8), 0, TILE_SIDE * TILE_SIDE / 8);
+                slot[t] = ++used;
+            }
+            uint8_t *b = bits + (size_t)(slot[t] - 1) * (TILE_SIDE * TILE_SIDE / 8);
+            unsigned c = (unsigned)((iy % TILE_SIDE) * TILE_SIDE + ix % TILE_SIDE);
+            if (!(b[c >> 3] & (1u << (c & 7)))) {
+                b[c >> 3] = (uint8_t)(b[c >> 3] | (1u << (c & 7)));
+                (*cells_hit)++;
+            }
+        }
+    }
+    *tiles_hit = used;
+    free(bits);
+    free(slot);
+    return 0;
+}
+
+/* The area's limits raised to what the log's returns need (an eighth to
+ * spare): the tiles they fall in and the cells with endpoints, which
+ * polyc_online_limits_for_area can only estimate for a usual building
+ * (fhw's 1,352 tiles and aces' 1,329 outgrew its 1,314 and 1,024, and the
+ * whole replay ran again with four times the limits). Never lowered. */
+static void fit_limits_to_log(const polyc_config *cfg, const scanlog *log, polyc_online_limits *lim)
+{
+    uint64_t tiles, cells;
+    if (count_hit_cells(cfg, log, lim->area_m, &tiles, &cells) != 0)
+        return; /* (the estimate, and the retries) */
+    double want_cells = fmin((double)(tiles + tiles / 8 + 16) * TILE_SIDE * TILE_SIDE, 0x40000000);
+    double want_points = fmin((double)(cells + cells / 8 + 1024), 0x10000000);
+    if (want_cells > (double)lim->max_grid_cells)
+        lim->max_grid_cells = (uint32_t)want_cells;
+    if (want_points > (double)lim->max_points) {
+        lim->max_points = (uint32_t)want_points;
+        /* (vertices as the library sizes them from the points) */
+        double want_vertices = fmin(want_points / 16.0 + 4096.0, 0x10000000);
+        if (want_vertices > (double)lim->max_vertices)
+            lim->max_vertices = (uint32_t)want_vertices;
+    }
+}
+
 /* a * 4, at most cap */
 static uint32_t times4(uint32_t a, double cap)
 {
@@ -276,6 +360,7 @@ int online_map(const options *o, run *r, double t_start, mapout_times *t)
         return complain(EXIT_INPUT, "%s: an online map of %g m square for scans of up to %u"
                                     " beams: %s", input_name(o), rp.area_m, (unsigned)max_beams,
                         polyc_status_str(st));
+    fit_limits_to_log(&cfg, &r->log, &lim);
     if (o->frames && (rc = frames_clash(o, r->log.count)) != 0)
         return rc;
     if (o->frames && make_frames_dir(o->frames))
