@@ -395,8 +395,10 @@ POLYC_API polyc_status polyc_online_init(void *block, size_t size, const polyc_c
  * *scan_id (may be NULL) gets its number: 0 for the first scan added.
  * POLYC_ERR_EXTENT when an endpoint or the pose lies outside the area
  * (nothing is added), POLYC_ERR_LIMIT when the scan has more than
- * max_scan_beams beams, POLYC_ERR_NOMEM when the grid or data cells are
- * used up (the scan is added up to the beam that ran out). */
+ * max_scan_beams beams, POLYC_ERR_NOMEM when the grid cells are used up
+ * (the scan is added up to the beam that ran out) or when its endpoints
+ * would outgrow the data cells or the points an update makes of them
+ * (limits.max_points: nothing of it is added, and the updates still run). */
 POLYC_API polyc_status polyc_online_add_scan(polyc_ctx *ctx, const polyc_scan *scan, int keep,
                                              uint32_t *scan_id);
 /* Re-optimises what the scans added or corrected since the last update

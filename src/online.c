@@ -492,6 +492,19 @@ static polyc_status accumulate(polyc_ctx *ctx, const polyc__scan *s, uint32_t nu
     int sums_ok = sum_endpoints(ctx, s, take_back ? -1.0f : 1.0f);
     if (take_back)
         return st;
+    /* A new scan whose endpoints outgrow the data cells, or the weighted
+     * points an update collects from them (their 2 x 2 blocks), goes out
+     * again: an update after an accepted add can always run (with blocks
+     * of one or two cells on average, limits.max_points / 2 points filled
+     * long before the cells did, and every update and the finish failed) */
+    if (how == SCAN_NEW && st == POLYC_OK &&
+        (!sums_ok || on->blocks_n > (uint32_t)polyc__points_bound(&ctx->cfg, &ctx->lim))) {
+        polyc__grid_add_scan(ctx, s, 1, on->tile_miss);
+        sum_endpoints(ctx, s, -1.0f);
+        on->refused = 1;
+        return polyc__fail(ctx, POLYC_ERR_NOMEM,
+                           "no room for the scan's endpoints (limits.max_points): not added");
+    }
     if (how == SCAN_NEW) {
         label_contour(ctx, s);
         /* (the block is sized for it; without it, NULL: the same lines,
@@ -593,19 +606,23 @@ polyc_status polyc_online_add_scan(polyc_ctx *ctx, const polyc_scan *s, int keep
         first = on->lim.max_scan_beams + on->kept_beams;
     }
     store_scan(ctx, d, s, first);
+    for (uint32_t i = 0; i < s->beam_count; i++)
+        ctx->ranges[first + i] = s->range_m[i];
+    on->refused = 0;
+    polyc_status st = accumulate(ctx, d, on->scans, SCAN_NEW);
+    if (on->refused)
+        return st; /* (nothing of it stays: not counted, not kept) */
     for (uint32_t i = 0; i < s->beam_count; i++) {
         float r = s->range_m[i];
         if (!(r >= 0.0f))
             ctx->stats.beams_skipped++;
         else if (r >= s->min_range_m && r < s->max_range_m)
             ctx->stats.hits++;
-        ctx->ranges[first + i] = r;
     }
     if (keep) {
         on->kept_id[on->kept_n++] = on->scans;
         on->kept_beams += s->beam_count;
     }
-    polyc_status st = accumulate(ctx, d, on->scans, SCAN_NEW);
     if (scan_id)
         *scan_id = on->scans;
     on->scans++;

@@ -32,6 +32,8 @@ typedef struct polyc__online {
     polyc__cell_sums *sums;
     uint32_t sums_n;
     uint32_t sums_free;            /* 1 + a free entry (a list through their n), 0: none */
+    uint32_t blocks_n;             /* 2 x 2 blocks of cells with sums: weighted points */
+    int refused;                   /* the last add's scan went out again (no room) */
     uint32_t *cell_at;
     uint32_t cell_mask, cell_shift;
     uint32_t *tile_cells;

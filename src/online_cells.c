@@ -51,6 +51,15 @@ uint32_t polyc__cell_find(const polyc__online *on, uint32_t key)
     return on->cell_at[probe(on, key)];
 }
 
+/* Whether another cell of key's 2 x 2 block (one weighted point, points.c)
+ * has sums: a tile's keys are its cells' indices, 32 a row, so the block's
+ * others are key ^ 1, ^ 32 and ^ 33, in the same tile. */
+static int block_has_other(const polyc__online *on, uint32_t key)
+{
+    return on->cell_at[probe(on, key ^ 1u)] != 0 || on->cell_at[probe(on, key ^ 32u)] != 0 ||
+           on->cell_at[probe(on, key ^ 33u)] != 0;
+}
+
 uint32_t polyc__cell_add(polyc__online *on, uint32_t key)
 {
     uint32_t i = probe(on, key);
@@ -67,6 +76,7 @@ uint32_t polyc__cell_add(polyc__online *on, uint32_t key)
     }
     memset(&on->sums[e], 0, sizeof on->sums[0]);
     on->sums[e].cell = key;
+    on->blocks_n += !block_has_other(on, key);
     on->cell_at[i] = e + 1;
     on->tile_cells[key / POLYC__TILE_CELLS]++;
     return e + 1;
@@ -91,6 +101,7 @@ void polyc__cell_drop(polyc__online *on, uint32_t entry)
         }
     }
     on->cell_at[i] = 0;
+    on->blocks_n -= !block_has_other(on, key);
     on->tile_cells[key / POLYC__TILE_CELLS]--;
     on->sums[entry - 1].n = on->sums_free;
     on->sums_free = entry;
@@ -102,4 +113,5 @@ void polyc__cells_clear(polyc__online *on, uint32_t tiles)
     memset(on->tile_cells, 0, (size_t)tiles * sizeof *on->tile_cells);
     on->sums_n = 0;
     on->sums_free = 0;
+    on->blocks_n = 0;
 }

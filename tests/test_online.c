@@ -1638,6 +1638,62 @@ static void test_nomem_update_then_scans(void **state)
     free(block);
 }
 
+/* Data cells too few for the office (limits.max_points 1,500 and 2,000):
+ * an add whose endpoints would outgrow them, or the weighted points an
+ * update collects from them, is refused with POLYC_ERR_NOMEM and leaves
+ * nothing behind; every update after an accepted add runs, and so does the
+ * finish. (Before: every add succeeded, and from scan 10 or 25 on every
+ * update and the finish failed with POLYC_ERR_NOMEM, for good.) */
+static void test_points_never_wedge(void **state)
+{
+    (void)state;
+    scene s;
+    scene_make(&s, "office", SCENE_SEED);
+    const uint32_t points[2] = {1500, 2000};
+    for (int k = 0; k < 2; k++) {
+        online o;
+        memset(&o, 0, sizeof o);
+        config_of(&o.config);
+        check_status(polyc_online_limits_for_area(&o.config, s.area_m, s.beams, &o.limits), NULL,
+                     "limits");
+        o.limits.max_points = points[k];
+        o.size = polyc_online_memory_size(&o.config, &o.limits);
+        o.block = malloc(o.size);
+        assert_non_null(o.block);
+        check_status(polyc_online_init(o.block, o.size, &o.config, &o.limits, &o.ctx), NULL, "init");
+        uint32_t refused = 0, accepted = 0;
+        for (uint32_t i = 0; i < s.sim.scan_count; i++) {
+            polyc_stats before, after;
+            check_status(polyc_get_stats(o.ctx, &before), o.ctx, "stats");
+            polyc_status st = polyc_online_add_scan(o.ctx, &s.sim.scans[i], 0, NULL);
+            check_status(polyc_get_stats(o.ctx, &after), o.ctx, "stats");
+            if (st == POLYC_ERR_NOMEM) {
+                refused++;
+                assert_true(after.scans == before.scans && after.hits == before.hits);
+                assert_non_null(strstr(polyc_last_error(o.ctx), "max_points"));
+            } else {
+                check_status(st, o.ctx, "add");
+                accepted++;
+            }
+            st = polyc_online_update(o.ctx, POLYC_ONLINE_WORK_DEFAULT, NULL);
+            if (st != POLYC_OK)
+                fail_msg("max_points %u, scan %u: update: %s (%s)", points[k], i,
+                         polyc_status_str(st), polyc_last_error(o.ctx));
+        }
+        polyc_online_report r;
+        check_status(polyc_online_finish(o.ctx, NULL, NULL, &r), o.ctx, "finish");
+        uint32_t crossings, junctions;
+        double cover;
+        map_validity(o.ctx, &crossings, &junctions, &cover);
+        print_message("office, max_points %u: %u scans accepted, %u refused; finished: %u "
+                      "polylines, %u vertices, %u crossings\n",
+                      points[k], accepted, refused, r.polylines, r.vertices, crossings);
+        assert_true(accepted > 0 && refused > 0 && r.polylines > 0 && crossings == 0);
+        online_close(&o);
+    }
+    scene_free(&s);
+}
+
 /* ---- 8. exhaustion ---------------------------------------------------------- */
 
 #define GUARD 64
@@ -1773,8 +1829,8 @@ static void sweep_limit(const scansim_scene *sc, uint32_t which, uint32_t lo, ui
         for (uint32_t pass = 0; pass < 2; pass++)
             for (uint32_t i = 0; i < sc->scan_count; i++) {
                 st = polyc_online_add_scan(ctx, &sc->scans[i], 0, NULL);
-                /* after an add that ran out of max_points, updates go on:
-                 * blocks whose cells hold hits but no sums have no point */
+                /* an add that would run out of max_points is refused and
+                 * the updates go on */
                 if (st == POLYC_OK)
                     st = polyc_online_update(ctx, i % 2 ? 1u : POLYC_ONLINE_WORK_DEFAULT, NULL);
                 if (st != POLYC_OK && st != POLYC_ERR_NOMEM)
@@ -1787,7 +1843,12 @@ static void sweep_limit(const scansim_scene *sc, uint32_t which, uint32_t lo, ui
                 assert_int_equal(map_is_valid(ctx, 11.5, -2.0, 4.0), 0);
             }
         st = polyc_online_finish(ctx, NULL, NULL, NULL);
-        if (st != POLYC_OK && st != POLYC_ERR_NOMEM)
+        polyc_stats stats;
+        check_status(polyc_get_stats(ctx, &stats), ctx, "stats");
+        /* (with max_points too small for any scan's endpoints, every add is
+         * refused: then there is nothing to finish) */
+        int none = st == POLYC_ERR_STATE && stats.scans == 0;
+        if (st != POLYC_OK && st != POLYC_ERR_NOMEM && !none)
             fail_msg("limit %u = %u: finish: %s (%s)", which, v, polyc_status_str(st),
                      polyc_last_error(ctx));
         (*nomem) += st != POLYC_OK;
@@ -1828,6 +1889,7 @@ int main(void)
         cmocka_unit_test(test_pose_correction),
         cmocka_unit_test(test_bad_use),
         cmocka_unit_test(test_nomem_update_then_scans),
+        cmocka_unit_test(test_points_never_wedge),
         cmocka_unit_test(test_exhaustion),
         cmocka_unit_test(test_exhaustion_limits),
     };

@@ -50,12 +50,14 @@ static double log_area(const polyc_config *cfg, const scanlog *log, polyc_box *b
     return 2.0 * (reach + ONLINE_EDGE_M + ONLINE_AIR_CELLS * (double)cfg->cell_m);
 }
 
-/* The grid's tiles (32 x 32 cells) and cells that the log's returns fall
- * in, the grid laid out as the library lays an online one: a square of
- * side area_m centred on the first pose. 0, or -1 if out of memory. */
+/* The grid's tiles (32 x 32 cells), cells and 2 x 2 blocks of cells (a
+ * weighted point each) that the log's returns fall in, the grid laid out
+ * as the library lays an online one: a square of side area_m centred on
+ * the first pose. 0, or -1 if out of memory. */
 #define TILE_SIDE 32
+#define TILE_BYTES (TILE_SIDE * TILE_SIDE / 8 + TILE_SIDE * TILE_SIDE / 32) /* cells, blocks */
 static int count_hit_cells(const polyc_config *cfg, const scanlog *log, double area_m,
-                           uint64_t *tiles_hit, uint64_t *cells_hit)
+                           uint64_t *tiles_hit, uint64_t *cells_hit, uint64_t *blocks_hit)
 {
     double cell = (double)cfg->cell_m, half = 0.5 * area_m;
     double x0 = log->scans[0].pose_x_m, y0 = log->scans[0].pose_y_m;
@@ -66,7 +68,7 @@ static int count_hit_cells(const polyc_config *cfg, const scanlog *log, double a
     uint32_t *slot = calloc(side * side, sizeof *slot);
     uint8_t *bits = NULL;
     uint32_t used = 0, cap = 0;
-    *tiles_hit = *cells_hit = 0;
+    *tiles_hit = *cells_hit = *blocks_hit = 0;
     if (!slot)
         return -1;
     for (uint32_t s = 0; s < log->count; s++) {
@@ -86,7 +88,7 @@ static int count_hit_cells(const polyc_config *cfg, const scanlog *log, double a
             if (slot[t] == 0) {
                 if (used == cap) {
                     cap = cap ? 2 * cap : 256;
-                    uint8_t *more = realloc(bits, (size_t)cap * (TILE_SIDE * TILE_SIDE / 8));
+                    uint8_t *more = realloc(bits, (size_t)cap * TILE_BYTES);
                     if (!more) {
                         free(bits);
                         free(slot);
@@ -94,14 +96,20 @@ static int count_hit_cells(const polyc_config *cfg, const scanlog *log, double a
                     }
                     bits = more;
                 }
-                memset(bits + (size_t)used * (TILE_SIDE * TILE_SIDE / 8), 0, TILE_SIDE * TILE_SIDE / 8);
+                memset(bits + (size_t)used * TILE_BYTES, 0, TILE_BYTES);
                 slot[t] = ++used;
             }
-            uint8_t *b = bits + (size_t)(slot[t] - 1) * (TILE_SIDE * TILE_SIDE / 8);
+            uint8_t *b = bits + (size_t)(slot[t] - 1) * TILE_BYTES;
             unsigned c = (unsigned)((iy % TILE_SIDE) * TILE_SIDE + ix % TILE_SIDE);
             if (!(b[c >> 3] & (1u << (c & 7)))) {
                 b[c >> 3] = (uint8_t)(b[c >> 3] | (1u << (c & 7)));
                 (*cells_hit)++;
+            }
+            uint8_t *k = b + TILE_SIDE * TILE_SIDE / 8;
+            unsigned q = (unsigned)((iy % TILE_SIDE) / 2 * (TILE_SIDE / 2) + (ix % TILE_SIDE) / 2);
+            if (!(k[q >> 3] & (1u << (q & 7)))) {
+                k[q >> 3] = (uint8_t)(k[q >> 3] | (1u << (q & 7)));
+                (*blocks_hit)++;
             }
         }
     }
@@ -112,17 +120,19 @@ static int count_hit_cells(const polyc_config *cfg, const scanlog *log, double a
 }
 
 /* The area's limits raised to what the log's returns need (an eighth to
- * spare): the tiles they fall in and the cells with endpoints, which
+ * spare): the tiles they fall in, the cells with endpoints and twice their
+ * 2 x 2 blocks (an update's points are limits.max_points / 2), which
  * polyc_online_limits_for_area can only estimate for a usual building
  * (fhw's 1,352 tiles and aces' 1,329 outgrew its 1,314 and 1,024, and the
  * whole replay ran again with four times the limits). Never lowered. */
 static void fit_limits_to_log(const polyc_config *cfg, const scanlog *log, polyc_online_limits *lim)
 {
-    uint64_t tiles, cells;
-    if (count_hit_cells(cfg, log, lim->area_m, &tiles, &cells) != 0)
+    uint64_t tiles, cells, blocks;
+    if (count_hit_cells(cfg, log, lim->area_m, &tiles, &cells, &blocks) != 0)
         return; /* (the estimate, and the retries) */
     double want_cells = fmin((double)(tiles + tiles / 8 + 16) * TILE_SIDE * TILE_SIDE, 0x40000000);
-    double want_points = fmin((double)(cells + cells / 8 + 1024), 0x10000000);
+    uint64_t need = cells > 2 * blocks ? cells : 2 * blocks;
+    double want_points = fmin((double)(need + need / 8 + 1024), 0x10000000);
     if (want_cells > (double)lim->max_grid_cells)
         lim->max_grid_cells = (uint32_t)want_cells;
     if (want_points > (double)lim->max_points) {
