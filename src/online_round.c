@@ -450,6 +450,10 @@ static polyc_status round_in(polyc_ctx *ctx, uint64_t work, int all, uint64_t *s
      * where the climbs after the links went) */
     if (polyc__op_unfold(o) + merged > 0)
         polyc__op_untangle(o);
+    if (polyc__op_end_gaps(o) >= 1000) {
+        polyc__op_untangle(o);
+        polyc__op_end_gaps(o);
+    }
     o->pol.add_vertices = add;
     o->region_since = 0;
     POLYC__CHECKS_ITERATION(o);

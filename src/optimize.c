@@ -73,6 +73,11 @@ static polyc_status polish(polyc__opt *o, float best)
     }
     polyc__op_unfold(o);
     polyc__op_untangle(o);
+    /* the map as written: no vertex on another segment */
+    if (polyc__op_end_gaps(o) >= 1000) {
+        polyc__op_untangle(o);
+        polyc__op_end_gaps(o);
+    }
     return POLYC_OK;
 }
 

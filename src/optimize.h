@@ -395,6 +395,11 @@ int polyc__op_corners(polyc__opt *o, uint32_t since);
 int polyc__op_trim_ends(polyc__opt *o);
 /* topology.c: every crossing of two segments resolved (not in the paper) */
 int polyc__op_untangle(polyc__opt *o);
+/* topology.c: open ends at T-junctions stop END_GAP_M (1 mm) short of the
+ * segment they meet, corners that touch a segment clear it by as much;
+ * the number moved, plus 1000 for each crossing at a vertex made one that
+ * polyc__op_untangle sees (run it, and this, again) */
+int polyc__op_end_gaps(polyc__opt *o);
 /* whether a segment from vertex a to vertex b would cross the map */
 int polyc__link_crosses(const polyc__opt *o, int32_t a, int32_t b);
 /* topology.c: stretches of map along another piece of map cut out */

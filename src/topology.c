@@ -21,6 +21,7 @@ extern inline int polyc__edited_since(const polyc__opt *o, int32_t v, uint32_t s
 #define CROSS_END_M 0.002f  /* a crossing this near a segment end is a junction */
 #define CUT_BACK_M 0.002f   /* a cut arm ends this short of the other segment */
 #define LOSES_RETURNS 1e6f   /* single scans: an edit that loses returns comes last */
+#define END_GAP_M 0.001f     /* an end that meets a segment stops this short of it */
 
 /* Whether segments p0-p1 and q0-q1 cross with the crossing at least
  * CROSS_END_M from all four ends; *t and *u: its position along each. */
@@ -210,4 +211,99 @@ int polyc__op_untangle(polyc__opt *o)
         }
     }
     return fixed;
+}
+
+/* An open end v whose segment (from n) meets segment c-d within
+ * CROSS_END_M of v, or stops less than END_GAP_M short of it (a T-junction:
+ * not a crossing to untangle_fix), pulled back along its segment to end
+ * END_GAP_M short of c-d; 1 if it moved. A junction left where it meets
+ * lies on the other segment up to float's rounding, a tenth of a millimetre
+ * through it or short of it, and once printed to 0.1 mm a strict test finds
+ * a crossing or a touch (shapely's validity on acapulco, edmonton). */
+static int gap_end(polyc__opt *o, int32_t v, int32_t n, int32_t sg)
+{
+    const polyc__store *s = o->s;
+    const polyc__vertex *V = s->v, *c = &V[sg], *d = &V[c->next];
+    float rx = V[v].x - V[n].x, ry = V[v].y - V[n].y;
+    float sx = d->x - c->x, sy = d->y - c->y;
+    float len = sqrtf(rx * rx + ry * ry), ls = sqrtf(sx * sx + sy * sy);
+    float den = rx * sy - ry * sx;
+    if (len < 4.0f * END_GAP_M || ls <= 0.0f || fabsf(den) < 0.05f * len * ls)
+        return 0; /* (short, or along the other segment: the zip's) */
+    float wx = c->x - V[n].x, wy = c->y - V[n].y;
+    float t = (wx * sy - wy * sx) / den, u = (wx * ry - wy * rx) / den;
+    /* where the line of n-v meets c-d, against where v is: the gap it must
+     * keep measured along n-v, END_GAP_M across c-d */
+    float sin_a = fabsf(den) / (len * ls), keep = END_GAP_M / sin_a;
+    if (u < -keep / ls || u > 1.0f + keep / ls || t * len < len - CROSS_END_M ||
+        t * len >= len + keep)
+        return 0;
+    float at = t * len - keep;
+    if (at < 2.0f * END_GAP_M)
+        return 0;
+    polyc__apply_move(o, v, V[n].x + rx * (at / len), V[n].y + ry * (at / len));
+    return 1;
+}
+
+/* An interior vertex v (between p and q) that lies within CROSS_END_M of
+ * segment c-d, on it or just across it, while p and q lie beyond END_GAP_M
+ * on one side (a corner that pokes through a wall by less than the
+ * crossings' end rule sees), moved across the line to END_GAP_M on their
+ * side; 1 if it moved. With p and q on two sides the polyline crosses c-d
+ * at v, which the end rule lets pass: v goes CROSS_END_M further its own
+ * way, and the crossing, now that far from it, is untangle's (2). */
+static int gap_corner(polyc__opt *o, int32_t v, int32_t p, int32_t q, int32_t sg)
+{
+    const polyc__vertex *V = o->s->v, *c = &V[sg], *d = &V[c->next];
+    float sx = d->x - c->x, sy = d->y - c->y, ls = sqrtf(sx * sx + sy * sy);
+    if (ls <= 4.0f * END_GAP_M)
+        return 0;
+    float nx = -sy / ls, ny = sx / ls; /* unit normal of c-d */
+    float dv = (V[v].x - c->x) * nx + (V[v].y - c->y) * ny;
+    float dp = (V[p].x - c->x) * nx + (V[p].y - c->y) * ny;
+    float dq = (V[q].x - c->x) * nx + (V[q].y - c->y) * ny;
+    float along = ((V[v].x - c->x) * sx + (V[v].y - c->y) * sy) / (ls * ls);
+    if (along < 0.0f || along > 1.0f || fabsf(dv) >= CROSS_END_M || fabsf(dp) <= END_GAP_M ||
+        fabsf(dq) <= END_GAP_M)
+        return 0;
+    if ((dp > 0.0f) != (dq > 0.0f)) {
+        float push = (dv >= 0.0f ? 1.5f : -1.5f) * CROSS_END_M;
+        polyc__apply_move(o, v, V[v].x + push * nx, V[v].y + push * ny);
+        return 2;
+    }
+    if ((dv > 0.0f) == (dp > 0.0f) && fabsf(dv) >= END_GAP_M)
+        return 0; /* (clear of it on its neighbours' side) */
+    float to = dp > 0.0f ? END_GAP_M : -END_GAP_M;
+    polyc__apply_move(o, v, V[v].x + (to - dv) * nx, V[v].y + (to - dv) * ny);
+    return 1;
+}
+
+int polyc__op_end_gaps(polyc__opt *o)
+{
+    const polyc__store *s = o->s;
+    const polyc__hash *h = &o->h;
+    int moved = 0;
+    for (int32_t v = 0; v < s->v_high; v++) {
+        const polyc__vertex *e = &s->v[v];
+        if (e->line == POLYC__NONE || (e->prev == POLYC__NONE && e->next == POLYC__NONE))
+            continue; /* (a polyline of one vertex) */
+        int inner = e->prev != POLYC__NONE && e->next != POLYC__NONE;
+        int32_t n = e->prev != POLYC__NONE ? e->prev : e->next;
+        int32_t bx, by, around[9];
+        polyc__bucket_xy(h, e->x, e->y, &bx, &by);
+        int nb = polyc__buckets_around(h, bx, by, around);
+        for (int i = 0; i < nb; i++)
+            for (int32_t en = h->seg_head[around[i]]; en != POLYC__NONE; en = h->entries[en].next) {
+                int32_t sg = h->entries[en].seg;
+                if (polyc__touches(s, sg, v, inner ? POLYC__NONE : n))
+                    continue;
+                int how = inner ? gap_corner(o, v, e->prev, e->next, sg) : gap_end(o, v, n, sg);
+                if (how) {
+                    moved += how == 2 ? 1000 : 1; /* (thousands: crossings made proper) */
+                    goto next; /* (its hash entries moved with it) */
+                }
+            }
+    next:;
+    }
+    return moved;
 }
