@@ -887,9 +887,10 @@ class Calls(unittest.TestCase):
                 call()
             self.assertIn("no scans found", str(e.exception))
 
-    def test_one_large_scan_is_retried_as_the_tool_does(self):
+    def test_one_large_scan_fits_its_limits(self):
         scan = big_scan(8000)
-        # the limits sized for it are too small for its data points...
+        # the limits sized for it hold it (a scan with more returns than
+        # data points has them summed by cell)...
         cfg = polyc._config({})
         held = polyc._scan(scan)
         lim = polyc._Limits()
@@ -898,11 +899,9 @@ class Calls(unittest.TestCase):
         ctx = polyc.Context((lim.max_scans, lim.max_beams, lim.max_grid_cells,
                              lim.max_vertices, lim.max_points))
         ctx.add_scan(*scan)
-        with self.assertRaises(polyc.PolycError) as e:
-            ctx.build()
-        self.assertEqual(e.exception.status, polyc.ERR_NOMEM)
-        self.assertIn("max_points", str(e.exception))
-        # ...build_map runs it again with the worst-case bound, as the tool does
+        ctx.build()
+        self.assertGreater(len(ctx.polylines()), 0)
+        # ...and build_map gives the tool's map
         result = polyc.build_map([scan])
         with tempfile.TemporaryDirectory() as tmp:
             path = os.path.join(tmp, "big.scans")
