@@ -333,7 +333,7 @@ $(EMB_EXAMPLES:%=$(XBUILD)/%.o): $(XBUILD)/%.o: examples/%.c examples/embedded_r
 	@mkdir -p $(dir $@)
 	$(CROSS)gcc $(XFLAGS) -D$(XTARGET) -c $< -o $@
 $(XELF): %.elf: %.o $(XBUILD)/libpolyc.a
-	$(CROSS)gcc $(XFLAGS) -specs=nosys.specs -Wl,--gc-sections $^ -lm -o $@
+	$(CROSS)gcc $(XFLAGS) -specs=nano.specs -specs=nosys.specs -Wl,--gc-sections $^ -lm -o $@
 
 # The embedded examples on an emulated Cortex-M4F (`make target`; needs
 # qemu-system-arm and newlib's rdimon, which make deps installs): each example

@@ -11,9 +11,9 @@
  *   range cap      4.5 m    (scan max_range_m and config free_range_m)
  *   counters       8 bit    (library built with -DPOLYC_COUNTER_BITS=8)
  *   vertices       96       (limits.max_vertices; the trace gives ~40, the map ~10)
- * polyc_memory_size() is then about 82 KB <= sizeof block (the host build;
+ * polyc_memory_size() is then about 80 KB <= sizeof block (the host build;
  * the spatial hash's buckets and entries follow the grid and the vertices).
- * With 16-bit counters it is 10 KB more, 92 KB: still within the block.
+ * With 16-bit counters it is 10 KB more, 91 KB: still within the block.
  *
  * Host:   prints the polylines in polyc's TXT format (tests/embedded_test.sh).
  * Target: built with -DEMBEDDED_SCAN_TARGET, main() only runs the pipeline

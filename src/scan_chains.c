@@ -36,10 +36,11 @@ extern inline int polyc__chain_member(const chains *c, int32_t i);
 static int chains_carve(polyc__arena *a, chains *c, int32_t n)
 {
     c->xy = polyc__alloc(a, (size_t)n + 1, 2 * sizeof(float));
+    c->turned = polyc__alloc(a, (size_t)n + 1, sizeof(float));
     c->keep = polyc__alloc(a, (size_t)n + 1, 1);
     c->cost = polyc__alloc(a, (size_t)n + 1, sizeof(float));
     c->chain_of = polyc__alloc(a, (size_t)n + 1, 1);
-    return c->xy && c->keep && c->cost && c->chain_of;
+    return c->xy && c->turned && c->keep && c->cost && c->chain_of;
 }
 
 void polyc__chains_reserve(polyc__arena *a, const polyc_limits *lim)
@@ -235,12 +236,13 @@ static polyc_status append_end(chains *c, int32_t line, const fitted *f, int32_t
  * else onto the lines), each end onto its line. The ends reach half a beam
  * spacing past the end hits, so that the end beams meet the map; a lone hit
  * becomes a segment across its beam, one beam spacing long. */
-static polyc_status emit(chains *c, int32_t a, int32_t b)
+static polyc_status emit(chains *c, int32_t a, int32_t b, int32_t *out)
 {
     polyc__store *s = &c->ctx->store;
     int32_t line = polyc__line_new(s);
     if (line == POLYC__NONE)
         return polyc__fail(c->ctx, POLYC_ERR_NOMEM, "too many polylines for limits.max_vertices");
+    *out = line;
     if (a == b) {
         float x = c->xy[2 * a], y = c->xy[2 * a + 1], dx = x - c->ox, dy = y - c->oy;
         float len = sqrtf(dx * dx + dy * dy);
@@ -346,6 +348,59 @@ static int links(const chains *c, const open_chain *h, int32_t i, int32_t n)
             dist2(c, i, next) <= GRAZING_REACH * GRAZING_REACH * reach * reach);
 }
 
+/* A scan over a full turn has no first beam: the chains start after its
+ * widest gap between returns (the most beams without one, then the
+ * longest jump), so that no wall is cut where the beam list wraps. The
+ * beam to start at (*full: the scan is a full turn); 0 for a scan over
+ * less than a turn. */
+static int32_t seam(const polyc__scan *s, const float *r, int *full)
+{
+    int32_t n = (int32_t)s->count;
+    *full = n >= 3 && (float)n * fabsf(s->step_rad) >= 6.2831853f - 0.5f * fabsf(s->step_rad);
+    if (!*full)
+        return 0;
+    int32_t first = -1, prev = -1, best = 0;
+    float best_gap = -1.0f;
+    for (int32_t k = 0; k <= n; k++) {
+        int32_t i = k % n;
+        if (!is_hit(s, r[i]) || (k == n && first < 0))
+            continue;
+        if (k == n && i != first)
+            break;
+        if (prev >= 0) {
+            int32_t beams = (i - prev + n) % n;
+            float a = (float)beams * s->step_rad;
+            float jump = r[i] * r[i] + r[prev] * r[prev] - 2.0f * r[i] * r[prev] * polyc__cosf(a);
+            float gap = (float)beams * 1e6f + jump; /* (beams first, then the jump) */
+            if (gap > best_gap) {
+                best_gap = gap;
+                best = i;
+            }
+        }
+        if (first < 0)
+            first = i;
+        prev = i;
+        if (k == n)
+            break;
+    }
+    return best;
+}
+
+/* A full turn whose chain ran round it whole (first and last returns of
+ * the turn in one chain that links across the seam) is closed: line is its
+ * polyline, a and b its first and last beams. */
+static void close_ring(chains *c, int32_t line, int32_t a, int32_t b, int32_t n)
+{
+    polyc__store *s = &c->ctx->store;
+    if (a != 0 || s->l[line].count < 3 || !polyc__chain_has_point(c, n - 1) || b != n - 1)
+        return;
+    float reach = c->range[b] * polyc__sinf(c->step) / polyc__sinf(LAMBDA_RAD - c->step) +
+                  2.0f * c->ctx->cfg.cell_m;
+    if (dist2(c, b, a) > reach * reach)
+        return;
+    polyc__line_close(s, line);
+}
+
 polyc_status polyc__chains_build(polyc_ctx *ctx)
 {
     if (!polyc__store_init(&ctx->arena, &ctx->store, polyc__max_vertices(&ctx->lim)))
@@ -366,14 +421,19 @@ polyc_status polyc__chains_build(polyc_ctx *ctx)
     c.tol = ctx->cfg.cell_m;
     c.cur = 0;
     const float *r = &ctx->ranges[s->first];
-    c.range = r;
+    int full;
+    int32_t off = seam(s, r, &full);
+    for (int32_t j = 0; j < n; j++)
+        c.turned[j] = r[(j + off) % n];
+    c.range = c.turned;
+    r = c.turned;
     c.alpha = ctx->cfg.alpha;
     int32_t returns = 0;
     for (int32_t i = 0; i < n; i++)
         returns += is_hit(s, r[i]);
     c.log_n = polyc__logf(returns > 1 ? (float)returns : 1.0f);
     for (int32_t i = 0; i < n; i++) {
-        float a = s->theta_rad + s->start_rad + (float)i * s->step_rad;
+        float a = s->theta_rad + s->start_rad + (float)((i + off) % n) * s->step_rad;
         c.chain_of[i] = 0;
         c.xy[2 * i] = c.xy[2 * i + 1] = NAN;
         if (is_hit(s, r[i])) {
@@ -392,8 +452,11 @@ polyc_status polyc__chains_build(polyc_ctx *ctx)
         for (int k = 0; k < n_open; k++)
             if (i == n || i - open[k].last > MAX_SKIP) {
                 c.cur = open[k].slot;
-                if ((st = emit(&c, open[k].first, open[k].last)) != POLYC_OK)
+                int32_t line;
+                if ((st = emit(&c, open[k].first, open[k].last, &line)) != POLYC_OK)
                     return st;
+                if (full)
+                    close_ring(&c, line, open[k].first, open[k].last, n);
                 slots_used &= ~(1u << (open[k].slot - 1));
                 open[k--] = open[--n_open];
             }

@@ -8,7 +8,8 @@
 typedef struct chains {
     polyc_ctx *ctx;
     float *xy;                 /* every beam's endpoint; NaN without a hit */
-    const float *range;        /* every beam's range */
+    const float *range;        /* every beam's range (in the order the chains take them) */
+    float *turned;             /* a full turn's ranges from its seam (range points here) */
     uint8_t *chain_of;         /* per beam: its chain's slot, 0 none */
     uint8_t cur;               /* the slot of the chain being emitted */
     uint8_t *keep;             /* per beam: a vertex of the simplified chain */

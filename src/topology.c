@@ -213,46 +213,18 @@ int polyc__op_untangle(polyc__opt *o)
     return fixed;
 }
 
-/* An open end v whose segment (from n) meets segment c-d within
- * CROSS_END_M of v, or stops less than END_GAP_M short of it (a T-junction:
- * not a crossing to untangle_fix), pulled back along its segment to end
- * END_GAP_M short of c-d; 1 if it moved. A junction left where it meets
- * lies on the other segment up to float's rounding, a tenth of a millimetre
- * through it or short of it, and once printed to 0.1 mm a strict test finds
- * a crossing or a touch (shapely's validity on acapulco, edmonton). */
-static int gap_end(polyc__opt *o, int32_t v, int32_t n, int32_t sg)
-{
-    const polyc__store *s = o->s;
-    const polyc__vertex *V = s->v, *c = &V[sg], *d = &V[c->next];
-    float rx = V[v].x - V[n].x, ry = V[v].y - V[n].y;
-    float sx = d->x - c->x, sy = d->y - c->y;
-    float len = sqrtf(rx * rx + ry * ry), ls = sqrtf(sx * sx + sy * sy);
-    float den = rx * sy - ry * sx;
-    if (len < 4.0f * END_GAP_M || ls <= 0.0f || fabsf(den) < 0.05f * len * ls)
-        return 0; /* (short, or along the other segment: the zip's) */
-    float wx = c->x - V[n].x, wy = c->y - V[n].y;
-    float t = (wx * sy - wy * sx) / den, u = (wx * ry - wy * rx) / den;
-    /* where the line of n-v meets c-d, against where v is: the gap it must
-     * keep measured along n-v, END_GAP_M across c-d */
-    float sin_a = fabsf(den) / (len * ls), keep = END_GAP_M / sin_a;
-    if (u < -keep / ls || u > 1.0f + keep / ls || t * len < len - CROSS_END_M ||
-        t * len >= len + keep)
-        return 0;
-    float at = t * len - keep;
-    if (at < 2.0f * END_GAP_M)
-        return 0;
-    polyc__apply_move(o, v, V[n].x + rx * (at / len), V[n].y + ry * (at / len));
-    return 1;
-}
-
-/* An interior vertex v (between p and q) that lies within CROSS_END_M of
- * segment c-d, on it or just across it, while p and q lie beyond END_GAP_M
- * on one side (a corner that pokes through a wall by less than the
- * crossings' end rule sees), moved across the line to END_GAP_M on their
- * side; 1 if it moved. With p and q on two sides the polyline crosses c-d
- * at v, which the end rule lets pass: v goes CROSS_END_M further its own
- * way, and the crossing, now that far from it, is untangle's (2). */
-static int gap_corner(polyc__opt *o, int32_t v, int32_t p, int32_t q, int32_t sg)
+/* Vertex v, within CROSS_END_M of segment c-d (its projection on it),
+ * cleared of it by END_GAP_M on the side of its neighbours p and q (q
+ * NONE: v is an open end). A T-junction's end, or a corner that touches a
+ * wall, lies on the other segment up to float's rounding, a tenth of a
+ * millimetre through it or short of it, which the crossings' end rule lets
+ * pass; printed to 0.1 mm a strict test finds a crossing or a touch
+ * (shapely's validity on acapulco, edmonton). An end moves back along its
+ * segment, a corner across the line. With p and q on two sides the
+ * polyline crosses c-d at v: v goes 1.5 CROSS_END_M further its own way,
+ * so that the crossing is one untangle sees. 0: unmoved, 1: cleared, 2:
+ * pushed through. */
+static int clear_vertex(polyc__opt *o, int32_t v, int32_t p, int32_t q, int32_t sg)
 {
     const polyc__vertex *V = o->s->v, *c = &V[sg], *d = &V[c->next];
     float sx = d->x - c->x, sy = d->y - c->y, ls = sqrtf(sx * sx + sy * sy);
@@ -261,7 +233,7 @@ static int gap_corner(polyc__opt *o, int32_t v, int32_t p, int32_t q, int32_t sg
     float nx = -sy / ls, ny = sx / ls; /* unit normal of c-d */
     float dv = (V[v].x - c->x) * nx + (V[v].y - c->y) * ny;
     float dp = (V[p].x - c->x) * nx + (V[p].y - c->y) * ny;
-    float dq = (V[q].x - c->x) * nx + (V[q].y - c->y) * ny;
+    float dq = q != POLYC__NONE ? (V[q].x - c->x) * nx + (V[q].y - c->y) * ny : dp;
     float along = ((V[v].x - c->x) * sx + (V[v].y - c->y) * sy) / (ls * ls);
     if (along < 0.0f || along > 1.0f || fabsf(dv) >= CROSS_END_M || fabsf(dp) <= END_GAP_M ||
         fabsf(dq) <= END_GAP_M)
@@ -271,10 +243,15 @@ static int gap_corner(polyc__opt *o, int32_t v, int32_t p, int32_t q, int32_t sg
         polyc__apply_move(o, v, V[v].x + push * nx, V[v].y + push * ny);
         return 2;
     }
+    float to = dp > 0.0f ? END_GAP_M : -END_GAP_M;
     if ((dv > 0.0f) == (dp > 0.0f) && fabsf(dv) >= END_GAP_M)
         return 0; /* (clear of it on its neighbours' side) */
-    float to = dp > 0.0f ? END_GAP_M : -END_GAP_M;
-    polyc__apply_move(o, v, V[v].x + (to - dv) * nx, V[v].y + (to - dv) * ny);
+    if (q == POLYC__NONE) { /* along p-v to where it is `to` from the line */
+        float f = (dp - to) / (dp - dv);
+        polyc__apply_move(o, v, V[p].x + f * (V[v].x - V[p].x), V[p].y + f * (V[v].y - V[p].y));
+    } else {
+        polyc__apply_move(o, v, V[v].x + (to - dv) * nx, V[v].y + (to - dv) * ny);
+    }
     return 1;
 }
 
@@ -289,6 +266,7 @@ int polyc__op_end_gaps(polyc__opt *o)
             continue; /* (a polyline of one vertex) */
         int inner = e->prev != POLYC__NONE && e->next != POLYC__NONE;
         int32_t n = e->prev != POLYC__NONE ? e->prev : e->next;
+        int32_t m = inner ? e->next : POLYC__NONE;
         int32_t bx, by, around[9];
         polyc__bucket_xy(h, e->x, e->y, &bx, &by);
         int nb = polyc__buckets_around(h, bx, by, around);
@@ -297,7 +275,7 @@ int polyc__op_end_gaps(polyc__opt *o)
                 int32_t sg = h->entries[en].seg;
                 if (polyc__touches(s, sg, v, inner ? POLYC__NONE : n))
                     continue;
-                int how = inner ? gap_corner(o, v, e->prev, e->next, sg) : gap_end(o, v, n, sg);
+                int how = clear_vertex(o, v, n, m, sg);
                 if (how) {
                     moved += how == 2 ? 1000 : 1; /* (thousands: crossings made proper) */
                     goto next; /* (its hash entries moved with it) */

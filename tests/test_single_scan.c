@@ -42,6 +42,31 @@ static void room_with_box(scansim_scene *sc)
     scansim_transform(sc, 0.4, 3.0, -1.0);
 }
 
+/* A scanner over a full turn (720 beams), the beam list starting and
+ * ending in the middle of a wall: in the room with its box (whose shadow
+ * cuts the wall behind it), and in the room alone. */
+static void laser_full_turn(scansim_scene *sc)
+{
+    sc->laser.beam_count = 720u;
+    sc->laser.start_angle_rad = (float)-PI;
+    sc->laser.angle_step_rad = (float)(PI / 360.0);
+}
+
+static void room_full_turn(scansim_scene *sc)
+{
+    room_with_box(sc);
+    laser_full_turn(sc);
+}
+
+static void empty_room_full_turn(scansim_scene *sc)
+{
+    scansim_scene_init(sc, "empty room", 5u);
+    assert_int_equal(scansim_add_box(sc, 0.0, 0.0, 6.0, 4.0), 0);
+    assert_int_equal(scansim_add_pose(sc, 1.0, 2.0, 0.1), 0);
+    scansim_transform(sc, 0.4, 3.0, -1.0);
+    laser_full_turn(sc);
+}
+
 /* A 1.6 m wide corridor, 30 m long, seen once from near one end along it. */
 static void corridor(scansim_scene *sc)
 {
@@ -384,6 +409,43 @@ static void test_optimised_room(void **state)
     check_optimised(room_with_box, 10);
 }
 
+/* A full turn has no seam where the beam list wraps: the empty room's
+ * walls are one closed ring (they were an open polyline whose two ends met
+ * behind the scanner), and in the room with the box no open polyline's
+ * ends meet. */
+static void check_full_turn(void (*scene)(scansim_scene *), uint32_t rings)
+{
+    one_map m;
+    scene_map(&m, scene, UINT32_MAX, 0);
+    uint32_t n = polyc_polyline_count(m.ctx), closed = 0, ring_vertices = 0;
+    for (uint32_t i = 0; i < n; i++) {
+        polyc_polyline pl;
+        assert_int_equal(polyc_get_polyline(m.ctx, i, &pl), POLYC_OK);
+        if (pl.closed) {
+            closed++;
+            ring_vertices = pl.point_count;
+        } else {
+            /* an open polyline's ends do not meet (a ring cut open) */
+            float dx = pl.xy_m[0] - pl.xy_m[2 * pl.point_count - 2];
+            float dy = pl.xy_m[1] - pl.xy_m[2 * pl.point_count - 1];
+            assert_true(dx * dx + dy * dy > 0.05f * 0.05f);
+        }
+    }
+    print_message("%s over a full turn: %u polylines, %u closed (%u vertices), f %.4f\n",
+                  m.scene.name, n, closed, ring_vertices, m.score.f);
+    assert_int_equal(closed, rings);
+    assert_true(rings == 0 || (ring_vertices >= 4 && ring_vertices <= 8));
+    assert_true(m.score.f >= 0.99);
+    done(&m);
+}
+
+static void test_full_turn_is_one_ring(void **state)
+{
+    (void)state;
+    check_full_turn(empty_room_full_turn, 1);
+    check_full_turn(room_full_turn, 0);
+}
+
 static void test_optimised_corridor(void **state)
 {
     (void)state;
@@ -604,21 +666,23 @@ static void test_dense_scan_maps(void **state)
         if (st != POLYC_OK)
             fail_msg("radius %.0f m: %s (%s)", (double)radius, polyc_status_str(st),
                      polyc_last_error(ctx));
-        uint32_t lines = polyc_polyline_count(ctx), verts = 0;
+        uint32_t lines = polyc_polyline_count(ctx), verts = 0, closed = 0;
         double worst = 0.0;
         for (uint32_t l = 0; l < lines; l++) {
             polyc_polyline pl;
             assert_int_equal(polyc_get_polyline(ctx, l, &pl), POLYC_OK);
+            closed += pl.closed != 0;
             for (uint32_t v = 0; v < pl.point_count; v++) {
                 double d = fabs(hypot((double)pl.xy_m[2 * v], (double)pl.xy_m[2 * v + 1]) - (double)radius);
                 worst = d > worst ? d : worst;
                 verts++;
             }
         }
-        print_message("radius %.0f m, 100,000 beams: %u polylines, %u vertices, within %.1f mm "
-                      "of the circle\n",
-                      (double)radius, lines, verts, 1e3 * worst);
-        assert_true(lines >= 1 && verts >= 8);
+        print_message("radius %.0f m, 100,000 beams: %u polylines (%u closed), %u vertices, "
+                      "within %.1f mm of the circle\n",
+                      (double)radius, lines, closed, verts, 1e3 * worst);
+        /* a full turn round one wall: one ring, no seam where the beams wrap */
+        assert_true(lines == 1 && closed == 1 && verts >= 8);
         /* vertices outside the circle by the chords' sag: a 16-gon's at 1 m
          * is 19 mm; the wall's cells are 2.5 cm */
         assert_true(worst < 0.025);
@@ -645,6 +709,7 @@ int main(void)
         cmocka_unit_test(test_grid_trace_flag),
         cmocka_unit_test(test_chains_take_the_contour_room),
         cmocka_unit_test(test_dense_scan_maps),
+        cmocka_unit_test(test_full_turn_is_one_ring),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
