@@ -271,7 +271,7 @@ fuzz-merge: $(FUZZ_BIN)
 
 # Cortex-M4 (`make cross`; needs gcc-arm-none-eabi, libnewlib-arm-none-eabi): the
 # library at -Os -Werror and its sizes; FAILS if it references an allocator or
-# stdio (nm -u), or if a linked example (nosys.specs) contains one; then each
+# stdio (nm -u), or if a linked example (newlib-nano, nosys.specs) contains one; then each
 # example's stack from -fstack-usage. A failed POLYC_ASSERT traps (udf): newlib's
 # assert() calls __assert_func, which pulls in fiprintf and all of stdio.
 CROSS  ?= arm-none-eabi-
