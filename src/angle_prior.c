@@ -306,8 +306,8 @@ static int cell_of(const polyc__prior *p, float x, float y, int32_t *cx, int32_t
     /* more than a cell outside (or NaN): no neighbour inside either */
     if (!(fx >= -1.0f && fy >= -1.0f && fx < (float)p->w + 1.0f && fy < (float)p->h + 1.0f))
         return 0;
-    *cx = (int32_t)floorf(fx);
-    *cy = (int32_t)floorf(fy);
+    *cx = polyc__floori(fx);
+    *cy = polyc__floori(fy);
     return 1;
 }
 

@@ -6,6 +6,7 @@
 #include "optimize.h"
 
 #include <math.h>
+#include <string.h>
 
 int polyc__size_carve(polyc__arena *a, polyc__size_scratch *sz, int32_t V)
 {
@@ -15,7 +16,6 @@ int polyc__size_carve(polyc__arena *a, polyc__size_scratch *sz, int32_t V)
     POLYC__CARVE(ok, a, sz->seg_far_d, V);
     POLYC__CARVE(ok, a, sz->seg_far, V);
     POLYC__CARVE_ZERO(ok, a, sz->add_failed, V);
-    POLYC__CARVE(ok, a, sz->add_failed_end, V);
     /* A pass pushes each live vertex once, and each removal pops one
      * candidate and pushes at most its two neighbours: the heap never holds
      * more than twice the vertices, so a small store's spare is V. A
@@ -205,21 +205,42 @@ void polyc__size_forget(polyc__opt *o)
         o->size.add_failed[v] = 0;
 }
 
-/* Whether the addition on segment u-w failed before and nothing it
- * depends on moved since: its ends and their neighbours untouched (the
- * trial climbs u, w and the new vertex; without noise it is a function of
- * them and of the data, which stay put during a search). */
+/* The four vertices an addition on segment u-w depends on: its ends and
+ * their neighbours (the trial climbs u, w and the new vertex; without
+ * noise it is a function of them and of the data, which stay put during a
+ * search). */
+static void addition_near(const polyc__opt *o, int32_t u, int32_t w, int32_t near[4])
+{
+    const polyc__vertex *V = o->s->v;
+    near[0] = V[u].prev;
+    near[1] = u;
+    near[2] = w;
+    near[3] = V[w].next;
+}
+
+/* A digest of those vertices' ids and positions (never 0). */
+static uint32_t addition_digest(const polyc__opt *o, const int32_t near[4])
+{
+    uint32_t h = 2166136261u;
+    for (int k = 0; k < 4; k++) {
+        uint32_t word[3] = {(uint32_t)near[k], 0u, 0u};
+        if (near[k] != POLYC__NONE) {
+            memcpy(&word[1], &o->s->v[near[k]].x, sizeof word[1]);
+            memcpy(&word[2], &o->s->v[near[k]].y, sizeof word[2]);
+        }
+        for (int j = 0; j < 3; j++)
+            h = (h ^ word[j]) * 16777619u;
+    }
+    return h != 0u ? h : 1u;
+}
+
+/* Whether the addition on segment u-w failed before with its four vertices
+ * where they are now: the same trial would fail the same way. */
 static int failed_before(const polyc__opt *o, int32_t u, int32_t w)
 {
-    uint32_t failed = o->size.add_failed[u];
-    if (failed == 0 || o->size.add_failed_end[u] != w)
-        return 0;
-    const polyc__vertex *V = o->s->v;
-    int32_t near[4] = {V[u].prev, u, w, V[w].next};
-    for (int k = 0; k < 4; k++)
-        if (near[k] != POLYC__NONE && o->v_touch[near[k]] >= failed)
-            return 0;
-    return 1;
+    int32_t near[4];
+    addition_near(o, u, w, near);
+    return o->size.add_failed[u] != 0 && o->size.add_failed[u] == addition_digest(o, near);
 }
 
 /* Tries a vertex at the farthest point of the worst segments (largest mean
@@ -292,8 +313,9 @@ int polyc__op_add_vertices(polyc__opt *o, int max_tries)
             polyc__op_move(o, u, ux, uy);
             polyc__op_move(o, w, wx, wy);
             polyc__chg_commit(o);
-            o->size.add_failed[u] = ++o->touch_stamp; /* (after the undo's touches) */
-            o->size.add_failed_end[u] = w;
+            int32_t near[4];
+            addition_near(o, u, w, near);
+            o->size.add_failed[u] = addition_digest(o, near);
         }
         if (!any)
             break;

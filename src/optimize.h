@@ -108,11 +108,10 @@ typedef struct polyc__split_scratch {
 typedef struct polyc__size_scratch {
     float *seg_sum, *seg_w, *seg_far_d;
     int32_t *seg_far;
-    /* per segment (its first vertex): the touch stamp just after an
-     * addition on it failed, and its other end then (0: none since the
+    /* per segment (its first vertex): a digest of the four vertices an
+     * addition on it moved or looked at when it failed (0: none since the
      * search began) */
     uint32_t *add_failed;
-    int32_t *add_failed_end;
     polyc__heap_entry *heap;
     int32_t heap_n, heap_cap;
 } polyc__size_scratch;

@@ -37,7 +37,7 @@ typedef struct polyc__walk {
  * one instruction where a 64-bit one is a library call */
 static inline int64_t polyc__fixed(float v, float scale)
 {
-    return (int64_t)(int32_t)floorf(v * scale);
+    return (int64_t)polyc__floori(v * scale);
 }
 
 static inline float polyc__max_abs(float a, float b)
@@ -49,10 +49,10 @@ static inline float polyc__max_abs(float a, float b)
 
 static inline void polyc__walk_start(polyc__walk *w, const polyc__beam *b)
 {
-    w->ix = (int32_t)floorf(b->sx);
-    w->iy = (int32_t)floorf(b->sy);
-    w->ex = (int32_t)floorf(b->ex);
-    w->ey = (int32_t)floorf(b->ey);
+    w->ix = polyc__floori(b->sx);
+    w->iy = polyc__floori(b->sy);
+    w->ex = polyc__floori(b->ex);
+    w->ey = polyc__floori(b->ey);
     /* fractional bits: coordinates (plus a tile's worth of steps past the
      * end) below 2^(30 - f) keep every key below 2^62; at f = 0 that holds
      * for any grid the configuration allows (1e6 m / 1 mm < 2^30 cells) */

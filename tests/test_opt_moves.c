@@ -332,6 +332,40 @@ static void test_add_vertex_at_cut_corner(void **state)
     fx_close(&f);
 }
 
+/* An addition that failed is not tried again while the four vertices it
+ * depends on stay where they are: a second pass over an unchanged map
+ * makes no trial, so it edits (stamps) nothing. Two trials on an L, whose
+ * undos stamped each other's vertices, were both made again. */
+static void test_failed_addition_not_tried_again(void **state)
+{
+    (void)state;
+    static fixture f;
+    fx_open_hand(&f, 0.0f);
+    corner_points(&f, 1);
+    clear_lines(&f.o);
+    const float xy[6] = {-1.0f, 0.0f, 0.0f, 0.0f, 0.0f, 1.0f};
+    int32_t l = add_line(&f.o, xy, 3, 0);
+    rebuild(&f.o);
+    assert_int_equal(polyc__op_add_vertices(&f.o, 1), 0);
+    assert_line_is(&f.o, l, xy, 3);
+    uint32_t touch[3];
+    for (int32_t v = 0; v < 3; v++)
+        touch[v] = f.o.v_touch[v];
+    assert_int_equal(polyc__op_add_vertices(&f.o, 1), 0);
+    for (int32_t v = 0; v < 3; v++)
+        if (f.o.v_touch[v] != touch[v])
+            fail_msg("vertex %d stamped again (%u -> %u): a failed addition was tried again",
+                     (int)v, (unsigned)touch[v], (unsigned)f.o.v_touch[v]);
+    /* a moved end is a new neighbourhood: its addition is tried again */
+    polyc__apply_move(&f.o, 0, -1.0f, 0.01f);
+    uint32_t before = f.o.v_touch[1];
+    f.o.touch_stamp++;
+    polyc__op_add_vertices(&f.o, 1);
+    assert_true(f.o.v_touch[1] > before);
+    check_books(&f.o, "additions");
+    fx_close(&f);
+}
+
 /* ---- corners ---- */
 
 static void test_corner_replaces_spike(void **state)
@@ -426,6 +460,7 @@ int main(void)
         cmocka_unit_test(test_remove_collinear_vertex),
         cmocka_unit_test(test_remove_keeps_true_corner),
         cmocka_unit_test(test_add_vertex_at_cut_corner),
+        cmocka_unit_test(test_failed_addition_not_tried_again),
         cmocka_unit_test(test_corner_replaces_spike),
         cmocka_unit_test(test_corners_leave_clean_map),
         cmocka_unit_test(test_vertex_blocks_only_new_beams),
