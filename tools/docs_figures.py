@@ -124,6 +124,9 @@ def nth(rx, n):
 
 
 # ---- make bench's tables ----------------------------------------------------
+HEADS = {}  # each bench table's column names, as its header line has them
+
+
 def bench_tables(out):
     """{table: {row key: [tokens]}}: each table from its header line; '|' dropped"""
     heads = {
@@ -145,21 +148,23 @@ def bench_tables(out):
         rx, nth_head = rx if isinstance(rx, tuple) else (rx, 0)
         starts = [i for i, ln in enumerate(lines) if re.match(rx, ln)]
         for i in starts[nth_head:nth_head + 1]:
-            if True:
-                for row in lines[i + 1:]:
-                    if not row.strip() or re.match(r'^(scene|log|peak RSS)\s', row):
-                        break
-                    t = [x for x in row.split() if x != '|']
-                    if not re.match(r'(sim|carmen)/', t[0]):
-                        continue
-                    key = t[0]
-                    if name == 'occ':
-                        key += ' ' + t[5]  # method
-                        t = t[:1] + t[1:5] + t[6:]
-                    if name in ('final', 'memmap', 'corrmap'):
-                        key += ' ' + t[1]
-                    rows[key] = t
-                break
+            head = [x for x in lines[i].split() if x != '|']
+            if name == 'occ':
+                head = head[:5] + head[6:]
+            HEADS[name] = head
+            for row in lines[i + 1:]:
+                if not row.strip() or re.match(r'^(scene|log|peak RSS)\s', row):
+                    break
+                t = [x for x in row.split() if x != '|']
+                if not re.match(r'(sim|carmen)/', t[0]):
+                    continue
+                key = t[0]
+                if name == 'occ':
+                    key += ' ' + t[5]  # method
+                    t = t[:5] + t[6:]
+                if name in ('final', 'memmap', 'corrmap'):
+                    key += ' ' + t[1]
+                rows[key] = t
         tables[name] = rows
     return tables
 
@@ -462,7 +467,7 @@ FIGURES = [
     Fig(R, 'in {}–{} ms a\nscan (the median per log), none over {} ms, none with a crossing', 'bench',
         lambda o: over_rows('single', 6, lambda v: [min(v), max(v)])(o) + [2 + over_rows('single', 8, sum)(o)]),
     # --data: docs/performance.md, the bench's tables (times not compared)
-    Table(P, 'main', 'bench', skip_cols=range(3, 11)),
+    Table(P, 'main', 'bench', skip_cols=tuple(range(3, 11)) + (13,)),  # times, the process's RSS
     Table(P, 'topo', 'bench', skip_cols=(15,)),
     Table(P, 'occ', 'bench', skip_cols=(4, 15)),
     Table(P, 'online', 'bench', skip_cols=range(4, 11)),
@@ -534,7 +539,8 @@ class Runner:
     def command(self, src):
         a = self.args
         if src == 'bench':
-            return COMMANDS['bench'].format(data=a.data)
+            cmd = COMMANDS['bench'].format(data=a.data)
+            return cmd + (' (its saved output %s)' % a.bench_out if a.bench_out else '')
         return SOURCES[src].format(polyc=os.path.join(a.build, 'polyc'), tmp=self.tmp,
                                    make=a.make, build=a.build, data=a.data)
 
@@ -587,7 +593,9 @@ def check_table(t, text, runner):
             n += 1
             m = got[c] if c < len(got) else '(none)'
             if q != m:
-                bad.append('%s, column %d: %s quoted, %s measured by `%s`' % (where, c, q, m, cmd))
+                head = HEADS.get(t.name, [])
+                col = '%d (%s)' % (c, head[c]) if c < len(head) else '%d' % c
+                bad.append('%s, column %s: %s quoted, %s measured by `%s`' % (where, col, q, m, cmd))
     return n, bad
 
 
@@ -641,9 +649,10 @@ def check(figs, runner, band, compare_times):
                                  % (where, q, dec, meas, band, cmd))
                 continue
             if not same(quoted, meas, dec):
-                fails.append('%s: figure %d: %s quoted, %.*f measured (%s) by `%s`'
+                desc = getattr(fig.read, 'desc', None)
+                fails.append('%s: figure %d: %s quoted, %.*f measured%s by `%s`'
                              % (where, i + 1, q, max(dec, 1) if meas != int(meas) else 0, meas,
-                                getattr(fig.read, 'desc', 'its reader'), cmd))
+                                ' (%s)' % desc if desc else '', cmd))
     return fails, checked, times
 
 
