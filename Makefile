@@ -94,7 +94,8 @@ unit: $(TEST_BIN) $(BUILD)/polyc
 # CHECK_STEPS, each into build-check/STEP.log: one line per step (the log's
 # tail if it failed), and last a line `N passed, N failed` alone (CI reads it).
 CHECK_STEPS = unit test-checks test-cli test-fuzz-replay test-asan test-cxx test-install \
-              test-python test-embedded test-opt-O3 test-opt-Os test-golden test-valgrind cross target
+              test-python test-embedded test-opt-O3 test-opt-Os test-golden test-valgrind cross target \
+              docs-figures
 check: deps
 	@mkdir -p build-check; pass=0; fail=0; \
 	for s in $(CHECK_STEPS); do \
@@ -106,6 +107,27 @@ check: deps
 	  fi; \
 	done; \
 	echo "$$pass passed, $$fail failed"; test $$fail -eq 0
+
+# The figures README.md and docs/ quote, against the commands that print them
+# (tools/docs_figures.py: each figure, its document, its command; --list).
+# docs-figures: those of the repository's own data (office.log and its grid,
+# the sweep's scenes, footprint, the embedded examples, cross, target);
+# sizes and counts exact, times not compared. docs-figures-data: those of the
+# real logs, the simulated logs and the TurtleBot3 map in DATA, from a run of
+# `make bench DATA=...` (or its saved output: BENCH_OUT=file) and build/polyc;
+# times within 2 x. Each failure names the document, the quoted and the
+# measured value, and the command.
+.PHONY: docs-figures docs-figures-data
+docs-figures: $(BUILD)/polyc
+	python3 tools/docs_figures.py --make "$(MAKE)" --build $(BUILD)
+docs-figures-data: $(BUILD)/polyc
+	@if [ -d "$(DATA)" ]; then \
+	  python3 tools/docs_figures.py --make "$(MAKE)" --build $(BUILD) --data "$(DATA)" \
+	    $(if $(BENCH_OUT),--bench-out "$(BENCH_OUT)"); \
+	else \
+	  echo "docs-figures-data: no data folder '$(DATA)' (the real logs are not in the repository;"; \
+	  echo "  build-bench/bench --help says what it holds): give DATA=path. Nothing compared."; \
+	fi
 
 # The unit suites on a library with its invariant checkers built in
 # (src/checks.c): the optimiser asserts its store, hash and arena after

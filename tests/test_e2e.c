@@ -1,6 +1,6 @@
 /* test_e2e.c - the whole library on simulated scenes with known ground
  * truth: scans from tools/eval/scansim go in through the public API, the map
- * comes out and tools/eval/gtscore scores it as shared/data/README.md defines.
+ * comes out and tools/eval/gtscore scores it as docs/evaluation.md defines.
  *
  * Two groups:
  *   initial    optimiser off (max_iterations = 0): the traced polylines must

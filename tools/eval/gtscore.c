@@ -1,7 +1,7 @@
 /* gtscore.c - ground-truth reader and map scores (definitions in gtscore.h).
  *
  * Takes a .gt.txt file and a map of polylines or single scans; gives the
- * figures of shared/data/README.md: precision, completeness, compactness,
+ * figures of docs/evaluation.md, "Scores": precision, completeness, compactness,
  * ray RMSE and f.
  */
 #include "gtscore.h"

@@ -1,5 +1,5 @@
 /* gtscore.h - score polyline maps against ground truth, as
- * shared/data/README.md ("How to score a map") defines it.
+ * docs/evaluation.md ("Scores") defines it.
  *
  * Takes: a ground-truth file (ideal, wall, seen lines; the format of
  * shared/data/sim/NAME.gt.txt) and a map as polyc_polyline records.
