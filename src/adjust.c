@@ -9,19 +9,6 @@
 static const float DIR_X[8] = {1.0f, 0.70710678f, 0.0f, -0.70710678f, -1.0f, -0.70710678f, 0.0f, 0.70710678f};
 static const float DIR_Y[8] = {0.0f, 0.70710678f, 1.0f, 0.70710678f, 0.0f, -0.70710678f, -1.0f, -0.70710678f};
 
-/* the turn at b, in [0, pi], of the path a -> b -> c */
-static float turn_of(float ax, float ay, float bx, float by, float cx, float cy)
-{
-    float ux = bx - ax, uy = by - ay, wx = cx - bx, wy = cy - by;
-    return polyc__turn_rad(ux * wy - uy * wx, ux * wx + uy * wy);
-}
-
-/* 1 - p(turn at b) for the path a -> b -> c */
-float polyc__turn_cost(const polyc__opt *o, float ax, float ay, float bx, float by, float cx, float cy)
-{
-    return 1.0f - (float)polyc__prior_p(&o->prior, bx, by, turn_of(ax, ay, bx, by, cx, cy));
-}
-
 /* The prior at the three vertices whose angles a move of v changes: its
  * neighbours stay put, v's cell is looked up again when it changes. */
 typedef struct angle_places {
@@ -50,14 +37,14 @@ static float local_angles(const polyc__opt *o, angle_places *pl, int32_t v, floa
     if (p != POLYC__NONE && n != POLYC__NONE) {
         if (!polyc__prior_same_place(&o->prior, &pl->at, x, y))
             polyc__prior_at(&o->prior, x, y, &pl->at);
-        sum += 1.0f - (float)polyc__prior_p_at(&pl->at, turn_of(V[p].x, V[p].y, x, y, V[n].x, V[n].y));
+        sum += 1.0f - (float)polyc__prior_p_at(&pl->at, polyc__turn_of(V[p].x, V[p].y, x, y, V[n].x, V[n].y));
     }
     if (p != POLYC__NONE && V[p].prev != POLYC__NONE && V[p].prev != v)
         sum += 1.0f - (float)polyc__prior_p_at(
-                         &pl->prev, turn_of(V[V[p].prev].x, V[V[p].prev].y, V[p].x, V[p].y, x, y));
+                         &pl->prev, polyc__turn_of(V[V[p].prev].x, V[V[p].prev].y, V[p].x, V[p].y, x, y));
     if (n != POLYC__NONE && V[n].next != POLYC__NONE && V[n].next != v)
         sum += 1.0f - (float)polyc__prior_p_at(
-                         &pl->next, turn_of(x, y, V[n].x, V[n].y, V[V[n].next].x, V[V[n].next].y));
+                         &pl->next, polyc__turn_of(x, y, V[n].x, V[n].y, V[V[n].next].x, V[V[n].next].y));
     return sum;
 }
 

@@ -2,7 +2,7 @@
  * Takes: the optimiser state. Gives: overlapping polyline ends zipped,
  * close ends merged (or a polyline closed), hairpin zigzags removed; all
  * through the edits of edits.c. (C, splitting and trimming, is split.c.) */
-#include "optimize.h"
+#include "cost.h"
 
 #include <float.h>
 #include <math.h>

@@ -4,7 +4,7 @@
  * zigzags, noise, vertex count) until `patience` iterations bring no better
  * BIC, or the iteration cap or the caller's progress callback stops it. */
 #include "cost.h"
-#include "online.h"
+#include "optimize.h"
 
 #include <math.h>
 #include <string.h>

@@ -9,7 +9,7 @@
  * short just before the crossing, the arm beyond it gone (at an open end
  * that is a trim; inside a polyline it splits it there). (Two pieces of
  * map along one wall are zip.c's.) */
-#include "optimize.h"
+#include "opt_state.h"
 
 #include <math.h>
 

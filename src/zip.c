@@ -4,7 +4,7 @@
  * lose that stretch from one of the two, the one whose loss raises the BIC
  * least, until no such stretch is left. Takes: the optimiser state (and
  * the sides segments are seen from, seg_side). Gives: the zipped map. */
-#include "optimize.h"
+#include "opt_state.h"
 
 #include <math.h>
 
