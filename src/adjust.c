@@ -206,15 +206,15 @@ int polyc__op_adjust(polyc__opt *o, int max_rounds, uint32_t since)
 {
     const polyc__store *s = o->s;
     int total = 0;
-    uint32_t stamp = ++o->work_stamp;
+    uint32_t stamp = ++o->climb.work_stamp;
     for (int32_t v = 0; v < s->v_high; v++)
         if (o->v_touch[v] >= since)
-            o->v_work[v] = stamp;
+            o->climb.v_work[v] = stamp;
     for (int r = 0; r < max_rounds; r++) {
-        uint32_t next = ++o->work_stamp;
+        uint32_t next = ++o->climb.work_stamp;
         int moved = 0;
         for (int32_t v = 0; v < s->v_high; v++) {
-            if (o->v_work[v] != stamp || s->v[v].line == POLYC__NONE)
+            if (o->climb.v_work[v] != stamp || s->v[v].line == POLYC__NONE)
                 continue;
             /* a single scan's ends are placed by end trimming (where the
              * end return's beam crosses the end segment's line), so a climb
@@ -228,7 +228,7 @@ int polyc__op_adjust(polyc__opt *o, int max_rounds, uint32_t since)
                 continue;
             moved++;
             if (how == 2 || !o->rays.on)
-                o->v_work[v] = next;
+                o->climb.v_work[v] = next;
             /* a single scan's neighbours are not climbed again for a move:
              * on the 10 slowest freiburg-campus scans four climbs in five
              * come from the first adjustment, and over 200 scans a log the
@@ -240,8 +240,8 @@ int polyc__op_adjust(polyc__opt *o, int max_rounds, uint32_t since)
             if (nb[0] != POLYC__NONE) nb[2] = s->v[nb[0]].prev;
             if (nb[1] != POLYC__NONE) nb[3] = s->v[nb[1]].next;
             for (int k = 0; k < 4; k++)
-                if (nb[k] != POLYC__NONE && o->v_work[nb[k]] != stamp)
-                    o->v_work[nb[k]] = next;
+                if (nb[k] != POLYC__NONE && o->climb.v_work[nb[k]] != stamp)
+                    o->climb.v_work[nb[k]] = next;
         }
         total += moved;
         stamp = next;

@@ -119,6 +119,14 @@ typedef struct polyc__size_scratch {
     int32_t heap_n, heap_cap;
 } polyc__size_scratch;
 
+/* Hill climbing's scratch (adjust.c): per vertex, the round stamp at
+ * which it is to be climbed. */
+typedef struct polyc__climb_scratch {
+    uint32_t *v_work;
+    uint32_t work_stamp;
+} polyc__climb_scratch;
+
+
 /* The data: weighted points sorted by hash bucket (points.c), and their
  * assignment to the model (cost.c, change.c). */
 typedef struct polyc__data {
@@ -186,8 +194,6 @@ typedef struct polyc__opt {
                                     * since op_split last looked at it */
     polyc__change chg;
 
-    uint32_t *v_work;              /* per vertex: == round stamp when to be climbed */
-    uint32_t work_stamp;
     uint32_t *v_touch;             /* per vertex: touch_stamp of the last edit near it */
     uint32_t touch_stamp;
     uint32_t untangle_mark, zip_mark; /* touch_stamp of their last passes: a segment
@@ -198,6 +204,7 @@ typedef struct polyc__opt {
     polyc__eval_scratch ev;
     polyc__split_scratch split;
     polyc__size_scratch size;
+    polyc__climb_scratch climb;
 
     /* an online update's region: only segments edited at or after this
      * stamp are split, trimmed or given vertices (0: the whole map); the
@@ -207,6 +214,26 @@ typedef struct polyc__opt {
 } polyc__opt;
 
 #define POLYC__CAND_MAX 48
+
+/* The zip's scratch (sides.c, zip.c): per segment, the weight of unit views across
+ * it from its left and from its right (polyc__find_sides fills them,
+ * polyc__two_sided reads them). A transient carve, the one place where two
+ * groups share memory: the pair is vertex removal's per-segment sums
+ * (polyc__size_scratch's seg_sum and seg_w, model_size.c), which the zip
+ * and the removal each fill anew before they read them within one pass, and
+ * no pass of the one runs inside a pass of the other. Stored nowhere, so
+ * that neither the block (the embedded examples fill 128 KiB) nor
+ * polyc__opt grows: polyc__sides gives it. */
+typedef struct polyc__side_scratch {
+    float *left_w, *right_w;
+} polyc__side_scratch;
+static inline polyc__side_scratch polyc__sides(const polyc__opt *o)
+{
+    polyc__side_scratch sd;
+    sd.left_w = o->size.seg_sum;
+    sd.right_w = o->size.seg_w;
+    return sd;
+}
 
 /* topology.c, zip.c */
 /* Does segment sg share vertex a or b (NONE: a new point)? */
@@ -307,7 +334,8 @@ inline void polyc__bucket_xy(const polyc__hash *h, float x, float y, int32_t *ix
     *iy = fy < 0.0f ? 0 : (fy >= (float)h->by ? h->by - 1 : (int32_t)fy);
 }
 /* The 3 x 3 buckets around bucket (bx, by) that lie in the hash, row by
- * row, into out; returns their count (the one bucket walk of the library). */
+ * row, into out; returns their count (the one bucket walk of the library:
+ * polyc__near_segs below walks their segments). */
 inline int polyc__buckets_around(const polyc__hash *h, int32_t bx, int32_t by, int32_t out[9])
 {
     int32_t x0 = bx > 0 ? bx - 1 : 0, x1 = bx + 1 < h->bx ? bx + 1 : h->bx - 1;
@@ -317,6 +345,40 @@ inline int polyc__buckets_around(const polyc__hash *h, int32_t bx, int32_t by, i
         for (int32_t x = x0; x <= x1; x++)
             out[n++] = y * h->bx + x;
     return n;
+}
+/* The segments entered in the 3 x 3 buckets around the bucket of (x, y),
+ * bucket by bucket and in each in its list's order (a segment entered in
+ * two of them comes twice): the walk of every query near a point (a search
+ * radius is at most a bucket). The hash must not change during the walk:
+ *     polyc__near_segs w;
+ *     for (int32_t sg = polyc__near_segs_first(&w, h, x, y); sg != POLYC__NONE;
+ *          sg = polyc__near_segs_next(&w)) ... */
+typedef struct polyc__near_segs {
+    const polyc__hash *h;
+    int32_t around[9];
+    int n, i;
+    int32_t e;                     /* the next entry in bucket around[i] */
+} polyc__near_segs;
+inline int32_t polyc__near_segs_next(polyc__near_segs *w)
+{
+    while (w->e == POLYC__NONE) {
+        if (++w->i >= w->n)
+            return POLYC__NONE;
+        w->e = w->h->seg_head[w->around[w->i]];
+    }
+    int32_t sg = w->h->entries[w->e].seg;
+    w->e = w->h->entries[w->e].next;
+    return sg;
+}
+inline int32_t polyc__near_segs_first(polyc__near_segs *w, const polyc__hash *h, float x, float y)
+{
+    int32_t bx, by;
+    polyc__bucket_xy(h, x, y, &bx, &by);
+    w->h = h;
+    w->n = polyc__buckets_around(h, bx, by, w->around);
+    w->i = -1;
+    w->e = POLYC__NONE;
+    return polyc__near_segs_next(w);
 }
 /* calls fn(o, user, bucket) for every bucket the segment a-b crosses */
 typedef void (*polyc__bucket_fn)(polyc__opt *o, void *user, int32_t bucket);
@@ -378,10 +440,14 @@ void polyc__apply_move(polyc__opt *o, int32_t v, float x, float y);
 /* operators.c: A (overlaps), B (merge), E (zigzags), folds */
 int polyc__op_overlaps(polyc__opt *o);
 int polyc__op_merge(polyc__opt *o);
-/* op_merge, with `folds` 0: no link whose two polylines leave it within 30
- * degrees of one direction (a hairpin, for a pass with no zigzag or zip
- * after it to judge it) */
-int polyc__op_merge_folds(polyc__opt *o, int folds);
+/* op_merge that refuses hairpins or not: a hairpin is a link whose two
+ * polylines leave it within 30 degrees of one direction; a pass with no
+ * zigzag or zip after it to judge one refuses them (op_merge allows them) */
+typedef enum polyc__hairpins {
+    POLYC__HAIRPINS_REFUSED = 0,
+    POLYC__HAIRPINS_ALLOWED = 1
+} polyc__hairpins;
+int polyc__op_merge_folds(polyc__opt *o, polyc__hairpins hairpins);
 /* split.c: C (split) and end trimming */
 int polyc__op_split(polyc__opt *o);
 int polyc__op_trim_ends(polyc__opt *o);
@@ -403,15 +469,15 @@ int polyc__op_untangle(polyc__opt *o);
 int polyc__op_end_gaps(polyc__opt *o);
 /* topology.c: whether a segment from vertex a to vertex b would cross the map */
 int polyc__link_crosses(const polyc__opt *o, int32_t a, int32_t b);
-/* zip.c: stretches of map along another piece of map cut out (op_zip);
- * what each segment is seen from, into seg_side (needs it), from
+/* sides.c: what each segment is seen from, into seg_side (needs it), from
  * the n points of list (NULL: every point); valid until the next edit.
  * With left and right (per vertex, or NULL), also the weight of unit views
  * across each segment from its left and from its right. */
 void polyc__find_sides(polyc__opt *o, const int32_t *list, int32_t n, float *left, float *right);
-/* zip.c: whether segment sg is seen from both sides, from the left and
- * right weights polyc__find_sides left in o->size.seg_sum and seg_w */
+/* sides.c: whether segment sg is seen from both sides, from the left and
+ * right weights polyc__find_sides left in polyc__sides(o) */
 int polyc__two_sided(const polyc__opt *o, int32_t sg);
+/* zip.c: stretches of map along another piece of map cut out */
 int polyc__op_zip(polyc__opt *o);
 /* model_size.c: G (vertex removal and addition) */
 int polyc__op_remove_vertices(polyc__opt *o, uint32_t since);

@@ -40,86 +40,186 @@ static polyc_status restore_best(polyc__opt *o, polyc_status st)
     return st;
 }
 
-/* The best map once more through merging and vertex removal, kept if its
- * BIC is no higher: the last edits of the search (cuts at crossings,
- * zipped stretches) can leave two ends a centimetre apart that the next
- * iteration would have joined. Then the rules the map must keep whatever
- * its BIC: every data gap split (a pass cuts one gap a segment), ends
- * trimmed, no double cover, no fold doubling a wall (op_unfold), no
- * crossing. Returns a status (the store holds
- * the result, scored). */
-static polyc_status polish(polyc__opt *o, float best)
+/* ---- the steps that give an operator its arguments, or are no operator ---- */
+
+/* every data gap split: a pass cuts one gap a segment */
+static int split_gaps(polyc__opt *o)
 {
-    polyc_status st;
-    o->untangle_mark = o->zip_mark = 0; /* the best map is a fresh store */
-    polyc__op_merge(o);
-    polyc__op_remove_vertices(o, 0);
-    if (polyc__bic(o) > best) {
-        if (polyc__store_from_flat(o->s, &o->best) != POLYC_OK)
-            return polyc__fail(o->ctx, POLYC_ERR_NOMEM, "no room to restore the best map");
-        if ((st = polyc__rebuild(o)) != POLYC_OK)
-            return st;
-        o->untangle_mark = o->zip_mark = 0;
-    }
     for (int k = 0; k < POLYC__POLISH_SPLITS && polyc__op_split(o) > 0; k++)
         ;
-    polyc__op_trim_ends(o);
-    uint32_t mark = ++o->touch_stamp;
-    if (polyc__op_zip(o) > 0) {
-        /* what is left of a zipped pair moves onto the data of both */
-        polyc__op_adjust(o, POLYC__ADJUST_ROUNDS, mark);
+    return 0;
+}
+static int remove_since(polyc__opt *o, polyc__op_args *a)
+{
+    return polyc__op_remove_vertices(o, a->since);
+}
+static int remove_marked(polyc__opt *o, polyc__op_args *a)
+{
+    return polyc__op_remove_vertices(o, a->mark);
+}
+static int add_vertices(polyc__opt *o)
+{
+    return polyc__op_add_vertices(o, POLYC__ADD_ROUNDS);
+}
+/* A single scan's later iterations climb only what the previous one edited
+ * after its first climbs (removals, zigzags, corners, trims): the vertices
+ * those climbs left at an optimum stay there (on 200 freiburg-campus scans,
+ * with ends not climbed, climbing them again takes a sixth of the time and
+ * lowers the BIC by 0.15 %) */
+static int climb_since(polyc__opt *o, polyc__op_args *a)
+{
+    return polyc__op_adjust(o, POLYC__ADJUST_ROUNDS, a->climb);
+}
+static int climb_marked(polyc__opt *o, polyc__op_args *a)
+{
+    return polyc__op_adjust(o, POLYC__ADJUST_ROUNDS, a->mark);
+}
+/* a new touch stamp: the steps after it look at what is edited from here */
+static int stamp(polyc__opt *o, polyc__op_args *a)
+{
+    a->mark = ++o->touch_stamp;
+    if (a->first == 0)
+        a->first = a->mark;
+    return 0;
+}
+static int corners(polyc__opt *o, polyc__op_args *a)
+{
+    return polyc__op_corners(o, a->since);
+}
+/* moves and additions can leave segments without data or hairpins: the
+ * CLEAN rows clean them, and a climb follows, before the model is judged,
+ * so that the best one is clean */
+static int clean(polyc__opt *o, polyc__op_args *a)
+{
+    for (int round = 0; round < POLYC__CLEAN_ROUNDS; round++) {
+        stamp(o, a);
+        if (polyc__run_ops(o, POLYC__SEQ_CLEAN, a) == 0)
+            break;
+        polyc__op_adjust(o, POLYC__ADJUST_ROUNDS, a->mark);
+    }
+    return 0;
+}
+/* the zip; what is left of a zipped pair then moves onto the data of both */
+static int zip_settled(polyc__opt *o, polyc__op_args *a)
+{
+    int n = polyc__op_zip(o);
+    if (n > 0) {
+        polyc__op_adjust(o, POLYC__ADJUST_ROUNDS, a->mark);
         polyc__op_trim_ends(o);
         polyc__op_zip(o);
     }
-    polyc__op_unfold(o);
-    polyc__op_untangle(o);
-    /* the map as written: no vertex on another segment */
-    if (polyc__op_end_gaps(o) >= 1000) {
+    return n;
+}
+/* the map as written: no vertex on another segment (a crossing that the
+ * gaps made proper is untangled, and the gaps looked at again) */
+static int end_gaps(polyc__opt *o)
+{
+    int n = polyc__op_end_gaps(o);
+    if (n >= 1000) {
         polyc__op_untangle(o);
         polyc__op_end_gaps(o);
     }
-    return POLYC_OK;
+    return n;
+}
+/* The polish's merge and removal can make the best map worse: then the best
+ * map comes back, scored afresh. */
+static int keep_best(polyc__opt *o, polyc__op_args *a)
+{
+    if (polyc__bic(o) <= a->best)
+        return 0;
+    if (polyc__store_from_flat(o->s, &o->best) != POLYC_OK) {
+        a->status = polyc__fail(o->ctx, POLYC_ERR_NOMEM, "no room to restore the best map");
+        return 0;
+    }
+    if ((a->status = polyc__rebuild(o)) != POLYC_OK)
+        return 0;
+    o->untangle_mark = o->zip_mark = 0;
+    return 0;
 }
 
-/* One iteration's operators after the noise, in their order; `since`: the
- * stamp after which edits are looked at again (0: all), `climb`: the
- * first climb's. Returns the stamp taken after the first climb. */
+#define ITER POLYC__SEQ_ITERATION
+#define POLISH POLYC__SEQ_POLISH
+#define CLEAN POLYC__SEQ_CLEAN
+#define RESTRUCTURE POLYC__OPF_RESTRUCTURE
+#define ADDS POLYC__OPF_ADDS
+/* THE OPERATOR TABLE: every step of the search's sequences, in the order
+ * they run (letters: paper IV; ours: not in the paper). ITER: one iteration after the noise (F, in
+ * polyc__search); POLISH: the best map once more through merging and vertex
+ * removal, kept if its BIC is no higher (the last edits of the search, cuts
+ * at crossings and zipped stretches, can leave two ends a centimetre apart
+ * that the next iteration would have joined), then the rules the map must
+ * keep whatever its BIC: every data gap split, ends trimmed, no double
+ * cover, no fold doubling a wall, no crossing, no vertex on a segment;
+ * CLEAN: the cleaning round (clean) repeats these while they edit.
+ * A NEW OPERATOR goes here, once: a row at the place in the order where it
+ * runs, with the sequences it is a step of and its flags (its function
+ * declared in opt_state.h, a step above that gives it its arguments). A
+ * step that runs in two sequences at different places, or with other
+ * arguments, has a row for each. */
+static const polyc__op OPS[] = {
+    /* name               op                   run            sequences       flags */
+    {"overlaps",          polyc__op_overlaps,  NULL,          ITER,           RESTRUCTURE}, /* A */
+    {"merge",             polyc__op_merge,     NULL,          ITER | POLISH,  RESTRUCTURE}, /* B */
+    {"split",             polyc__op_split,     NULL,          ITER | CLEAN,   RESTRUCTURE}, /* C */
+    {"remove vertices",   NULL,                remove_since,  ITER | POLISH,  0}, /* G first, */
+    {"keep the best",     NULL,                keep_best,     POLISH,         0},
+    {"split every gap",   split_gaps,          NULL,          POLISH,         0},
+    {"climb",             NULL,                climb_since,   ITER,           0}, /* so that D moves */
+    {"stamp",             NULL,                stamp,         ITER,           0}, /* what is left */
+    {"zigzags",           polyc__op_zigzag,    NULL,          ITER | CLEAN,   0}, /* E */
+    {"corners",           NULL,                corners,       ITER | CLEAN,   0}, /* (ours) */
+    {"remove vertices",   NULL,                remove_marked, ITER,           0}, /* G */
+    {"add vertices",      add_vertices,        NULL,          ITER,           ADDS}, /* G */
+    {"climb",             NULL,                climb_marked,  ITER,           0}, /* D */
+    {"clean",             NULL,                clean,         ITER,           0},
+    {"trim ends",         polyc__op_trim_ends, NULL,          ITER | POLISH,  0}, /* (ours) */
+    {"stamp",             NULL,                stamp,         POLISH,         0},
+    {"zip",               polyc__op_zip,       NULL,          ITER,           RESTRUCTURE}, /* (ours) */
+    {"zip and climb",     NULL,                zip_settled,   POLISH,         0},
+    {"unfold",            polyc__op_unfold,    NULL,          POLISH,         0}, /* (ours) */
+    {"untangle",          polyc__op_untangle,  NULL,          ITER | POLISH,  0}, /* (ours) */
+    {"end gaps",          end_gaps,            NULL,          POLISH,         0}, /* (ours) */
+};
+#undef ITER
+#undef POLISH
+#undef CLEAN
+#undef RESTRUCTURE
+#undef ADDS
+
+int polyc__run_ops(polyc__opt *o, unsigned seq, polyc__op_args *a)
+{
+    unsigned allowed = (o->pol.restructure ? POLYC__OPF_RESTRUCTURE : 0u) |
+                       (o->pol.add_vertices ? POLYC__OPF_ADDS : 0u);
+    allowed &= ~a->skip;
+    int sum = 0;
+    for (size_t i = 0; i < sizeof OPS / sizeof OPS[0] && a->status == POLYC_OK; i++)
+        if ((OPS[i].seq & seq) && (OPS[i].flags & ~allowed) == 0)
+            sum += OPS[i].run ? OPS[i].run(o, a) : OPS[i].op(o);
+    return sum;
+}
+
+/* The best map after the search, polished (POLISH); returns a status (the
+ * store holds the result, scored). */
+static polyc_status polish(polyc__opt *o, float best)
+{
+    polyc__op_args a;
+    memset(&a, 0, sizeof a);
+    a.best = best;
+    a.status = POLYC_OK;
+    o->untangle_mark = o->zip_mark = 0; /* the best map is a fresh store */
+    polyc__run_ops(o, POLYC__SEQ_POLISH, &a);
+    return a.status;
+}
+
 uint32_t polyc__operators(polyc__opt *o, uint32_t since, uint32_t climb)
 {
-    if (o->pol.restructure) {
-        polyc__op_overlaps(o);      /* A */
-        polyc__op_merge(o);         /* B */
-        polyc__op_split(o);         /* C */
-    }
-    polyc__op_remove_vertices(o, since); /* G: fewer vertices first, so that */
-    /* D moves what is left. A single scan's later iterations climb only
-     * what the previous one edited after its first climbs (removals,
-     * zigzags, corners, trims): the vertices those climbs left at an
-     * optimum stay there (on 200 freiburg-campus scans, with ends not
-     * climbed, climbing them again takes a sixth of the time and lowers
-     * the BIC by 0.15 %) */
-    polyc__op_adjust(o, POLYC__ADJUST_ROUNDS, climb);
-    uint32_t first = ++o->touch_stamp, mark = first;
-    polyc__op_zigzag(o);            /* E */
-    polyc__op_corners(o, since);    /* corners (not in the paper) */
-    polyc__op_remove_vertices(o, mark); /* G */
-    if (o->pol.add_vertices)
-        polyc__op_add_vertices(o, POLYC__ADD_ROUNDS); /* G, more vertices */
-    polyc__op_adjust(o, POLYC__ADJUST_ROUNDS, mark);
-    /* moves and additions can leave segments without data or hairpins:
-     * clean them before the model is judged, so the best one is clean */
-    for (int round = 0; round < POLYC__CLEAN_ROUNDS; round++) {
-        mark = ++o->touch_stamp;
-        if ((!o->pol.restructure ? 0 : polyc__op_split(o)) + polyc__op_zigzag(o) +
-                polyc__op_corners(o, since) == 0)
-            break;
-        polyc__op_adjust(o, POLYC__ADJUST_ROUNDS, mark);
-    }
-    polyc__op_trim_ends(o); /* moves could push ends past the data */
-    if (o->pol.restructure)
-        polyc__op_zip(o);   /* one piece of map per wall */
-    polyc__op_untangle(o);  /* last: the map judged has no crossing */
-    return first;
+    polyc__op_args a;
+    memset(&a, 0, sizeof a);
+    a.since = since;
+    a.climb = climb;
+    a.status = POLYC_OK;
+    polyc__run_ops(o, POLYC__SEQ_ITERATION, &a);
+    return a.first;
 }
 
 polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *user)
