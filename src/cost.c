@@ -13,6 +13,12 @@ extern inline float polyc__cost(const polyc__point *p, float ax, float ay, float
 extern inline float polyc__point_cap(const polyc__opt *o, const polyc__point *p);
 extern inline float polyc__cost_seg(const polyc__opt *o, const polyc__point *p, int32_t seg);
 
+float polyc__turn_of(float ax, float ay, float bx, float by, float cx, float cy)
+{
+    float ux = bx - ax, uy = by - ay, wx = cx - bx, wy = cy - by;
+    return polyc__turn_rad(ux * wy - uy * wx, ux * wx + uy * wy);
+}
+
 /* 1 - p(turn at b) for the path a -> b -> c */
 float polyc__turn_cost(const polyc__opt *o, float ax, float ay, float bx, float by, float cx, float cy)
 {

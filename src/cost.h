@@ -46,13 +46,8 @@ inline float polyc__cost_seg(const polyc__opt *o, const polyc__point *p, int32_t
     return polyc__cost(p, a->x, a->y, b->x, b->y);
 }
 
-/* the turn at b, in [0, pi], of the path a -> b -> c */
-static inline float polyc__turn_of(float ax, float ay, float bx, float by, float cx, float cy)
-{
-    float ux = bx - ax, uy = by - ay, wx = cx - bx, wy = cy - by;
-    return polyc__turn_rad(ux * wy - uy * wx, ux * wx + uy * wy);
-}
-
+/* cost.c: the turn at b, in [0, pi], of the path a -> b -> c */
+float polyc__turn_of(float ax, float ay, float bx, float by, float cx, float cy);
 /* cost.c: the angle term of a vertex b on the path a -> b -> c, 1 - p(turn
  * at b); the same at vertex v of the map (open ends: 0) */
 float polyc__turn_cost(const polyc__opt *o, float ax, float ay, float bx, float by, float cx,

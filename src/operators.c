@@ -32,8 +32,7 @@ static float other_dist2(const polyc__opt *o, float x, float y, int32_t v)
     const polyc__hash *h = &o->h;
     float best = 1e30f;
     polyc__near_segs w;
-    for (int32_t sg = polyc__near_segs_first(&w, h, x, y); sg != POLYC__NONE;
-         sg = polyc__near_segs_next(&w)) {
+    POLYC__FOR_NEAR_SEGS(w, h, x, y, sg) {
         if (near_on_line(o, v, sg, 3))
             continue;
         const polyc__vertex *a = &o->s->v[sg], *c = &o->s->v[a->next];
@@ -126,8 +125,7 @@ static int32_t nearest_end(const polyc__opt *o, int32_t e, float lim2)
     float best = lim2;
     float x = s->v[e].x, y = s->v[e].y;
     polyc__near_segs w;
-    for (int32_t sg = polyc__near_segs_first(&w, h, x, y); sg != POLYC__NONE;
-         sg = polyc__near_segs_next(&w)) {
+    POLYC__FOR_NEAR_SEGS(w, h, x, y, sg) {
         int32_t cand[2] = {sg, s->v[sg].next};
         for (int k = 0; k < 2; k++) {
             int32_t f = cand[k];

@@ -349,37 +349,25 @@ inline int polyc__buckets_around(const polyc__hash *h, int32_t bx, int32_t by, i
 /* The segments entered in the 3 x 3 buckets around the bucket of (x, y),
  * bucket by bucket and in each in its list's order (a segment entered in
  * two of them comes twice): the walk of every query near a point (a search
- * radius is at most a bucket). The hash must not change during the walk:
+ * radius is at most a bucket). Two loops, so that the walk costs what the
+ * loops written out did (an iterator function, inlined or not, cost the
+ * embedded online example 1.7 to 2.8 % more instructions at -Os): in the
+ * body, `continue` goes to the next segment, `break` only to the next
+ * bucket (leave the walk with return or goto). The hash must not change
+ * during the walk.
  *     polyc__near_segs w;
- *     for (int32_t sg = polyc__near_segs_first(&w, h, x, y); sg != POLYC__NONE;
- *          sg = polyc__near_segs_next(&w)) ... */
+ *     POLYC__FOR_NEAR_SEGS(w, h, x, y, sg) { ... sg ... } */
 typedef struct polyc__near_segs {
-    const polyc__hash *h;
-    int32_t around[9];
-    int n, i;
-    int32_t e;                     /* the next entry in bucket around[i] */
+    int32_t bx, by, around[9];
+    int n;
 } polyc__near_segs;
-inline int32_t polyc__near_segs_next(polyc__near_segs *w)
-{
-    while (w->e == POLYC__NONE) {
-        if (++w->i >= w->n)
-            return POLYC__NONE;
-        w->e = w->h->seg_head[w->around[w->i]];
-    }
-    int32_t sg = w->h->entries[w->e].seg;
-    w->e = w->h->entries[w->e].next;
-    return sg;
-}
-inline int32_t polyc__near_segs_first(polyc__near_segs *w, const polyc__hash *h, float x, float y)
-{
-    int32_t bx, by;
-    polyc__bucket_xy(h, x, y, &bx, &by);
-    w->h = h;
-    w->n = polyc__buckets_around(h, bx, by, w->around);
-    w->i = -1;
-    w->e = POLYC__NONE;
-    return polyc__near_segs_next(w);
-}
+#define POLYC__FOR_NEAR_SEGS(w, h, x, y, sg)                                                       \
+    for (int w##_b = (polyc__bucket_xy((h), (x), (y), &(w).bx, &(w).by),                           \
+                      (w).n = polyc__buckets_around((h), (w).bx, (w).by, (w).around), 0);           \
+         w##_b < (w).n; w##_b++)                                                                    \
+        for (int32_t w##_e = (h)->seg_head[(w).around[w##_b]], sg = POLYC__NONE;                   \
+             w##_e != POLYC__NONE && ((sg) = (h)->entries[w##_e].seg, 1);                          \
+             w##_e = (h)->entries[w##_e].next)
 /* calls fn(o, user, bucket) for every bucket the segment a-b crosses */
 typedef void (*polyc__bucket_fn)(polyc__opt *o, void *user, int32_t bucket);
 void polyc__segment_buckets(polyc__opt *o, float ax, float ay, float bx, float by,

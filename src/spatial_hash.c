@@ -11,8 +11,6 @@
  * where a caller does not inline them, as at -Os) */
 extern inline int polyc__buckets_around(const polyc__hash *h, int32_t bx, int32_t by, int32_t out[9]);
 extern inline void polyc__bucket_xy(const polyc__hash *h, float x, float y, int32_t *ix, int32_t *iy);
-extern inline int32_t polyc__near_segs_next(polyc__near_segs *w);
-extern inline int32_t polyc__near_segs_first(polyc__near_segs *w, const polyc__hash *h, float x, float y);
 extern inline float polyc__seg_dist2(float px, float py, float ax, float ay, float bx, float by);
 
 #include <math.h>

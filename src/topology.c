@@ -268,16 +268,16 @@ int polyc__op_end_gaps(polyc__opt *o)
         int32_t n = e->prev != POLYC__NONE ? e->prev : e->next;
         int32_t m = inner ? e->next : POLYC__NONE;
         polyc__near_segs w;
-        for (int32_t sg = polyc__near_segs_first(&w, h, e->x, e->y); sg != POLYC__NONE;
-             sg = polyc__near_segs_next(&w)) {
+        POLYC__FOR_NEAR_SEGS(w, h, e->x, e->y, sg) {
             if (polyc__touches(s, sg, v, inner ? POLYC__NONE : n))
                 continue;
             int how = clear_vertex(o, v, n, m, sg);
             if (how) {
                 moved += how == 2 ? 1000 : 1; /* (thousands: crossings made proper) */
-                break; /* (its hash entries moved with it: the walk ends) */
+                goto next; /* (its hash entries moved with it) */
             }
         }
+    next:;
     }
     return moved;
 }

@@ -35,8 +35,7 @@ static int32_t nearest_other(const polyc__opt *o, float x, float y, int32_t a, i
     int32_t best = POLYC__NONE;
     *d2 = 1e30f;
     polyc__near_segs w;
-    for (int32_t sg = polyc__near_segs_first(&w, h, x, y); sg != POLYC__NONE;
-         sg = polyc__near_segs_next(&w)) {
+    POLYC__FOR_NEAR_SEGS(w, h, x, y, sg) {
         if (polyc__touches(s, sg, a, b))
             continue;
         const polyc__vertex *c = &s->v[sg], *d = &s->v[c->next];
