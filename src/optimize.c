@@ -40,7 +40,7 @@ static polyc_status restore_best(polyc__opt *o, polyc_status st)
     return st;
 }
 
-/* ---- the steps that give an operator its arguments, or are no operator ---- */
+/* ---- the steps that are no one operator ---- */
 
 /* every data gap split: a pass cuts one gap a segment */
 static int split_gaps(polyc__opt *o)
@@ -49,31 +49,6 @@ static int split_gaps(polyc__opt *o)
         ;
     return 0;
 }
-static int remove_since(polyc__opt *o, polyc__op_args *a)
-{
-    return polyc__op_remove_vertices(o, a->since);
-}
-static int remove_marked(polyc__opt *o, polyc__op_args *a)
-{
-    return polyc__op_remove_vertices(o, a->mark);
-}
-static int add_vertices(polyc__opt *o)
-{
-    return polyc__op_add_vertices(o, POLYC__ADD_ROUNDS);
-}
-/* A single scan's later iterations climb only what the previous one edited
- * after its first climbs (removals, zigzags, corners, trims): the vertices
- * those climbs left at an optimum stay there (on 200 freiburg-campus scans,
- * with ends not climbed, climbing them again takes a sixth of the time and
- * lowers the BIC by 0.15 %) */
-static int climb_since(polyc__opt *o, polyc__op_args *a)
-{
-    return polyc__op_adjust(o, POLYC__ADJUST_ROUNDS, a->climb);
-}
-static int climb_marked(polyc__opt *o, polyc__op_args *a)
-{
-    return polyc__op_adjust(o, POLYC__ADJUST_ROUNDS, a->mark);
-}
 /* a new touch stamp: the steps after it look at what is edited from here */
 static int stamp(polyc__opt *o, polyc__op_args *a)
 {
@@ -81,10 +56,6 @@ static int stamp(polyc__opt *o, polyc__op_args *a)
     if (a->first == 0)
         a->first = a->mark;
     return 0;
-}
-static int corners(polyc__opt *o, polyc__op_args *a)
-{
-    return polyc__op_corners(o, a->since);
 }
 /* moves and additions can leave segments without data or hairpins: the
  * CLEAN rows clean them, and a climb follows, before the model is judged,
@@ -137,54 +108,75 @@ static int keep_best(polyc__opt *o, polyc__op_args *a)
     return 0;
 }
 
-#define ITER POLYC__SEQ_ITERATION
-#define POLISH POLYC__SEQ_POLISH
-#define CLEAN POLYC__SEQ_CLEAN
-#define RESTRUCTURE POLYC__OPF_RESTRUCTURE
-#define ADDS POLYC__OPF_ADDS
 /* THE OPERATOR TABLE: every step of the search's sequences, in the order
- * they run (letters: paper IV; ours: not in the paper). ITER: one iteration after the noise (F, in
- * polyc__search); POLISH: the best map once more through merging and vertex
- * removal, kept if its BIC is no higher (the last edits of the search, cuts
- * at crossings and zipped stretches, can leave two ends a centimetre apart
- * that the next iteration would have joined), then the rules the map must
- * keep whatever its BIC: every data gap split, ends trimmed, no double
- * cover, no fold doubling a wall, no crossing, no vertex on a segment;
- * CLEAN: the cleaning round (clean) repeats these while they edit.
+ * they run (letters: paper IV; ours: not in the paper). ITER: one
+ * iteration after the noise (F, in polyc__search); POLISH: the best map
+ * once more through merging and vertex removal, kept if its BIC is no
+ * higher (the last edits of the search, cuts at crossings and zipped
+ * stretches, can leave two ends a centimetre apart that the next iteration
+ * would have joined), then the rules the map must keep whatever its BIC:
+ * every data gap split, ends trimmed, no double cover, no fold doubling a
+ * wall, no crossing, no vertex on a segment; CLEAN: the cleaning round
+ * (clean) repeats these while they edit. A single scan's later iterations
+ * climb only what the previous one edited after its first climbs (`climb`;
+ * removals, zigzags, corners, trims): the vertices those climbs left at an
+ * optimum stay there (on 200 freiburg-campus scans, with ends not climbed,
+ * climbing them again takes a sixth of the time and lowers the BIC by
+ * 0.15 %).
  * A NEW OPERATOR goes here, once: a row at the place in the order where it
- * runs, with the sequences it is a step of and its flags (its function
- * declared in opt_state.h, a step above that gives it its arguments). A
- * step that runs in two sequences at different places, or with other
- * arguments, has a row for each. */
-static const polyc__op OPS[] = {
-    /* name               op                   run            sequences       flags */
-    {"overlaps",          polyc__op_overlaps,  NULL,          ITER,           RESTRUCTURE}, /* A */
-    {"merge",             polyc__op_merge,     NULL,          ITER | POLISH,  RESTRUCTURE}, /* B */
-    {"split",             polyc__op_split,     NULL,          ITER | CLEAN,   RESTRUCTURE}, /* C */
-    {"remove vertices",   NULL,                remove_since,  ITER | POLISH,  0}, /* G first, */
-    {"keep the best",     NULL,                keep_best,     POLISH,         0},
-    {"split every gap",   split_gaps,          NULL,          POLISH,         0},
-    {"climb",             NULL,                climb_since,   ITER,           0}, /* so that D moves */
-    {"stamp",             NULL,                stamp,         ITER,           0}, /* what is left */
-    {"zigzags",           polyc__op_zigzag,    NULL,          ITER | CLEAN,   0}, /* E */
-    {"corners",           NULL,                corners,       ITER | CLEAN,   0}, /* (ours) */
-    {"remove vertices",   NULL,                remove_marked, ITER,           0}, /* G */
-    {"add vertices",      add_vertices,        NULL,          ITER,           ADDS}, /* G */
-    {"climb",             NULL,                climb_marked,  ITER,           0}, /* D */
-    {"clean",             NULL,                clean,         ITER,           0},
-    {"trim ends",         polyc__op_trim_ends, NULL,          ITER | POLISH,  0}, /* (ours) */
-    {"stamp",             NULL,                stamp,         POLISH,         0},
-    {"zip",               polyc__op_zip,       NULL,          ITER,           RESTRUCTURE}, /* (ours) */
-    {"zip and climb",     NULL,                zip_settled,   POLISH,         0},
-    {"unfold",            polyc__op_unfold,    NULL,          POLISH,         0}, /* (ours) */
-    {"untangle",          polyc__op_untangle,  NULL,          ITER | POLISH,  0}, /* (ours) */
-    {"end gaps",          end_gaps,            NULL,          POLISH,         0}, /* (ours) */
-};
-#undef ITER
-#undef POLISH
-#undef CLEAN
-#undef RESTRUCTURE
-#undef ADDS
+ * runs, with its name, its call (o: the optimiser, a: the run's
+ * polyc__op_args), the sequences it is a step of and its flags; its
+ * function is declared in opt_state.h. A step that runs in two sequences at
+ * different places, or with other arguments, has a row for each. (Rows,
+ * not function pointers: each step is a direct call, which -Os inlines or
+ * not as it likes, and the stack analysis of `make cross` follows.) */
+#define POLYC__OP_TABLE(X)                                                                       \
+    /* id           name               the call                                 sequences  flags */ \
+    X(OVERLAPS,     "overlaps",        polyc__op_overlaps(o),                   I,        R)  /* A */ \
+    X(MERGE,        "merge",           polyc__op_merge(o),                      I | P,    R)  /* B */ \
+    X(SPLIT,        "split",           polyc__op_split(o),                      I | C,    R)  /* C */ \
+    X(REMOVE,       "remove vertices", polyc__op_remove_vertices(o, a->since),  I | P,    0)  /* G */ \
+    X(KEEP_BEST,    "keep the best",   keep_best(o, a),                         P,        0)          \
+    X(SPLIT_GAPS,   "split every gap", split_gaps(o),                           P,        0)          \
+    X(CLIMB,        "climb",           polyc__op_adjust(o, ADJUST, a->climb),   I,        0)  /* D */ \
+    X(STAMP,        "stamp",           stamp(o, a),                             I,        0)          \
+    X(ZIGZAG,       "zigzags",         polyc__op_zigzag(o),                     I | C,    0)  /* E */ \
+    X(CORNERS,      "corners",         polyc__op_corners(o, a->since),          I | C,    0)  /* ours */ \
+    X(REMOVE_MARK,  "remove vertices", polyc__op_remove_vertices(o, a->mark),   I,        0)  /* G */ \
+    X(ADD,          "add vertices",    polyc__op_add_vertices(o, ADD),          I,        A)  /* G */ \
+    X(CLIMB_MARK,   "climb",           polyc__op_adjust(o, ADJUST, a->mark),    I,        0)  /* D */ \
+    X(CLEAN,        "clean",           clean(o, a),                             I,        0)          \
+    X(TRIM,         "trim ends",       polyc__op_trim_ends(o),                  I | P,    0)  /* ours */ \
+    X(STAMP_POLISH, "stamp",           stamp(o, a),                             P,        0)          \
+    X(ZIP,          "zip",             polyc__op_zip(o),                        I,        R)  /* ours */ \
+    X(ZIP_CLIMB,    "zip and climb",   zip_settled(o, a),                       P,        0)  /* ours */ \
+    X(UNFOLD,       "unfold",          polyc__op_unfold(o),                     P,        0)  /* ours */ \
+    X(UNTANGLE,     "untangle",        polyc__op_untangle(o),                   I | P,    0)  /* ours */ \
+    X(END_GAPS,     "end gaps",        end_gaps(o),                             P,        0)  /* ours */
+
+#define I POLYC__SEQ_ITERATION
+#define P POLYC__SEQ_POLISH
+#define C POLYC__SEQ_CLEAN
+#define R POLYC__OPF_RESTRUCTURE
+#define A POLYC__OPF_ADDS
+#define ADJUST POLYC__ADJUST_ROUNDS
+#define ADD POLYC__ADD_ROUNDS
+#define OP_ID(id, name, call, seq, flags) OP_##id,
+enum { POLYC__OP_TABLE(OP_ID) OP_COUNT };
+#define OP_ROW(id, name, call, seq, flags) {seq, flags},
+static const polyc__op OPS[OP_COUNT] = {POLYC__OP_TABLE(OP_ROW)};
+
+/* The step of row i, with the run's arguments a. */
+static int run_step(polyc__opt *o, polyc__op_args *a, int i)
+{
+#define OP_CASE(id, name, call, seq, flags) \
+    case OP_##id:                           \
+        return call;
+    switch (i) {
+        POLYC__OP_TABLE(OP_CASE)
+    }
+    return 0;
+}
 
 int polyc__run_ops(polyc__opt *o, unsigned seq, polyc__op_args *a)
 {
@@ -194,9 +186,20 @@ int polyc__run_ops(polyc__opt *o, unsigned seq, polyc__op_args *a)
     int sum = 0;
     for (size_t i = 0; i < sizeof OPS / sizeof OPS[0] && a->status == POLYC_OK; i++)
         if ((OPS[i].seq & seq) && (OPS[i].flags & ~allowed) == 0)
-            sum += OPS[i].run ? OPS[i].run(o, a) : OPS[i].op(o);
+            sum += run_step(o, a, (int)i);
     return sum;
 }
+
+#undef I
+#undef P
+#undef C
+#undef R
+#undef A
+#undef ADJUST
+#undef ADD
+#undef OP_ID
+#undef OP_ROW
+#undef OP_CASE
 
 /* The best map after the search, polished (POLISH); returns a status (the
  * store holds the result, scored). */

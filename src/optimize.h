@@ -8,8 +8,8 @@
 #include "opt_state.h"
 
 /* ---- the operator table (optimize.c) ----
- * One table lists every step of the search's operator sequences, in the
- * order they run; each row says which sequences it is a step of (bits
+ * One table (POLYC__OP_TABLE) lists every step of the search's operator
+ * sequences, in the order they run; each row says which sequences it is a step of (bits
  * POLYC__SEQ_*) and when it is skipped (POLYC__OPF_*). A sequence runs the
  * rows that carry its bit, top to bottom. */
 enum {
@@ -31,14 +31,11 @@ typedef struct polyc__op_args {
     float best;        /* the polish: the best map's BIC (o->best holds it) */
     polyc_status status; /* a step that fails sets it, and the run stops */
 } polyc__op_args;
-/* A step: an operator that needs no argument (op), or a function that
- * gives one its arguments (run); returns how much it edited (what the
- * cleaning round sums). */
-typedef int (*polyc__op_fn)(polyc__opt *o, polyc__op_args *a);
+/* A row of the table (optimize.c) as the runs read it: the sequences it is
+ * a step of and its flags (its name and its call stand in the table's
+ * source; the names cost the firmware 250 bytes and nothing reads them). A
+ * step returns how much it edited (what the cleaning round sums). */
 typedef struct polyc__op {
-    const char *name;
-    int (*op)(polyc__opt *o); /* NULL: run */
-    polyc__op_fn run;
     uint8_t seq;   /* POLYC__SEQ_* bits: the sequences it is a step of */
     uint8_t flags; /* POLYC__OPF_*: skipped unless the policy allows */
 } polyc__op;
