@@ -9,19 +9,6 @@
 static const float DIR_X[8] = {1.0f, 0.70710678f, 0.0f, -0.70710678f, -1.0f, -0.70710678f, 0.0f, 0.70710678f};
 static const float DIR_Y[8] = {0.0f, 0.70710678f, 1.0f, 0.70710678f, 0.0f, -0.70710678f, -1.0f, -0.70710678f};
 
-/* the turn at b, in [0, pi], of the path a -> b -> c */
-static float turn_of(float ax, float ay, float bx, float by, float cx, float cy)
-{
-    float ux = bx - ax, uy = by - ay, wx = cx - bx, wy = cy - by;
-    return polyc__turn_rad(ux * wy - uy * wx, ux * wx + uy * wy);
-}
-
-/* 1 - p(turn at b) for the path a -> b -> c */
-float polyc__turn_cost(const polyc__opt *o, float ax, float ay, float bx, float by, float cx, float cy)
-{
-    return 1.0f - (float)polyc__prior_p(&o->prior, bx, by, turn_of(ax, ay, bx, by, cx, cy));
-}
-
 /* The prior at the three vertices whose angles a move of v changes: its
  * neighbours stay put, v's cell is looked up again when it changes. */
 typedef struct angle_places {
@@ -50,14 +37,14 @@ static float local_angles(const polyc__opt *o, angle_places *pl, int32_t v, floa
     if (p != POLYC__NONE && n != POLYC__NONE) {
         if (!polyc__prior_same_place(&o->prior, &pl->at, x, y))
             polyc__prior_at(&o->prior, x, y, &pl->at);
-        sum += 1.0f - (float)polyc__prior_p_at(&pl->at, turn_of(V[p].x, V[p].y, x, y, V[n].x, V[n].y));
+        sum += 1.0f - (float)polyc__prior_p_at(&pl->at, polyc__turn_of(V[p].x, V[p].y, x, y, V[n].x, V[n].y));
     }
     if (p != POLYC__NONE && V[p].prev != POLYC__NONE && V[p].prev != v)
         sum += 1.0f - (float)polyc__prior_p_at(
-                         &pl->prev, turn_of(V[V[p].prev].x, V[V[p].prev].y, V[p].x, V[p].y, x, y));
+                         &pl->prev, polyc__turn_of(V[V[p].prev].x, V[V[p].prev].y, V[p].x, V[p].y, x, y));
     if (n != POLYC__NONE && V[n].next != POLYC__NONE && V[n].next != v)
         sum += 1.0f - (float)polyc__prior_p_at(
-                         &pl->next, turn_of(x, y, V[n].x, V[n].y, V[V[n].next].x, V[V[n].next].y));
+                         &pl->next, polyc__turn_of(x, y, V[n].x, V[n].y, V[V[n].next].x, V[V[n].next].y));
     return sum;
 }
 
@@ -219,15 +206,15 @@ int polyc__op_adjust(polyc__opt *o, int max_rounds, uint32_t since)
 {
     const polyc__store *s = o->s;
     int total = 0;
-    uint32_t stamp = ++o->work_stamp;
+    uint32_t stamp = ++o->climb.work_stamp;
     for (int32_t v = 0; v < s->v_high; v++)
         if (o->v_touch[v] >= since)
-            o->v_work[v] = stamp;
+            o->climb.v_work[v] = stamp;
     for (int r = 0; r < max_rounds; r++) {
-        uint32_t next = ++o->work_stamp;
+        uint32_t next = ++o->climb.work_stamp;
         int moved = 0;
         for (int32_t v = 0; v < s->v_high; v++) {
-            if (o->v_work[v] != stamp || s->v[v].line == POLYC__NONE)
+            if (o->climb.v_work[v] != stamp || s->v[v].line == POLYC__NONE)
                 continue;
             /* a single scan's ends are placed by end trimming (where the
              * end return's beam crosses the end segment's line), so a climb
@@ -241,7 +228,7 @@ int polyc__op_adjust(polyc__opt *o, int max_rounds, uint32_t since)
                 continue;
             moved++;
             if (how == 2 || !o->rays.on)
-                o->v_work[v] = next;
+                o->climb.v_work[v] = next;
             /* a single scan's neighbours are not climbed again for a move:
              * on the 10 slowest freiburg-campus scans four climbs in five
              * come from the first adjustment, and over 200 scans a log the
@@ -253,8 +240,8 @@ int polyc__op_adjust(polyc__opt *o, int max_rounds, uint32_t since)
             if (nb[0] != POLYC__NONE) nb[2] = s->v[nb[0]].prev;
             if (nb[1] != POLYC__NONE) nb[3] = s->v[nb[1]].next;
             for (int k = 0; k < 4; k++)
-                if (nb[k] != POLYC__NONE && o->v_work[nb[k]] != stamp)
-                    o->v_work[nb[k]] = next;
+                if (nb[k] != POLYC__NONE && o->climb.v_work[nb[k]] != stamp)
+                    o->climb.v_work[nb[k]] = next;
         }
         total += moved;
         stamp = next;

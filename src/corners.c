@@ -3,7 +3,7 @@
  * segments (spikes, little steps where two walls meet) replaced by one
  * vertex where the lines of the two segments intersect, when that lowers
  * the BIC. Hill climbing cannot get there: every single step is uphill. */
-#include "optimize.h"
+#include "cost.h"
 
 #include <math.h>
 

@@ -5,7 +5,7 @@
 #ifndef POLYC_COST_H
 #define POLYC_COST_H
 
-#include "optimize.h"
+#include "opt_state.h"
 
 /* Sum of squared distances of a weighted point's endpoints to segment a-b,
  * all of them taken to fall in the region (interior or end) of their mean. */
@@ -45,6 +45,19 @@ inline float polyc__cost_seg(const polyc__opt *o, const polyc__point *p, int32_t
     const polyc__vertex *b = &o->s->v[a->next];
     return polyc__cost(p, a->x, a->y, b->x, b->y);
 }
+
+/* cost.c: the turn at b, in [0, pi], of the path a -> b -> c */
+float polyc__turn_of(float ax, float ay, float bx, float by, float cx, float cy);
+/* cost.c: the angle term of a vertex b on the path a -> b -> c, 1 - p(turn
+ * at b); the same at vertex v of the map (open ends: 0) */
+float polyc__turn_cost(const polyc__opt *o, float ax, float ay, float bx, float by, float cx,
+                        float cy);
+float polyc__vertex_angle_cost(const polyc__opt *o, int32_t v);
+
+/* The nearest segment costing less than `start`, skipping `skip` (NONE
+ * and `start` if there is none). */
+float polyc__nearest_below(const polyc__opt *o, int32_t pi, const int32_t *skip, int n_skip,
+                            float start, int32_t *seg);
 
 /* checks.c, with -DPOLYC_CHECKS: invariants, NULL when they hold, else
  * the first violation (*at: its point, vertex, line or bucket, -1 none) */

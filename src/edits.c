@@ -2,7 +2,7 @@
  * remove and insert a vertex, cut a link, join two ends, reverse a polyline.
  * Takes: the optimiser state. Gives: the edit, with the segments it takes
  * out and puts in recorded in the current change, so the score stays exact. */
-#include "optimize.h"
+#include "opt_state.h"
 
 /* ---- edits ---- */
 

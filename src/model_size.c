@@ -3,7 +3,7 @@
  * removal lowers the BIC (a lazy priority queue: every candidate is
  * re-evaluated before it is applied), and vertices added on the segments
  * with the largest mean squared distance when that lowers the BIC. */
-#include "optimize.h"
+#include "cost.h"
 
 #include <math.h>
 #include <string.h>

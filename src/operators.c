@@ -2,7 +2,7 @@
  * Takes: the optimiser state. Gives: overlapping polyline ends zipped,
  * close ends merged (or a polyline closed), hairpin zigzags removed; all
  * through the edits of edits.c. (C, splitting and trimming, is split.c.) */
-#include "optimize.h"
+#include "cost.h"
 
 #include <float.h>
 #include <math.h>
@@ -31,19 +31,15 @@ static float other_dist2(const polyc__opt *o, float x, float y, int32_t v)
 {
     const polyc__hash *h = &o->h;
     float best = 1e30f;
-    int32_t bx, by, around[9];
-    polyc__bucket_xy(h, x, y, &bx, &by);
-    int n = polyc__buckets_around(h, bx, by, around);
-    for (int i = 0; i < n; i++)
-        for (int32_t e = h->seg_head[around[i]]; e != POLYC__NONE; e = h->entries[e].next) {
-            int32_t sg = h->entries[e].seg;
-            if (near_on_line(o, v, sg, 3))
-                continue;
-            const polyc__vertex *a = &o->s->v[sg], *c = &o->s->v[a->next];
-            float d = polyc__seg_dist2(x, y, a->x, a->y, c->x, c->y);
-            if (d < best)
-                best = d;
-        }
+    polyc__near_segs w;
+    POLYC__FOR_NEAR_SEGS(w, h, x, y, sg) {
+        if (near_on_line(o, v, sg, 3))
+            continue;
+        const polyc__vertex *a = &o->s->v[sg], *c = &o->s->v[a->next];
+        float d = polyc__seg_dist2(x, y, a->x, a->y, c->x, c->y);
+        if (d < best)
+            best = d;
+    }
     return best;
 }
 
@@ -128,27 +124,23 @@ static int32_t nearest_end(const polyc__opt *o, int32_t e, float lim2)
     int32_t best_v = POLYC__NONE;
     float best = lim2;
     float x = s->v[e].x, y = s->v[e].y;
-    int32_t bx, by, around[9];
-    polyc__bucket_xy(h, x, y, &bx, &by);
-    int n = polyc__buckets_around(h, bx, by, around);
-    for (int i = 0; i < n; i++)
-        for (int32_t en = h->seg_head[around[i]]; en != POLYC__NONE; en = h->entries[en].next) {
-            int32_t sg = h->entries[en].seg;
-            int32_t cand[2] = {sg, s->v[sg].next};
-            for (int k = 0; k < 2; k++) {
-                int32_t f = cand[k];
-                const polyc__vertex *fv = &s->v[f];
-                if (f == e || (fv->prev != POLYC__NONE && fv->next != POLYC__NONE))
-                    continue; /* not an open end */
-                if (fv->line == s->v[e].line && s->l[fv->line].count < 3)
-                    continue;
-                float dx = fv->x - x, dy = fv->y - y, d = dx * dx + dy * dy;
-                if (d < best) {
-                    best = d;
-                    best_v = f;
-                }
+    polyc__near_segs w;
+    POLYC__FOR_NEAR_SEGS(w, h, x, y, sg) {
+        int32_t cand[2] = {sg, s->v[sg].next};
+        for (int k = 0; k < 2; k++) {
+            int32_t f = cand[k];
+            const polyc__vertex *fv = &s->v[f];
+            if (f == e || (fv->prev != POLYC__NONE && fv->next != POLYC__NONE))
+                continue; /* not an open end */
+            if (fv->line == s->v[e].line && s->l[fv->line].count < 3)
+                continue;
+            float dx = fv->x - x, dy = fv->y - y, d = dx * dx + dy * dy;
+            if (d < best) {
+                best = d;
+                best_v = f;
             }
         }
+    }
     return best_v;
 }
 
@@ -197,10 +189,10 @@ static float link_delta(polyc__opt *o, int32_t e, int32_t f)
  * search has pulled 18 cm apart on a circle stays open otherwise. */
 int polyc__op_merge(polyc__opt *o)
 {
-    return polyc__op_merge_folds(o, 1);
+    return polyc__op_merge_folds(o, POLYC__HAIRPINS_ALLOWED);
 }
 
-int polyc__op_merge_folds(polyc__opt *o, int folds)
+int polyc__op_merge_folds(polyc__opt *o, polyc__hairpins hairpins)
 {
     polyc__store *s = o->s;
     float lim2 = o->cfg->merge_dist_m * o->cfg->merge_dist_m, bridge2 = 4.0f * lim2;
@@ -217,7 +209,8 @@ int polyc__op_merge_folds(polyc__opt *o, int folds)
             int bridge = f == POLYC__NONE;
             if (bridge)
                 f = nearest_end(o, e, bridge2);
-            if (f == POLYC__NONE || polyc__link_crosses(o, e, f) || (!folds && would_fold(o, e, f)))
+            if (f == POLYC__NONE || polyc__link_crosses(o, e, f) ||
+                (hairpins == POLYC__HAIRPINS_REFUSED && would_fold(o, e, f)))
                 continue; /* (a link through a wall would be cut again) */
             if (bridge && link_delta(o, e, f) >= 0.0f)
                 continue;

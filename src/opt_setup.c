@@ -39,8 +39,9 @@ static int opt_carve(polyc__arena *a, polyc__opt *o, int32_t P, int32_t V, int v
     if (online)
         POLYC__CARVE(ok, a, o->region_pt, P);
     POLYC__CARVE(ok, a, o->split_due, V);
-    POLYC__CARVE(ok, a, o->v_work, V);
+    POLYC__CARVE(ok, a, o->climb.v_work, V);
     POLYC__CARVE(ok, a, o->v_touch, V);
+    /* (the zip's scratch is the size scratch's pair: polyc__sides) */
     return ok && polyc__change_carve(a, &o->chg, V) && polyc__eval_carve(a, &o->ev, P, lsoa_cap) &&
            polyc__split_carve(a, &o->split, P, V) && polyc__size_carve(a, &o->size, V);
 }
@@ -142,7 +143,7 @@ int polyc__opt_carve_online(polyc_ctx *ctx, polyc__arena *a, polyc__opt *o)
     /* no points yet: every bucket empty */
     memset(o->h.pt_start, 0, ((size_t)o->h.bx * (size_t)o->h.by + 1) * sizeof(uint32_t));
     memset(o->acost, 0, (size_t)V * sizeof(float));
-    memset(o->v_work, 0, (size_t)V * sizeof(uint32_t));
+    memset(o->climb.v_work, 0, (size_t)V * sizeof(uint32_t));
     memset(o->v_touch, 0, (size_t)V * sizeof(uint32_t));
     memset(o->seg_in, 0, (size_t)V);
     memset(o->split_due, 0, (size_t)V);
@@ -196,7 +197,7 @@ polyc_status polyc__opt_setup(polyc_ctx *ctx, polyc__opt *o)
     int32_t P = o->d.np > 0 ? o->d.np : 1;
     if (!opt_carve(&ctx->arena, o, P, V, o->d.pt_view != NULL, loc_soa_cap(o->cfg, &ctx->lim), 0))
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the optimiser");
-    memset(o->v_work, 0, (size_t)V * sizeof(uint32_t));
+    memset(o->climb.v_work, 0, (size_t)V * sizeof(uint32_t));
     memset(o->v_touch, 0, (size_t)V * sizeof(uint32_t));
     memset(o->seg_in, 0, (size_t)V);
     memset(o->split_due, 0, (size_t)V);

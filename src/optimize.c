@@ -4,7 +4,7 @@
  * zigzags, noise, vertex count) until `patience` iterations bring no better
  * BIC, or the iteration cap or the caller's progress callback stops it. */
 #include "cost.h"
-#include "online.h"
+#include "optimize.h"
 
 #include <math.h>
 #include <string.h>
@@ -40,86 +40,189 @@ static polyc_status restore_best(polyc__opt *o, polyc_status st)
     return st;
 }
 
-/* The best map once more through merging and vertex removal, kept if its
- * BIC is no higher: the last edits of the search (cuts at crossings,
- * zipped stretches) can leave two ends a centimetre apart that the next
- * iteration would have joined. Then the rules the map must keep whatever
- * its BIC: every data gap split (a pass cuts one gap a segment), ends
- * trimmed, no double cover, no fold doubling a wall (op_unfold), no
- * crossing. Returns a status (the store holds
- * the result, scored). */
-static polyc_status polish(polyc__opt *o, float best)
+/* ---- the steps that are no one operator ---- */
+
+/* every data gap split: a pass cuts one gap a segment */
+static int split_gaps(polyc__opt *o)
 {
-    polyc_status st;
-    o->untangle_mark = o->zip_mark = 0; /* the best map is a fresh store */
-    polyc__op_merge(o);
-    polyc__op_remove_vertices(o, 0);
-    if (polyc__bic(o) > best) {
-        if (polyc__store_from_flat(o->s, &o->best) != POLYC_OK)
-            return polyc__fail(o->ctx, POLYC_ERR_NOMEM, "no room to restore the best map");
-        if ((st = polyc__rebuild(o)) != POLYC_OK)
-            return st;
-        o->untangle_mark = o->zip_mark = 0;
-    }
     for (int k = 0; k < POLYC__POLISH_SPLITS && polyc__op_split(o) > 0; k++)
         ;
-    polyc__op_trim_ends(o);
-    uint32_t mark = ++o->touch_stamp;
-    if (polyc__op_zip(o) > 0) {
-        /* what is left of a zipped pair moves onto the data of both */
-        polyc__op_adjust(o, POLYC__ADJUST_ROUNDS, mark);
+    return 0;
+}
+/* a new touch stamp: the steps after it look at what is edited from here */
+static int stamp(polyc__opt *o, polyc__op_args *a)
+{
+    a->mark = ++o->touch_stamp;
+    if (a->first == 0)
+        a->first = a->mark;
+    return 0;
+}
+/* moves and additions can leave segments without data or hairpins: the
+ * CLEAN rows clean them, and a climb follows, before the model is judged,
+ * so that the best one is clean */
+static int clean(polyc__opt *o, polyc__op_args *a)
+{
+    for (int round = 0; round < POLYC__CLEAN_ROUNDS; round++) {
+        stamp(o, a);
+        if (polyc__run_ops(o, POLYC__SEQ_CLEAN, a) == 0)
+            break;
+        polyc__op_adjust(o, POLYC__ADJUST_ROUNDS, a->mark);
+    }
+    return 0;
+}
+/* the zip; what is left of a zipped pair then moves onto the data of both */
+static int zip_settled(polyc__opt *o, polyc__op_args *a)
+{
+    int n = polyc__op_zip(o);
+    if (n > 0) {
+        polyc__op_adjust(o, POLYC__ADJUST_ROUNDS, a->mark);
         polyc__op_trim_ends(o);
         polyc__op_zip(o);
     }
-    polyc__op_unfold(o);
-    polyc__op_untangle(o);
-    /* the map as written: no vertex on another segment */
-    if (polyc__op_end_gaps(o) >= 1000) {
+    return n;
+}
+/* the map as written: no vertex on another segment (a crossing that the
+ * gaps made proper is untangled, and the gaps looked at again) */
+static int end_gaps(polyc__opt *o)
+{
+    int n = polyc__op_end_gaps(o);
+    if (n >= 1000) {
         polyc__op_untangle(o);
         polyc__op_end_gaps(o);
     }
-    return POLYC_OK;
+    return n;
+}
+/* The polish's merge and removal can make the best map worse: then the best
+ * map comes back, scored afresh. */
+static int keep_best(polyc__opt *o, polyc__op_args *a)
+{
+    if (polyc__bic(o) <= a->best)
+        return 0;
+    if (polyc__store_from_flat(o->s, &o->best) != POLYC_OK) {
+        a->status = polyc__fail(o->ctx, POLYC_ERR_NOMEM, "no room to restore the best map");
+        return 0;
+    }
+    if ((a->status = polyc__rebuild(o)) != POLYC_OK)
+        return 0;
+    o->untangle_mark = o->zip_mark = 0;
+    return 0;
 }
 
-/* One iteration's operators after the noise, in their order; `since`: the
- * stamp after which edits are looked at again (0: all), `climb`: the
- * first climb's. Returns the stamp taken after the first climb. */
+/* THE OPERATOR TABLE: every step of the search's sequences, in the order
+ * they run (letters: paper IV; ours: not in the paper). ITER: one
+ * iteration after the noise (F, in polyc__search); POLISH: the best map
+ * once more through merging and vertex removal, kept if its BIC is no
+ * higher (the last edits of the search, cuts at crossings and zipped
+ * stretches, can leave two ends a centimetre apart that the next iteration
+ * would have joined), then the rules the map must keep whatever its BIC:
+ * every data gap split, ends trimmed, no double cover, no fold doubling a
+ * wall, no crossing, no vertex on a segment; CLEAN: the cleaning round
+ * (clean) repeats these while they edit. A single scan's later iterations
+ * climb only what the previous one edited after its first climbs (`climb`;
+ * removals, zigzags, corners, trims): the vertices those climbs left at an
+ * optimum stay there (on 200 freiburg-campus scans, with ends not climbed,
+ * climbing them again takes a sixth of the time and lowers the BIC by
+ * 0.15 %).
+ * A NEW OPERATOR goes here, once: a row at the place in the order where it
+ * runs, with its name, its call (o: the optimiser, a: the run's
+ * polyc__op_args), the sequences it is a step of and its flags; its
+ * function is declared in opt_state.h. A step that runs in two sequences at
+ * different places, or with other arguments, has a row for each. (Rows,
+ * not function pointers: each step is a direct call, which -Os inlines or
+ * not as it likes, and the stack analysis of `make cross` follows.) */
+#define POLYC__OP_TABLE(X)                                                                       \
+    /* id           name               the call                                 sequences  flags */ \
+    X(OVERLAPS,     "overlaps",        polyc__op_overlaps(o),                   I,        R)  /* A */ \
+    X(MERGE,        "merge",           polyc__op_merge(o),                      I | P,    R)  /* B */ \
+    X(SPLIT,        "split",           polyc__op_split(o),                      I | C,    R)  /* C */ \
+    X(REMOVE,       "remove vertices", polyc__op_remove_vertices(o, a->since),  I | P,    0)  /* G */ \
+    X(KEEP_BEST,    "keep the best",   keep_best(o, a),                         P,        0)          \
+    X(SPLIT_GAPS,   "split every gap", split_gaps(o),                           P,        0)          \
+    X(CLIMB,        "climb",           polyc__op_adjust(o, ADJUST, a->climb),   I,        0)  /* D */ \
+    X(STAMP,        "stamp",           stamp(o, a),                             I,        0)          \
+    X(ZIGZAG,       "zigzags",         polyc__op_zigzag(o),                     I | C,    0)  /* E */ \
+    X(CORNERS,      "corners",         polyc__op_corners(o, a->since),          I | C,    0)  /* ours */ \
+    X(REMOVE_MARK,  "remove vertices", polyc__op_remove_vertices(o, a->mark),   I,        0)  /* G */ \
+    X(ADD,          "add vertices",    polyc__op_add_vertices(o, ADD),          I,        A)  /* G */ \
+    X(CLIMB_MARK,   "climb",           polyc__op_adjust(o, ADJUST, a->mark),    I,        0)  /* D */ \
+    X(CLEAN,        "clean",           clean(o, a),                             I,        0)          \
+    X(TRIM,         "trim ends",       polyc__op_trim_ends(o),                  I | P,    0)  /* ours */ \
+    X(STAMP_POLISH, "stamp",           stamp(o, a),                             P,        0)          \
+    X(ZIP,          "zip",             polyc__op_zip(o),                        I,        R)  /* ours */ \
+    X(ZIP_CLIMB,    "zip and climb",   zip_settled(o, a),                       P,        0)  /* ours */ \
+    X(UNFOLD,       "unfold",          polyc__op_unfold(o),                     P,        0)  /* ours */ \
+    X(UNTANGLE,     "untangle",        polyc__op_untangle(o),                   I | P,    0)  /* ours */ \
+    X(END_GAPS,     "end gaps",        end_gaps(o),                             P,        0)  /* ours */
+
+#define I POLYC__SEQ_ITERATION
+#define P POLYC__SEQ_POLISH
+#define C POLYC__SEQ_CLEAN
+#define R POLYC__OPF_RESTRUCTURE
+#define A POLYC__OPF_ADDS
+#define ADJUST POLYC__ADJUST_ROUNDS
+#define ADD POLYC__ADD_ROUNDS
+#define OP_ID(id, name, call, seq, flags) OP_##id,
+enum { POLYC__OP_TABLE(OP_ID) OP_COUNT };
+#define OP_ROW(id, name, call, seq, flags) {seq, flags},
+static const polyc__op OPS[OP_COUNT] = {POLYC__OP_TABLE(OP_ROW)};
+
+/* The step of row i, with the run's arguments a. */
+static int run_step(polyc__opt *o, polyc__op_args *a, int i)
+{
+#define OP_CASE(id, name, call, seq, flags) \
+    case OP_##id:                           \
+        return call;
+    switch (i) {
+        POLYC__OP_TABLE(OP_CASE)
+    }
+    return 0;
+}
+
+int polyc__run_ops(polyc__opt *o, unsigned seq, polyc__op_args *a)
+{
+    unsigned allowed = (o->pol.restructure ? POLYC__OPF_RESTRUCTURE : 0u) |
+                       (o->pol.add_vertices ? POLYC__OPF_ADDS : 0u);
+    allowed &= ~a->skip;
+    int sum = 0;
+    for (size_t i = 0; i < sizeof OPS / sizeof OPS[0] && a->status == POLYC_OK; i++)
+        if ((OPS[i].seq & seq) && (OPS[i].flags & ~allowed) == 0)
+            sum += run_step(o, a, (int)i);
+    return sum;
+}
+
+#undef I
+#undef P
+#undef C
+#undef R
+#undef A
+#undef ADJUST
+#undef ADD
+#undef OP_ID
+#undef OP_ROW
+#undef OP_CASE
+
+/* The best map after the search, polished (POLISH); returns a status (the
+ * store holds the result, scored). */
+static polyc_status polish(polyc__opt *o, float best)
+{
+    polyc__op_args a;
+    memset(&a, 0, sizeof a);
+    a.best = best;
+    a.status = POLYC_OK;
+    o->untangle_mark = o->zip_mark = 0; /* the best map is a fresh store */
+    polyc__run_ops(o, POLYC__SEQ_POLISH, &a);
+    return a.status;
+}
+
 uint32_t polyc__operators(polyc__opt *o, uint32_t since, uint32_t climb)
 {
-    if (o->pol.restructure) {
-        polyc__op_overlaps(o);      /* A */
-        polyc__op_merge(o);         /* B */
-        polyc__op_split(o);         /* C */
-    }
-    polyc__op_remove_vertices(o, since); /* G: fewer vertices first, so that */
-    /* D moves what is left. A single scan's later iterations climb only
-     * what the previous one edited after its first climbs (removals,
-     * zigzags, corners, trims): the vertices those climbs left at an
-     * optimum stay there (on 200 freiburg-campus scans, with ends not
-     * climbed, climbing them again takes a sixth of the time and lowers
-     * the BIC by 0.15 %) */
-    polyc__op_adjust(o, POLYC__ADJUST_ROUNDS, climb);
-    uint32_t first = ++o->touch_stamp, mark = first;
-    polyc__op_zigzag(o);            /* E */
-    polyc__op_corners(o, since);    /* corners (not in the paper) */
-    polyc__op_remove_vertices(o, mark); /* G */
-    if (o->pol.add_vertices)
-        polyc__op_add_vertices(o, POLYC__ADD_ROUNDS); /* G, more vertices */
-    polyc__op_adjust(o, POLYC__ADJUST_ROUNDS, mark);
-    /* moves and additions can leave segments without data or hairpins:
-     * clean them before the model is judged, so the best one is clean */
-    for (int round = 0; round < POLYC__CLEAN_ROUNDS; round++) {
-        mark = ++o->touch_stamp;
-        if ((!o->pol.restructure ? 0 : polyc__op_split(o)) + polyc__op_zigzag(o) +
-                polyc__op_corners(o, since) == 0)
-            break;
-        polyc__op_adjust(o, POLYC__ADJUST_ROUNDS, mark);
-    }
-    polyc__op_trim_ends(o); /* moves could push ends past the data */
-    if (o->pol.restructure)
-        polyc__op_zip(o);   /* one piece of map per wall */
-    polyc__op_untangle(o);  /* last: the map judged has no crossing */
-    return first;
+    polyc__op_args a;
+    memset(&a, 0, sizeof a);
+    a.since = since;
+    a.climb = climb;
+    a.status = POLYC_OK;
+    polyc__run_ops(o, POLYC__SEQ_ITERATION, &a);
+    return a.first;
 }
 
 polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *user)

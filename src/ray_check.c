@@ -7,7 +7,7 @@
  * bridge a gap that beams passed through, and those beams then meet the map
  * metres short of what they measured; and on a wall seen at a grazing angle
  * a centimetre across the wall is decimetres along the beam. */
-#include "optimize.h"
+#include "opt_state.h"
 
 #include <math.h>
 #include <string.h>

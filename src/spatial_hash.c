@@ -4,7 +4,7 @@
  * path crosses) and the data points lying in it. With buckets at least as
  * wide as the search radius, every segment within reach of a point passes
  * through the 3 x 3 buckets around it. */
-#include "optimize.h"
+#include "opt_state.h"
 #include "walk.h"
 
 /* the external definitions of optimize.h's inline functions (C99: used

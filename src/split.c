@@ -3,7 +3,7 @@
  * ends are pulled back to their last data. Takes: the optimiser state and
  * its split scratch (polyc__split_scratch, carved here). Gives: the cuts
  * and trims, through the edits of edits.c. */
-#include "optimize.h"
+#include "opt_state.h"
 
 #include <math.h>
 #include <string.h>

@@ -9,7 +9,7 @@
  * short just before the crossing, the arm beyond it gone (at an open end
  * that is a trim; inside a polyline it splits it there). (Two pieces of
  * map along one wall are zip.c's.) */
-#include "optimize.h"
+#include "opt_state.h"
 
 #include <math.h>
 
@@ -267,20 +267,16 @@ int polyc__op_end_gaps(polyc__opt *o)
         int inner = e->prev != POLYC__NONE && e->next != POLYC__NONE;
         int32_t n = e->prev != POLYC__NONE ? e->prev : e->next;
         int32_t m = inner ? e->next : POLYC__NONE;
-        int32_t bx, by, around[9];
-        polyc__bucket_xy(h, e->x, e->y, &bx, &by);
-        int nb = polyc__buckets_around(h, bx, by, around);
-        for (int i = 0; i < nb; i++)
-            for (int32_t en = h->seg_head[around[i]]; en != POLYC__NONE; en = h->entries[en].next) {
-                int32_t sg = h->entries[en].seg;
-                if (polyc__touches(s, sg, v, inner ? POLYC__NONE : n))
-                    continue;
-                int how = clear_vertex(o, v, n, m, sg);
-                if (how) {
-                    moved += how == 2 ? 1000 : 1; /* (thousands: crossings made proper) */
-                    goto next; /* (its hash entries moved with it) */
-                }
+        polyc__near_segs w;
+        POLYC__FOR_NEAR_SEGS(w, h, e->x, e->y, sg) {
+            if (polyc__touches(s, sg, v, inner ? POLYC__NONE : n))
+                continue;
+            int how = clear_vertex(o, v, n, m, sg);
+            if (how) {
+                moved += how == 2 ? 1000 : 1; /* (thousands: crossings made proper) */
+                goto next; /* (its hash entries moved with it) */
             }
+        }
     next:;
     }
     return moved;

@@ -1,7 +1,7 @@
-/* trial.h - what the trial evaluation (score.c) and the bounded removal
+/* trial.h - what the trial evaluation (trial.c) and the bounded removal
  * delta (delta.c) share: a segment prepared for many
- * cost queries (the same value as polyc__cost without its divisions), the
- * set of segments an edit takes out, and the nearest segment below a bound. */
+ * cost queries (the same value as polyc__cost without its divisions) and the
+ * set of segments an edit takes out. */
 #ifndef POLYC_TRIAL_H
 #define POLYC_TRIAL_H
 
@@ -69,10 +69,5 @@ inline int polyc__is_old(const polyc__old_set *s, int32_t seg)
         hit |= seg == s->rest[j];
     return hit;
 }
-
-/* The nearest segment costing less than `start`, skipping `skip` (NONE
- * and `start` if there is none); score.c. */
-float polyc__nearest_below(const polyc__opt *o, int32_t pi, const int32_t *skip, int n_skip,
-                            float start, int32_t *seg);
 
 #endif

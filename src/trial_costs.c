@@ -1,13 +1,13 @@
 /* trial_costs.c - the costs of a hill-climbing trial, several points at once.
- * Takes: the points a prepared move lists (copied by field, in double) and one trial
+ * Takes: the points a prepared move lists (copied by field) and one trial
  * segment. Gives: each point's cost on that segment, folded into a running
  * minimum. The loop has no branches, so that the compiler can vectorise it;
  * it is built with -fno-trapping-math (Makefile), without which gcc keeps
- * the comparisons as branches. The same flag on score.c made its branchy
+ * the comparisons as branches. The same flag on trial.c made its branchy
  * per-point code slower (single scans 3 %), hence a file of its own. */
-#include "optimize.h"
+#include "opt_state.h"
 
-/* Each value is the one score.c's seg_cost computes, operation for
+/* Each value is the one trial.h's polyc__seg_pre_cost computes, operation for
  * operation, selected instead of branched to. */
 void polyc__trial_costs_min(const polyc__opt *o, const polyc__seg_pre *q, float *restrict c)
 {

@@ -3,8 +3,9 @@
  * another piece of the map (not its neighbours) for more than ZIP_RUN_M,
  * lose that stretch from one of the two, the one whose loss raises the BIC
  * least, until no such stretch is left. Takes: the optimiser state (and
- * the sides segments are seen from, seg_side). Gives: the zipped map. */
-#include "optimize.h"
+ * the sides segments are seen from, seg_side: sides.c). Gives: the zipped
+ * map. */
+#include "opt_state.h"
 
 #include <math.h>
 
@@ -22,7 +23,6 @@
 #define BAND_END_M 0.15f   /* past the other's end: a 10 cm recess's back is within this of
                              * the wall's ends over 11 cm only (less than ZIP_RUN_M) */
 #define BAND_COS 0.9397f    /* cos 20 degrees */
-#define SIDE_REACH_M 0.10f  /* endpoints this near a segment tell its side */
 
 /* The nearest segment to (x, y) that does not touch a or b (within the
  * 3 x 3 buckets around it: at least the search radius), or NONE; *d2 its
@@ -32,22 +32,19 @@ static int32_t nearest_other(const polyc__opt *o, float x, float y, int32_t a, i
 {
     const polyc__hash *h = &o->h;
     const polyc__store *s = o->s;
-    int32_t bx, by, best = POLYC__NONE, around[9];
+    int32_t best = POLYC__NONE;
     *d2 = 1e30f;
-    polyc__bucket_xy(h, x, y, &bx, &by);
-    int n = polyc__buckets_around(h, bx, by, around);
-    for (int i = 0; i < n; i++)
-        for (int32_t e = h->seg_head[around[i]]; e != POLYC__NONE; e = h->entries[e].next) {
-            int32_t sg = h->entries[e].seg;
-            if (polyc__touches(s, sg, a, b))
-                continue;
-            const polyc__vertex *c = &s->v[sg], *d = &s->v[c->next];
-            float dd = polyc__seg_dist2(x, y, c->x, c->y, d->x, d->y);
-            if (dd < *d2) {
-                *d2 = dd;
-                best = sg;
-            }
+    polyc__near_segs w;
+    POLYC__FOR_NEAR_SEGS(w, h, x, y, sg) {
+        if (polyc__touches(s, sg, a, b))
+            continue;
+        const polyc__vertex *c = &s->v[sg], *d = &s->v[c->next];
+        float dd = polyc__seg_dist2(x, y, c->x, c->y, d->x, d->y);
+        if (dd < *d2) {
+            *d2 = dd;
+            best = sg;
         }
+    }
     return best;
 }
 
@@ -56,47 +53,6 @@ static int covered(const polyc__opt *o, float x, float y, int32_t a, int32_t b, 
 {
     float d2;
     return nearest_other(o, x, y, a, b, &d2) != POLYC__NONE && d2 <= lim2;
-}
-
-/* What each segment is seen from, into seg_side (x, y per vertex): the sum
- * of the vectors to their sensors of the endpoints within SIDE_REACH_M
- * whose nearest segment it is (a point's own cost says how near: its mean
- * squared distance). Along the segment's left normal it gives its side
- * (> 0: seen from the left; as docs/evaluation.md's band15 gives a segment
- * its side). Valid for the segments not edited since zip_mark. */
-void polyc__find_sides(polyc__opt *o, const int32_t *list, int32_t n, float *left, float *right)
-{
-    const polyc__store *s = o->s;
-    float *side = o->seg_side;
-    const float reach2 = (float)SIDE_REACH_M * (float)SIDE_REACH_M;
-    for (int32_t v = 0; v < s->v_high; v++) {
-        side[2 * v] = side[2 * v + 1] = 0.0f;
-        if (left)
-            left[v] = right[v] = 0.0f;
-    }
-    if (!list)
-        n = o->d.np;
-    for (int32_t j = 0; j < n; j++) {
-        int32_t i = list ? list[j] : j;
-        int32_t sg = o->d.pt_seg[i];
-        if (sg == POLYC__NONE || o->d.pt_cost[i] > reach2 * (float)o->d.pts[i].w)
-            continue;
-        float vx = o->d.pt_view[2 * i], vy = o->d.pt_view[2 * i + 1];
-        side[2 * sg] += vx;
-        side[2 * sg + 1] += vy;
-        if (!left)
-            continue;
-        const polyc__vertex *a = &s->v[sg], *b = &s->v[a->next];
-        float dx = b->x - a->x, dy = b->y - a->y, len = sqrtf(dx * dx + dy * dy);
-        float vl = sqrtf(vx * vx + vy * vy);
-        if (!(len > 0.0f) || !(vl > 0.0f))
-            continue;
-        float across = o->d.pts[i].w * (-vx * dy + vy * dx) / (len * vl);
-        if (across > 0.0f)
-            left[sg] += across;
-        else
-            right[sg] -= across;
-    }
 }
 
 /* The unit normal of segment sg towards those who saw it; 0 if unknown
@@ -112,33 +68,6 @@ static int seen_normal(const polyc__opt *o, int32_t sg, float *nx, float *ny)
     *nx = -sign * dy / len;
     *ny = sign * dx / len;
     return 1;
-}
-
-/* A segment is seen from both sides when the endpoints within 10 cm of
- * it whose nearest it is were seen from its left and from its right in at
- * least this ratio (their unit views across it, by weight): a line drawn
- * between the two faces of a thin wall, each face 3 cm off it. Its summed
- * view nearly cancels, and the side rule of explained() left both faces to
- * it: on the sweep's thin walls, one line between the faces for most of a
- * wall's length, core precision 3 times the batch map's (seeds 2 and 6:
- * 7.0 and 6.4 mm; 1.9 and 2.8 mm with the rule, the batch's 2.3 and 2.8).
- * (online_round.c's explained(); and the band rule below) */
-#define TWO_SIDED_RATIO 0.25f
-/* Only segments this long: on short ones (furniture, chair legs seen from
- * all round) the rule traced bits of clutter, orebro's finished map 523 ->
- * 624 polylines, 57 of them under 10 cm long against 23. */
-#define TWO_SIDED_MIN_M 0.5f
-
-/* Whether segment sg is seen from both sides, from the weights of views
- * across it that polyc__find_sides left in o->size.seg_sum (from its left)
- * and o->size.seg_w (from its right), scratch of the operators'. */
-int polyc__two_sided(const polyc__opt *o, int32_t sg)
-{
-    const polyc__vertex *a = &o->s->v[sg], *b = &o->s->v[a->next];
-    float dx = b->x - a->x, dy = b->y - a->y;
-    float l = o->size.seg_sum[sg], r = o->size.seg_w[sg];
-    return dx * dx + dy * dy >= TWO_SIDED_MIN_M * TWO_SIDED_MIN_M && l > 0.0f && r > 0.0f &&
-           polyc__minf(l, r) >= TWO_SIDED_RATIO * polyc__maxf(l, r);
 }
 
 /* Whether segment sg is seen from both sides by the sides the zip found
@@ -449,7 +378,8 @@ static int zip_pass(polyc__opt *o, uint32_t since)
         /* in an online round, from the region's points: from every point
          * each round, the sides took a tenth of freiburg-campus's updates */
         int32_t np = polyc__region_points(o, polyc__in_region);
-        polyc__find_sides(o, np >= 0 ? o->region_pt : NULL, np, o->size.seg_sum, o->size.seg_w);
+        const polyc__side_scratch sd = polyc__sides(o);
+        polyc__find_sides(o, np >= 0 ? o->region_pt : NULL, np, sd.left_w, sd.right_w);
     }
     for (int32_t v = 0; v < s->v_high; v++) {
         for (int k = 0; k < POLYC__FIXES_PER_SEGMENT; k++) {

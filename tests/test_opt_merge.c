@@ -172,20 +172,20 @@ static void test_merge_without_folds(void **state)
     /* from ends 4 cm apart, 10 degrees between the pieces */
     const float a[4] = {0.0f, 0.0f, 1.0f, 0.0f}, b[4] = {0.0f, 0.04f, 0.985f, 0.2137f};
     merge_case(&f, a, b, 2);
-    assert_int_equal(polyc__op_merge_folds(&f.o, 0), 0);
+    assert_int_equal(polyc__op_merge_folds(&f.o, POLYC__HAIRPINS_REFUSED), 0);
     assert_int_equal(live_lines(&f.o), 2);
     assert_int_equal(polyc__op_merge(&f.o), 1);
     assert_int_equal(live_lines(&f.o), 1);
     /* end to end */
     const float c[4] = {-1.0f, 0.0f, -0.05f, 0.0f}, d[4] = {0.05f, 0.0f, 1.0f, 0.0f};
     merge_case(&f, c, d, 2);
-    assert_int_equal(polyc__op_merge_folds(&f.o, 0), 1);
+    assert_int_equal(polyc__op_merge_folds(&f.o, POLYC__HAIRPINS_REFUSED), 1);
     check_books(&f.o, "merge without folds");
     assert_int_equal(live_lines(&f.o), 1);
     /* a corner: 90 degrees */
     const float e[4] = {-1.0f, 0.0f, -0.05f, 0.0f}, g[4] = {0.0f, 0.05f, 0.0f, 1.0f};
     merge_case(&f, e, g, 2);
-    assert_int_equal(polyc__op_merge_folds(&f.o, 0), 1);
+    assert_int_equal(polyc__op_merge_folds(&f.o, POLYC__HAIRPINS_REFUSED), 1);
     assert_int_equal(live_lines(&f.o), 1);
     fx_close(&f);
 }

@@ -1,9 +1,8 @@
-/* score.c - trial evaluation: the nearest segment to a point (below a
- * bound), and a read-only local evaluation of trial edits: the points near
- * the segments an edit would change are listed once with their cost
- * without those segments, and each trial prices only them (trial_costs.c
- * in batches). Takes: the optimiser state. Gives: the change of the error
- * a trial would make, exactly or bounded (removal candidates). */
+/* trial.c - trial evaluation, read-only: the points near the segments an
+ * edit would change are listed once with their cost without those segments
+ * (list_near_points), and each trial prices only them (trial_costs.c in
+ * batches). Takes: the optimiser state. Gives: the error a trial geometry
+ * would make near the edit. */
 #include "trial.h"
 
 #include <math.h>
@@ -37,72 +36,6 @@ int polyc__eval_carve(polyc__arena *a, polyc__eval_scratch *ev, int32_t P, int32
         POLYC__CARVE(ok, a, ev->lsoa_c, lsoa_cap);
     }
     return ok;
-}
-
-/* The nearest segment costing less than `start` (NONE and `start` if there
- * is none). Own bucket first, then the eight around it nearest first, each
- * only if it is nearer than the best cost so far allows: a segment is
- * entered in every bucket it crosses, so one within distance D of the point
- * crosses a bucket within D of it, and its cost is at least w D^2. */
-float polyc__nearest_below(const polyc__opt *o, int32_t pi, const int32_t *skip, int n_skip,
-                            float start, int32_t *seg)
-{
-    static const int8_t ORDER[9][2] = {{0, 0}, {-1, 0}, {1, 0}, {0, -1}, {0, 1},
-                                       {-1, -1}, {1, -1}, {-1, 1}, {1, 1}};
-    const polyc__hash *h = &o->h;
-    const polyc__point *p = &o->d.pts[pi];
-    float best = start, w = (float)p->w;
-    int32_t best_seg = POLYC__NONE;
-    int32_t bx, by;
-    polyc__bucket_xy(h, p->x, p->y, &bx, &by);
-    /* distances to the bucket's four sides (0 if outside that side) */
-    float fx = ((float)p->x - (float)h->origin_x) - (float)bx * (float)h->bucket_m;
-    float fy = ((float)p->y - (float)h->origin_y) - (float)by * (float)h->bucket_m;
-    float side[2][3];
-    side[0][0] = fx > 0.0f ? fx : 0.0f;
-    side[0][1] = 0.0f;
-    side[0][2] = (float)h->bucket_m - fx > 0.0f ? (float)h->bucket_m - fx : 0.0f;
-    side[1][0] = fy > 0.0f ? fy : 0.0f;
-    side[1][1] = 0.0f;
-    side[1][2] = (float)h->bucket_m - fy > 0.0f ? (float)h->bucket_m - fy : 0.0f;
-    float near = side[0][0];
-    for (int k = 1; k < 4; k++) {
-        float g = side[k >> 1][k & 1 ? 2 : 0];
-        near = g < near ? g : near;
-    }
-    for (int k = 0; k < 9; k++) {
-        /* the own bucket done: no neighbour is nearer than its nearest side */
-        if (k == 1 && w * near * near >= best)
-            break;
-        float sx = side[0][ORDER[k][0] + 1], sy = side[1][ORDER[k][1] + 1];
-        if (w * (sx * sx + sy * sy) >= best)
-            continue;
-        int32_t x = bx + ORDER[k][0], y = by + ORDER[k][1];
-        if (x < 0 || x >= h->bx || y < 0 || y >= h->by)
-            continue;
-        for (int32_t e = h->seg_head[y * h->bx + x]; e != POLYC__NONE; e = h->entries[e].next) {
-            int32_t sg = h->entries[e].seg;
-            int skipped = 0;
-            for (int j = 0; j < n_skip; j++)
-                skipped |= skip[j] == sg;
-            if (skipped)
-                continue;
-            float c = polyc__cost_seg(o, p, sg);
-            if (c < best) {
-                best = c;
-                best_seg = sg;
-            }
-        }
-    }
-    if (seg)
-        *seg = best_seg;
-    return best;
-}
-
-float polyc__nearest(const polyc__opt *o, int32_t pi, const int32_t *skip, int n_skip,
-                      int32_t *seg)
-{
-    return polyc__nearest_below(o, pi, skip, n_skip, polyc__point_cap(o, &o->d.pts[pi]), seg);
 }
 
 /* ---- local evaluation (read-only) ---- */
@@ -242,7 +175,7 @@ static float nearest_candidate(const polyc__opt *o, int32_t pi, float start, int
 
 /* The old segments of an edit, for the test every listed point makes: the
  * first two compared directly (a climb has two), the rest in a loop. */
-/* The aggregation of a move (prepare): on when moving the shared end of at
+/* The aggregation of a move (list_near_points): on when moving the shared end of at
  * most two segments; each segment's fixed end. */
 static void agg_begin(polyc__eval_scratch *ev, int move, const float *seg_xy, int n_new, float mx,
                       float my)
@@ -290,17 +223,34 @@ static void copy_listed(polyc__opt *o)
     }
 }
 
-/* Collects the points near the `old` segments and the candidate geometry,
+/* A trial edit as the listing sees it: the `old` segments it replaces, the
+ * candidate geometry (n_new segments, x0 y0 x1 y1 each), how far the
+ * candidates stray from it (0: unknown), and for a move the shared end
+ * (mx, my) that alone differs between candidates. */
+typedef struct trial_edit {
+    const int32_t *old;
+    int n_old;
+    const float *seg_xy;
+    int n_new;
+    float reach;
+    int move;
+    float mx, my;
+} trial_edit;
+
+/* Lists the points near the `old` segments and the candidate geometry,
  * with their cost when the old segments are gone (loc_base, loc_seg). With
  * reach > 0 the candidates stay within `reach` of seg_xy: a point not on an
  * old segment whose cost is below any cost it could get from them never
  * changes, and is summed once into loc_fixed instead of being listed. With
  * `move`, the candidates differ by the position of the shared end (mx, my)
  * only, and the points that stay on one segment are aggregated. */
-static void prepare(polyc__opt *o, const int32_t *old, int n_old, const float *seg_xy, int n_new,
-                    float reach, int move, float mx, float my)
+static void list_near_points(polyc__opt *o, const trial_edit *ed)
 {
     const polyc__hash *h = &o->h;
+    const int32_t *old = ed->old;
+    const float *seg_xy = ed->seg_xy;
+    const int n_old = ed->n_old, n_new = ed->n_new, move = ed->move;
+    const float reach = ed->reach, mx = ed->mx, my = ed->my;
     const polyc__old_set olds = polyc__old_set_of(old, n_old);
     seg_span span[4];
     POLYC_ASSERT(n_new <= 4);
@@ -402,13 +352,15 @@ static void prepare(polyc__opt *o, const int32_t *old, int n_old, const float *s
 void polyc__local_prepare(polyc__opt *o, const int32_t *old, int n_old, const float *seg_xy,
                           int n_new, float reach)
 {
-    prepare(o, old, n_old, seg_xy, n_new, reach, 0, 0.0f, 0.0f);
+    const trial_edit ed = {old, n_old, seg_xy, n_new, reach, 0, 0.0f, 0.0f};
+    list_near_points(o, &ed);
 }
 
 void polyc__local_prepare_move(polyc__opt *o, const int32_t *old, int n_old, const float *seg_xy,
                                int n_new, float reach, float mx, float my)
 {
-    prepare(o, old, n_old, seg_xy, n_new, reach, 1, mx, my);
+    const trial_edit ed = {old, n_old, seg_xy, n_new, reach, 1, mx, my};
+    list_near_points(o, &ed);
 }
 
 float polyc__local_eval(const polyc__opt *o, const float *seg_xy, int n_new)
