@@ -113,18 +113,6 @@ polyc_status polyc_online_limits_for_area(const polyc_config *config, double are
     return POLYC_OK;
 }
 
-/* The grid's records of misses in tiles not stored (grid.c): for four
- * times as many tiles as it stores, and no more than the area holds. On
- * freiburg-campus beams cross 59,893 tiles, 15,405 of them stored; the
- * sweep's halls, seen with a 30 m scanner, spent a pool of twice the
- * tiles (hall seed 6: core precision 10.9 mm against 9.9 with every
- * record it needed), not one of four. */
-static size_t pre_records(uint32_t tile_cap, size_t dir_n)
-{
-    size_t n = 4 * (size_t)tile_cap;
-    return n < dir_n ? n : dir_n;
-}
-
 /* Everything an online context carves, in the block's order, on the block
  * or on the size query's counting arena (nothing is written then); the
  * grid's tiles come last, as beams reach them. ctx->cfg and ctx->lim are set. */
@@ -175,18 +163,9 @@ static int lay_out(polyc_ctx *ctx, polyc__online *on, polyc__arena *a)
     POLYC__CARVE_ZERO(ok, a, on->tile_raw, tile_cap);
     POLYC__CARVE_ZERO(ok, a, on->tile_new, tile_cap);
     POLYC__CARVE_ZERO(ok, a, on->tile_miss, tile_cap);
-    /* the grid's records of misses in tiles not stored: carved here, set in
-     * the grid below (its layout clears the grid) */
-    size_t pre_cap = pre_records(tile_cap, dir_n);
-    uint32_t *pre_of = NULL, *pre_free = NULL;
-    uint16_t *pre_miss = NULL;
-    uint8_t *pre_cells = NULL;
-    POLYC__CARVE_ZERO(ok, a, pre_of, dir_n);
-    POLYC__CARVE_ZERO(ok, a, pre_miss, pre_cap * POLYC__PRE_BLOCKS);
-    POLYC__CARVE_ZERO(ok, a, pre_cells, pre_cap * (POLYC__TILE_CELLS / 2));
-    POLYC__CARVE(ok, a, pre_free, pre_cap);
-    uint32_t *redo_need = NULL;
-    POLYC__CARVE_ZERO(ok, a, redo_need, dir_n / 32 + 1);
+    /* the grid's records of misses in tiles not stored: carved here, handed
+     * to the grid below (its layout clears the grid) */
+    ok = ok && polyc__records_carve(a, &on->rec, tile_cap, dir_n);
     if (!ok)
         return 0;
     saved = ctx->arena;
@@ -196,20 +175,19 @@ static int lay_out(polyc_ctx *ctx, polyc__online *on, polyc__arena *a)
     ctx->arena = saved;
     if (st != POLYC_OK)
         return 0;
-    ctx->grid.pre_of = pre_of;
-    ctx->grid.pre_miss = pre_miss;
-    ctx->grid.pre_cells = pre_cells;
-    ctx->grid.pre_free = pre_free;
-    ctx->grid.pre_cap = (uint32_t)pre_cap;
-    ctx->grid.redo_need = redo_need;
+    ctx->grid.rec = &on->rec;
     /* the tiles, and above them the largest step's scratch */
     size_t scratch = 0;
     for (int step = POLYC__STEP_TRACE; step <= POLYC__STEP_LEARN; step++) {
         polyc__arena c;
         polyc__arena_counting(&c);
         polyc__online_scratch(&c, on, (int32_t)P, (polyc__online_step)step);
-        if (step == POLYC__STEP_TRACE) /* and the trace's walk, which trace.c carves */
-            c.peak = polyc__add(c.peak, polyc__bytes(2 * (size_t)on->cells_cap + 2, sizeof(int32_t)));
+        if (step == POLYC__STEP_TRACE) { /* and the trace's walk, which trace.c carves, or after it
+                                          * the round's flags */
+            size_t walk = polyc__bytes(2 * (size_t)on->cells_cap + 2, sizeof(int32_t));
+            size_t flags = polyc__bytes((size_t)polyc__max_vertices(&ctx->lim), 1);
+            c.peak = polyc__add(c.peak, walk > flags ? walk : flags);
+        }
         scratch = c.peak > scratch ? c.peak : scratch;
     }
     size_t cast = polyc__contour_cast_bytes(dir_n); /* relabel's */
@@ -220,6 +198,7 @@ static int lay_out(polyc_ctx *ctx, polyc__online *on, polyc__arena *a)
     on->fresh_tile = NULL;
     on->fresh_bucket = NULL;
     on->learn_cache = NULL;
+    on->seg_data = NULL;
     a->peak = polyc__add(a->used, polyc__add(polyc__bytes(tile_cap, sizeof(polyc__tile)), scratch));
     return 1;
 }
@@ -243,9 +222,47 @@ int polyc__online_scratch(polyc__arena *a, polyc__online *on, int32_t points, po
     case POLYC__STEP_LEARN:
         POLYC__CARVE(ok, a, on->learn_cache, 3 * (size_t)on->lim.max_scan_beams);
         break;
+    case POLYC__STEP_DATALESS:
+        POLYC__CARVE(ok, a, on->seg_data, (size_t)on->opt.s->v_cap);
+        break;
     }
     return ok;
 }
+
+/* The layer's spacing table (polyc__layer): from the tiles where some pose
+ * was (the poses are not kept);
+ * made again when a pose fell in a new tile, at most once in this many
+ * scans (a pass over the area's tiles: on freiburg-campus's 300 m square,
+ * at every new pose tile, 30 % of the updates' time): meanwhile a new
+ * tile's spacing is measured from the poses before it. */
+#define REMAKE_SCANS 32u
+
+static polyc_status online_spacing(polyc_ctx *ctx, polyc__spacing *sp, size_t n)
+{
+    polyc__online *on = ctx->online;
+    sp->min_step_rad = on->min_step_rad;
+    sp->dist = on->spacing_dist;
+    if (!on->spacing_stale || (!on->spacing_now && on->spacing_scans != 0 &&
+                               on->scans - on->spacing_scans < REMAKE_SCANS))
+        return POLYC_OK;
+    for (size_t i = 0; i < n; i++)
+        sp->dist[i] = (on->pose_bits[i >> 5] >> (i & 31)) & 1u ? 0.0f : 1e30f;
+    polyc__spacing_chamfer(sp);
+    on->spacing_stale = 0;
+    on->spacing_scans = on->scans;
+    return POLYC_OK;
+}
+
+/* The layer's points' scratch (polyc__layer, for polyc__opt_refresh). */
+static int points_scratch(polyc_ctx *ctx, int32_t points)
+{
+    return polyc__online_scratch(&ctx->arena, ctx->online, points, POLYC__STEP_POINTS);
+}
+
+/* What the online layer lends the batch stages it runs on its own data. */
+static const polyc__layer online_layer = {
+    online_spacing, points_scratch, polyc__online_collect, polyc__records_walk, polyc__records_take,
+};
 
 static size_t header_bytes(void)
 {
@@ -291,6 +308,7 @@ polyc_status polyc_online_init(void *block, size_t size, const polyc_config *con
         return st;
     polyc__online *on = (polyc__online *)((unsigned char *)ctx + polyc__bytes(1, sizeof(polyc_ctx)));
     ctx->online = on;
+    ctx->layer = &online_layer;
     on->lim = *limits;
     polyc__online_stage_limits(limits, &ctx->lim);
     polyc__arena a = ctx->arena;
@@ -537,18 +555,6 @@ static int inside_area(const polyc_ctx *ctx, const polyc_scan *s)
     return polyc__frame_inside(ctx, s, 0.5f * polyc__narrow(ctx->online->lim.area_m) - AREA_MARGIN_M);
 }
 
-/* The stored form of a scan (pose relative to the frame). */
-static void store_scan(polyc_ctx *ctx, polyc__scan *d, const polyc_scan *s, uint32_t first)
-{
-    polyc__frame_scan(ctx, s, d);
-    d->start_rad = s->start_angle_rad;
-    d->step_rad = s->angle_step_rad;
-    d->min_m = s->min_range_m;
-    d->max_m = s->max_range_m;
-    d->first = first;
-    d->count = s->beam_count;
-}
-
 /* Kept scan k as the caller gave it, at another pose (frame-free metres). */
 static void moved_scan(const polyc_ctx *ctx, uint32_t k, double x, double y, double theta,
                        polyc_scan *out)
@@ -568,20 +574,14 @@ static void moved_scan(const polyc_ctx *ctx, uint32_t k, double x, double y, dou
 
 polyc_status polyc_online_add_scan(polyc_ctx *ctx, const polyc_scan *s, int keep, uint32_t *scan_id)
 {
-    polyc_status cst = polyc__check_ctx(ctx);
-    if (cst != POLYC_OK || !s)
-        return cst != POLYC_OK ? cst : POLYC_ERR_NULL;
-    ctx->err.msg = NULL;
+    polyc_status cst = polyc__enter(ctx, s != NULL);
+    if (cst != POLYC_OK)
+        return cst;
     polyc__online *on = ctx->online;
     if (!on)
         return polyc__fail(ctx, POLYC_ERR_STATE, "not an online context (polyc_online_init)");
-    if (s->beam_count && !s->range_m)
-        return polyc__fail(ctx, POLYC_ERR_NULL, "scan.range_m is NULL with beams");
-    const char *bad = polyc__scan_problem(s);
-    if (bad) {
-        ctx->err.scan = (int32_t)on->scans;
-        return polyc__fail(ctx, POLYC_ERR_SCAN, bad);
-    }
+    if ((cst = polyc__scan_check(ctx, s, on->scans)) != POLYC_OK)
+        return cst;
     if (s->beam_count > on->lim.max_scan_beams)
         return polyc__fail(ctx, POLYC_ERR_LIMIT, "a scan with more beams than limits.max_scan_beams");
     if (keep && (on->kept_n >= on->lim.keep_scans || s->beam_count > on->lim.keep_beams - on->kept_beams))
@@ -605,20 +605,12 @@ polyc_status polyc_online_add_scan(polyc_ctx *ctx, const polyc_scan *s, int keep
         d = &ctx->scans[1 + on->kept_n];
         first = on->lim.max_scan_beams + on->kept_beams;
     }
-    store_scan(ctx, d, s, first);
-    for (uint32_t i = 0; i < s->beam_count; i++)
-        ctx->ranges[first + i] = s->range_m[i];
+    polyc__take_scan(ctx, d, s, first);
     on->refused = 0;
     polyc_status st = accumulate(ctx, d, on->scans, SCAN_NEW);
     if (on->refused)
         return st; /* (nothing of it stays: not counted, not kept) */
-    for (uint32_t i = 0; i < s->beam_count; i++) {
-        float r = s->range_m[i];
-        if (!(r >= 0.0f))
-            ctx->stats.beams_skipped++;
-        else if (r >= s->min_range_m && r < s->max_range_m)
-            ctx->stats.hits++;
-    }
+    polyc__tally_beams(ctx, s);
     if (keep) {
         on->kept_id[on->kept_n++] = on->scans;
         on->kept_beams += s->beam_count;
@@ -628,7 +620,6 @@ polyc_status polyc_online_add_scan(polyc_ctx *ctx, const polyc_scan *s, int keep
     on->scans++;
     on->pending++;
     ctx->stats.scans = on->scans;
-    ctx->stats.beams += s->beam_count;
     return st;
 }
 
@@ -639,7 +630,7 @@ polyc_status polyc_online_add_scan(polyc_ctx *ctx, const polyc_scan *s, int keep
  *   counts and the cells' sums are cleared and every kept scan counted
  *   again, as a batch build counts them: the tiles of all their hits
  *   wanted first, then one cast each, over the tiles not stored in one
- *   move; the records of those the updates make again after (grid.c).
+ *   move; the records of those the updates make again after (online_grid.c).
  *   Taking each scan out and in again costs two casts a scan (intel: 910
  *   corrections in 288 ms, against 130 counted afresh), and the float sums
  *   come out exact;
@@ -658,10 +649,9 @@ polyc_status polyc_online_add_scan(polyc_ctx *ctx, const polyc_scan *s, int keep
 polyc_status polyc_online_correct(polyc_ctx *ctx, uint32_t scan_id, double pose_x_m,
                                   double pose_y_m, double pose_theta_rad)
 {
-    polyc_status cst = polyc__check_ctx(ctx);
+    polyc_status cst = polyc__enter(ctx, 1);
     if (cst != POLYC_OK)
         return cst;
-    ctx->err.msg = NULL;
     polyc__online *on = ctx->online;
     if (!on)
         return polyc__fail(ctx, POLYC_ERR_STATE, "not an online context (polyc_online_init)");
@@ -705,7 +695,7 @@ static void take_new_pose(polyc_ctx *ctx, uint32_t k)
     const double *p = &on->new_pose[3 * (size_t)k];
     polyc_scan moved;
     moved_scan(ctx, k, p[0], p[1], p[2], &moved);
-    store_scan(ctx, d, &moved, d->first);
+    polyc__store_scan(ctx, d, &moved, d->first);
 }
 
 /* Every kept scan counted afresh (every scan is kept); the records after. */
@@ -716,7 +706,7 @@ static polyc_status count_afresh(polyc_ctx *ctx)
     for (uint32_t k = 0; k < on->kept_n; k++)
         if (is_moved(on, k))
             take_new_pose(ctx, k);
-    polyc__grid_clear_counts(g);
+    polyc__records_clear_counts(g, &on->rec);
     polyc__cells_clear(on, g->tile_count);
     memset(on->tile_new, 0, (size_t)g->tile_count * sizeof *on->tile_new);
     memset(on->tile_miss, 0, (size_t)g->tile_count * sizeof *on->tile_miss);
@@ -725,21 +715,8 @@ static polyc_status count_afresh(polyc_ctx *ctx)
     polyc_status st = POLYC_OK;
     for (uint32_t k = 0; k < on->kept_n && st == POLYC_OK; k++)
         st = accumulate(ctx, &ctx->scans[1 + k], on->kept_id[k], SCAN_RECOUNT);
-    polyc__grid_redo_begin(g);
-    on->redo_next = 0;
-    on->redo_end = on->kept_n;
+    polyc__records_redo_begin(ctx, &on->rec, on->kept_n);
     return st;
-}
-
-void polyc__online_redo_records(polyc_ctx *ctx, uint32_t beams)
-{
-    polyc__online *on = ctx->online;
-    uint32_t done = 0;
-    while (on->redo_next < on->redo_end && done < beams) {
-        const polyc__scan *s = &ctx->scans[1 + on->redo_next++];
-        polyc__grid_redo_scan(ctx, s, on->tile_miss);
-        done += s->count > 0 ? s->count : 1;
-    }
 }
 
 /* Each moved scan out at its old pose and in at its new one. */

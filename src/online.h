@@ -24,6 +24,22 @@ typedef struct polyc__pub {
     uint64_t born, version;        /* the versions that added it and last changed it */
 } polyc__pub;
 
+/* The misses in tiles not stored (online_grid.c): a pool of pre_cap
+ * records, and the redo of the kept scans' misses after a recount. */
+typedef struct polyc__records {
+    uint32_t *pre_of;              /* per directory entry: its record + 1, or 0 */
+    uint16_t *pre_miss;            /* per record: per block, its cells' misses */
+    uint8_t *pre_cells;            /* per record: each cell's, half a byte, up to POLYC__PRE_FULL */
+    uint32_t *pre_free;            /* records given back */
+    uint32_t pre_cap, pre_high, pre_nfree;
+    /* bit per directory entry: the tile was not stored when the counts were
+     * made again without their records (polyc__grid_recount_scan) */
+    uint32_t *redo_need;
+    /* the kept scans redo_next .. redo_end - 1 still to put their misses
+     * back (polyc__online_redo_records) */
+    uint32_t redo_next, redo_end;
+} polyc__records;
+
 typedef struct polyc__online {
     polyc_online_limits lim;
     /* the cells with endpoints (online_cells.c): their sums, and a table
@@ -59,9 +75,7 @@ typedef struct polyc__online {
     uint32_t *moved;               /* bit per kept scan: a correction waits */
     double *new_pose;              /* per kept scan: the waiting pose (x, y, theta) */
     uint32_t moved_n;
-    /* the kept scans redo_next .. redo_end - 1 still to put their misses
-     * back into the records after a recount (grid.c) */
-    uint32_t redo_next, redo_end;
+    polyc__records rec;            /* the grid's records (online_grid.c) */
     /* corrections of every kept scan were applied: the prior and the
      * accuracy are learned again before the next round or scan */
     uint32_t learn_due;
@@ -81,6 +95,7 @@ typedef struct polyc__online {
     uint32_t *fresh_tile;          /* per new point: its tile's directory entry */
     int32_t *fresh_bucket;         /* per new point: its bucket */
     float *learn_cache;
+    uint8_t *seg_data;             /* per segment: a point supports it (drop_dataless) */
     /* per point, its tile's directory entry; per bucket a count or fill
      * position (online_data.c); per stored tile the endpoints its points
      * hold */
@@ -107,7 +122,10 @@ typedef struct polyc__online {
 typedef enum polyc__online_step {
     POLYC__STEP_TRACE,             /* cells (and the trace's own walk) */
     POLYC__STEP_POINTS,            /* pts_tmp, view_tmp, fresh_tile, fresh_bucket */
-    POLYC__STEP_LEARN              /* learn_cache */
+    POLYC__STEP_LEARN,             /* learn_cache */
+    /* seg_data: after the trace, in its walk's room (so counted in
+     * POLYC__STEP_TRACE's) */
+    POLYC__STEP_DATALESS
 } polyc__online_step;
 int polyc__online_scratch(polyc__arena *a, polyc__online *on, int32_t points, polyc__online_step step);
 /* online.c: the context's limits for the stages, from the online limits */
@@ -124,11 +142,29 @@ void polyc__online_backlog_all(polyc_ctx *ctx);
 polyc_status polyc__online_apply_corrections(polyc_ctx *ctx, uint64_t *beams_cast);
 /* the prior and the accuracy learned again from the kept scans, if due */
 void polyc__online_learn_due(polyc_ctx *ctx);
-/* after a recount, the records' misses of the next kept scans put back,
- * until `beams` (> 0) of their beams are done (UINT32_MAX: all) */
+/* online_grid.c: the records carved for a grid of tile_cap tiles and
+ * dir_n directory entries (0: no room) */
+int polyc__records_carve(polyc__arena *a, polyc__records *r, uint32_t tile_cap, size_t dir_n);
+/* the layer's hooks for the grid's count (polyc__layer) */
+int polyc__records_walk(polyc__records *rec, size_t d, struct polyc__walk *w, int64_t miss_key,
+                        int take_back);
+void polyc__records_take(polyc__records *rec, polyc__tile *t, size_t d);
+/* every count to 0, in the stored tiles and in the records, which go back
+ * to the pool; the tiles stay stored (their contour bits too: the caller
+ * casts the contour again) */
+void polyc__records_clear_counts(polyc__grid *g, polyc__records *r);
+/* after every kept scan was counted again without the records: the tiles
+ * not stored now noted, and the kept_n kept scans' misses in them due */
+void polyc__records_redo_begin(polyc_ctx *ctx, polyc__records *r, uint32_t kept_n);
+/* the records' misses of the next kept scans put back (in the tiles
+ * stored since, into their counts, misses on cells with hits tallied in
+ * tile_miss), until `beams` (> 0) of their beams are done (UINT32_MAX: all) */
 void polyc__online_redo_records(polyc_ctx *ctx, uint32_t beams);
 /* the sum of the view vectors of a cell's endpoints (0, 0: none) */
 void polyc__online_cell_view(const polyc_ctx *ctx, int32_t ix, int32_t iy, float *vx, float *vy);
+/* online_data.c: the layer's collect (polyc__layer): every stored tile's
+ * points from the cells' sums, into the points' scratch */
+polyc_status polyc__online_collect(polyc__opt *o, int32_t cap, polyc__points_in *in, int32_t *n_out);
 /* online_data.c: the points of the n taken tiles (the first n of the
  * backlog, marked) made again from the sums */
 polyc_status polyc__online_refresh_tiles(polyc_ctx *ctx, uint32_t n);

@@ -285,18 +285,16 @@ static void stamp_region(polyc_ctx *ctx, uint32_t taken, uint32_t since)
  * people's lines on the sweep's halls (full-map RMS median 22.6 to 9.3 mm)
  * but also walls drawn through bands, whose cells fall under the contour
  * threshold: intel's final BIC 67,795 to 76,137, orebro's 45,582 to 47,449. */
-static void drop_dataless(polyc__opt *o)
+static void drop_dataless(polyc__opt *o, uint8_t *has)
 {
     const polyc__store *s = o->s;
-    float *has = o->size.seg_w;
-    for (int32_t v = 0; v < s->v_high; v++)
-        has[v] = 0.0f;
+    memset(has, 0, (size_t)s->v_high);
     int32_t np = polyc__region_points(o, polyc__in_region);
     float sup2 = (float)o->d.support_m * (float)o->d.support_m;
     for (int32_t j = 0; j < np; j++) {
         int32_t i = o->region_pt[j], sg = o->d.pt_seg[i];
         if (sg != POLYC__NONE && o->d.pt_cost[i] <= sup2 * (float)o->d.pts[i].w)
-            has[sg] = 1.0f;
+            has[sg] = 1;
     }
     for (int32_t l = 0; l < s->l_high; l++) {
         const polyc__line *ln = &s->l[l];
@@ -306,7 +304,7 @@ static void drop_dataless(polyc__opt *o)
         int32_t v = ln->head;
         for (int32_t k = 0; k < ln->count; k++, v = s->v[v].next) {
             in |= o->v_touch[v] >= o->region_since;
-            data |= has[v] != 0.0f;
+            data |= has[v];
         }
         if (!in || data)
             continue;
@@ -404,6 +402,7 @@ polyc_status polyc__online_round(polyc_ctx *ctx, uint64_t work, int all, uint64_
     polyc_status st = round_in(ctx, work, all, spent);
     ctx->arena.used = mark;
     ctx->online->cells = NULL;
+    ctx->online->seg_data = NULL;
     return st;
 }
 
@@ -422,11 +421,7 @@ static polyc_status round_in(polyc_ctx *ctx, uint64_t work, int all, uint64_t *s
     uint32_t n = unexplained_cells(ctx, taken, NEAR_CELLS * ctx->grid.cell_m, all);
     if (n > 0) {
         uint32_t last_id = o->s->last_id;
-        ctx->contour_xy = on->cells;
-        ctx->contour_count = n;
-        st = polyc__trace_more(ctx);
-        ctx->contour_xy = NULL; /* (scratch: an online context keeps no list) */
-        ctx->contour_count = 0;
+        st = polyc__trace_cells(ctx, on->cells, n);
         if (st == POLYC_OK)
             st = polyc__online_add_lines(ctx, last_id);
         if (st != POLYC_OK) { /* the map stays the one before */
@@ -434,12 +429,15 @@ static polyc_status round_in(polyc_ctx *ctx, uint64_t work, int all, uint64_t *s
             return st;
         }
     }
+    /* in the trace's walk's room, given back (polyc__online_scratch) */
+    if (!polyc__online_scratch(&ctx->arena, on, 0, POLYC__STEP_DATALESS))
+        return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the round's scratch");
     stamp_region(ctx, taken, since);
     o->region_since = since;
     uint8_t add = o->pol.add_vertices;
     o->pol.add_vertices = 0;
     polyc__operators(o, since, since);
-    drop_dataless(o);
+    drop_dataless(o, on->seg_data);
     int merged = link_left_ends(o);
     /* the operators' zip came before their crossing repair and the drop of
      * dataless polylines: what those edited, and the pieces of map the ends
@@ -469,10 +467,9 @@ static polyc_status round_in(polyc_ctx *ctx, uint64_t work, int all, uint64_t *s
 
 static polyc_status online_ctx(polyc_ctx *ctx)
 {
-    polyc_status cst = polyc__check_ctx(ctx);
+    polyc_status cst = polyc__enter(ctx, 1);
     if (cst != POLYC_OK)
         return cst;
-    ctx->err.msg = NULL;
     if (!ctx->online)
         return polyc__fail(ctx, POLYC_ERR_STATE, "not an online context (polyc_online_init)");
     if (ctx->online->scans == 0)
