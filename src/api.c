@@ -46,16 +46,11 @@ size_t polyc_memory_size(const polyc_config *config, const polyc_limits *limits)
 polyc_status polyc_init(void *block, size_t size, const polyc_config *config,
                         const polyc_limits *limits, polyc_ctx **out)
 {
-    if (!out)
-        return POLYC_ERR_NULL;
-    *out = NULL;
-    if (!block || !config || !limits)
-        return POLYC_ERR_NULL;
-    if (polyc_config_check(config, NULL) != POLYC_OK)
-        return POLYC_ERR_CONFIG;
     polyc_ctx *ctx;
-    polyc_status st = polyc__place_ctx(block, size, polyc_memory_size(config, limits),
-                                       polyc__bytes(1, sizeof(polyc_ctx)), config, &ctx);
+    polyc_status st = polyc__init_args(block, config, limits, out);
+    if (st == POLYC_OK)
+        st = polyc__place_ctx(block, size, polyc_memory_size(config, limits),
+                              polyc__bytes(1, sizeof(polyc_ctx)), config, &ctx);
     if (st != POLYC_OK)
         return st;
     ctx->lim = *limits;
@@ -126,12 +121,10 @@ polyc_status polyc_add_scan(polyc_ctx *ctx, const polyc_scan *s)
 
 polyc_status polyc_add_grid(polyc_ctx *ctx, const polyc_occupancy_grid *grid)
 {
-    polyc_status cst = polyc__enter(ctx, grid != NULL);
-    if (cst != POLYC_OK)
-        return cst;
-    if (ctx->online)
-        return polyc__fail(ctx, POLYC_ERR_STATE, "an online context: use the polyc_online_* calls");
-    return polyc__occ_add(ctx, grid);
+    polyc_status st = polyc__enter(ctx, grid != NULL);
+    if (st == POLYC_OK && ctx->online)
+        st = polyc__fail(ctx, POLYC_ERR_STATE, "an online context: use the polyc_online_* calls");
+    return st != POLYC_OK ? st : polyc__occ_add(ctx, grid);
 }
 
 /* ---- stages ---- */

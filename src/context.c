@@ -3,7 +3,8 @@
  * (its stored form, its ranges, its beams' tallies) and publishing the
  * store as the result. Takes: the caller's block, context and scans.
  * Gives: the context's header and scan slots filled; api.c (batch) and
- * online.c (online) sit above it and call nothing of each other. */
+ * the online files (online.c, online_scan.c, ...) sit above it, and the
+ * batch files call nothing of the online ones. */
 #include "context.h"
 
 #include <math.h>
@@ -27,6 +28,17 @@ polyc_status polyc__enter(polyc_ctx *ctx, int args_ok)
         return cst != POLYC_OK ? cst : POLYC_ERR_NULL;
     ctx->err.msg = NULL;
     return POLYC_OK;
+}
+
+polyc_status polyc__init_args(const void *block, const polyc_config *config, const void *limits,
+                              polyc_ctx **out)
+{
+    if (!out)
+        return POLYC_ERR_NULL;
+    *out = NULL;
+    if (!block || !config || !limits)
+        return POLYC_ERR_NULL;
+    return polyc_config_check(config, NULL) != POLYC_OK ? POLYC_ERR_CONFIG : POLYC_OK;
 }
 
 polyc_status polyc__place_ctx(void *block, size_t size, size_t need, size_t head,

@@ -81,8 +81,12 @@ struct polyc_ctx {
  * its magic reads POLYC__MAGIC_BUSY and every entry point refuses it with
  * POLYC_ERR_BUSY (context.c, guarded_progress). */
 #define POLYC__MAGIC_BUSY 0x62757379u /* "busy" */
-/* context.c: what every entry point, batch (api.c) or online (online.c),
+/* context.c: what every entry point, batch (api.c) or online (online*.c),
  * does on a context. */
+/* an init's preamble: *out cleared (out not NULL), POLYC_ERR_NULL for a
+ * missing argument, POLYC_ERR_CONFIG for an invalid config */
+polyc_status polyc__init_args(const void *block, const polyc_config *config, const void *limits,
+                              polyc_ctx **out);
 /* Places a context at block's first 16-byte boundary: the first `head`
  * bytes zeroed (the context's header and what follows it), the arena after
  * them; POLYC_ERR_CONFIG when `need` (the size query's) is 0, NOMEM when

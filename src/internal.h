@@ -353,7 +353,7 @@ typedef struct polyc__layer {
  * (the pose and every reflected endpoint, frame shifted by ox, oy) grows
  * box[4] = min x, min y, max x, max y (have: it holds something) */
 int polyc__pose_ok(double x, double y, double th);
-/* api.c: what is wrong with a scan's geometry (a static message), or NULL */
+/* context.c: what is wrong with a scan's geometry (a static message), or NULL */
 const char *polyc__scan_problem(const polyc_scan *s);
 void polyc__extent_add(const polyc_scan *s, double ox, double oy, double *box, int *have);
 

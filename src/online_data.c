@@ -25,7 +25,7 @@ static void move_point(polyc__opt *o, polyc__online *on, uint32_t i, uint32_t k)
 /* The taken tiles are marked TAKEN in dirty_since (online_round.c). */
 static int taken(const polyc__online *on, uint32_t d)
 {
-    return on->dirty_since[d] == UINT32_MAX;
+    return on->backlog.dirty_since[d] == UINT32_MAX;
 }
 
 /* ---- the points made again from the cells' sums ----
@@ -45,10 +45,10 @@ static float sum_tile(const polyc_ctx *ctx, int32_t d, polyc__point *tmp, float 
     for (int idx = 0; idx < POLYC__TILE_CELLS; idx++) {
         if (!t->hits[idx] || !polyc__cell_holds_data(t, idx, ctx->cfg.data_min_m))
             continue;
-        uint32_t e = polyc__cell_find(on, polyc__cell_key(k, idx));
+        uint32_t e = polyc__cell_find(&on->tab, polyc__cell_key(k, idx));
         if (!e)
             continue;
-        const polyc__cell_sums *c = &on->sums[e - 1];
+        const polyc__cell_sums *c = &on->tab.sums[e - 1];
         int32_t ix = idx & (POLYC__TILE_SIDE - 1), iy = idx >> POLYC__TILE_SHIFT;
         int32_t bx = ix & ~(int32_t)(POLYC__BLOCK_SIDE - 1), by = iy & ~(int32_t)(POLYC__BLOCK_SIDE - 1);
         float dx = ((float)(ix - bx) - half) * g->cell_m, dy = ((float)(iy - by) - half) * g->cell_m;
@@ -92,9 +92,9 @@ polyc_status polyc__online_collect(polyc__opt *o, int32_t cap, polyc__points_in 
 {
     polyc_ctx *ctx = o->ctx;
     polyc__online *on = ctx->online;
-    in->pts = on->pts_tmp;
-    in->view = on->view_tmp;
-    in->tag = on->fresh_tile;
+    in->pts = on->scr.pts_tmp;
+    in->view = on->scr.view_tmp;
+    in->tag = on->scr.fresh_tile;
     in->tag_out = on->pt_tile;
     uint32_t n;
     polyc_status st = polyc__blocks_begin(ctx, in->pts, in->view, cap, &n);
@@ -108,11 +108,11 @@ polyc_status polyc__online_collect(polyc__opt *o, int32_t cap, polyc__points_in 
         uint32_t k = g->dir[d] - 1;
         uint32_t end = k + 1 < g->tile_count ? g->tiles[k + 1].mark_base : n;
         for (uint32_t i = g->tiles[k].mark_base; i < end; i++)
-            on->fresh_tile[i] = (uint32_t)d;
-        on->tile_raw[k] = sum_tile(ctx, d, in->pts, in->view);
+            on->scr.fresh_tile[i] = (uint32_t)d;
+        on->backlog.tile_raw[k] = sum_tile(ctx, d, in->pts, in->view);
     }
     polyc__blocks_finish(ctx, in->pts);
-    *n_out = (int32_t)drop_empty(in->pts, in->view, on->fresh_tile, n);
+    *n_out = (int32_t)drop_empty(in->pts, in->view, on->scr.fresh_tile, n);
     return POLYC_OK;
 }
 
@@ -164,10 +164,10 @@ polyc_status polyc__online_refresh_tiles(polyc_ctx *ctx, uint32_t n_taken)
     else
         st = refresh(ctx, n_taken);
     ctx->arena.used = mark;
-    on->pts_tmp = NULL;
-    on->view_tmp = NULL;
-    on->fresh_tile = NULL;
-    on->fresh_bucket = NULL;
+    on->scr.pts_tmp = NULL;
+    on->scr.view_tmp = NULL;
+    on->scr.fresh_tile = NULL;
+    on->scr.fresh_bucket = NULL;
     return st;
 }
 
@@ -185,18 +185,18 @@ static polyc_status refresh(polyc_ctx *ctx, uint32_t n_taken)
     int32_t cap = polyc__points_bound(o->cfg, &ctx->lim);
     const polyc__grid *g = &ctx->grid;
     for (uint32_t j = 0; j < n_taken; j++)
-        if (g->dir[on->dirty[j]]) {
-            o->d.n -= on->tile_raw[g->dir[on->dirty[j]] - 1];
-            on->tile_new[g->dir[on->dirty[j]] - 1] = 0;
-            on->tile_miss[g->dir[on->dirty[j]] - 1] = 0;
+        if (g->dir[on->backlog.dirty[j]]) {
+            o->d.n -= on->backlog.tile_raw[g->dir[on->backlog.dirty[j]] - 1];
+            on->backlog.tile_new[g->dir[on->backlog.dirty[j]] - 1] = 0;
+            on->backlog.tile_miss[g->dir[on->backlog.dirty[j]] - 1] = 0;
         }
-    int32_t nf = points_of_tiles(o, on->dirty, n_taken, on->pts_tmp, on->view_tmp, on->fresh_tile,
-                                 cap, on->tile_raw);
+    int32_t nf = points_of_tiles(o, on->backlog.dirty, n_taken, on->scr.pts_tmp, on->scr.view_tmp, on->scr.fresh_tile,
+                                 cap, on->backlog.tile_raw);
     if (nf < 0)
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "more weighted data points than limits.max_points");
     for (uint32_t j = 0; j < n_taken; j++)
-        if (g->dir[on->dirty[j]])
-            o->d.n += on->tile_raw[g->dir[on->dirty[j]] - 1];
+        if (g->dir[on->backlog.dirty[j]])
+            o->d.n += on->backlog.tile_raw[g->dir[on->backlog.dirty[j]] - 1];
     /* old points of the taken tiles out of the error; the kept ones counted
      * per bucket (nothing moves before the room is known) */
     int32_t nb = h->bx * h->by;
@@ -228,8 +228,8 @@ static polyc_status refresh(polyc_ctx *ctx, uint32_t n_taken)
             move_point(o, on, i, w++);
     memset(h->pt_start, 0, ((size_t)nb + 1) * sizeof(uint32_t));
     for (int32_t j = 0; j < nf; j++) {
-        on->fresh_bucket[j] = polyc__bucket_of(h, on->pts_tmp[j].x, on->pts_tmp[j].y);
-        h->pt_start[on->fresh_bucket[j] + 1]++;
+        on->scr.fresh_bucket[j] = polyc__bucket_of(h, on->scr.pts_tmp[j].x, on->scr.pts_tmp[j].y);
+        h->pt_start[on->scr.fresh_bucket[j] + 1]++;
     }
     for (int32_t b = 0; b < nb; b++)
         h->pt_start[b + 1] += h->pt_start[b] + kept_in[b];
@@ -241,12 +241,12 @@ static polyc_status refresh(polyc_ctx *ctx, uint32_t n_taken)
         kept_in[b] = h->pt_start[b] + n_b; /* where its new points go */
     }
     for (int32_t j = 0; j < nf; j++) {
-        uint32_t k = kept_in[on->fresh_bucket[j]]++;
-        o->d.pts[k] = on->pts_tmp[j];
-        o->d.pt_view[2 * k] = on->view_tmp[2 * j];
-        o->d.pt_view[2 * k + 1] = on->view_tmp[2 * j + 1];
+        uint32_t k = kept_in[on->scr.fresh_bucket[j]]++;
+        o->d.pts[k] = on->scr.pts_tmp[j];
+        o->d.pt_view[2 * k] = on->scr.view_tmp[2 * j];
+        o->d.pt_view[2 * k + 1] = on->scr.view_tmp[2 * j + 1];
         o->d.pt_seg[k] = POLYC__NONE - 1; /* new: assigned below */
-        on->pt_tile[k] = on->fresh_tile[j];
+        on->pt_tile[k] = on->scr.fresh_tile[j];
     }
     o->d.np = kept + nf;
     for (int32_t i = 0; i < o->d.np; i++)

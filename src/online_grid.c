@@ -251,7 +251,7 @@ void polyc__online_redo_records(polyc_ctx *ctx, uint32_t beams)
     uint32_t done = 0;
     while (r->redo_next < r->redo_end && done < beams) {
         const polyc__scan *s = &ctx->scans[1 + r->redo_next++];
-        redo_scan(ctx, r, s, on->tile_miss);
+        redo_scan(ctx, r, s, on->backlog.tile_miss);
         done += s->count > 0 ? s->count : 1;
     }
 }
