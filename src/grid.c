@@ -167,6 +167,25 @@ int polyc__beam_turned(const polyc_ctx *ctx, const polyc__scan *s, uint32_t i, p
     return beam_fill(ctx, s, i, b, 1, rot);
 }
 
+/* The walk's per-beam and per-tile steps out of line, for the records'
+ * redo (online_grid.c): one copy of them in the library (at -Os, walk.h's
+ * inline steps are a copy per file). */
+void polyc__grid_walk_start(struct polyc__walk *w, const polyc__beam *b)
+{
+    polyc__walk_start(w, b);
+}
+
+int64_t polyc__grid_walk_key_at(const struct polyc__walk *w, float t)
+{
+    return polyc__walk_key_at(w, t);
+}
+
+int polyc__grid_walk_skip_tiles(struct polyc__walk *w, int32_t width, int32_t height, int32_t tiles_x,
+                                const uint32_t *stop)
+{
+    return polyc__walk_skip_tiles(w, width, height, tiles_x, stop);
+}
+
 /* Exact traversal of the cells from (sx, sy) to (ex, ey); `visit` gets each
  * cell with the beam parameter t at which the beam enters it. Returns early
  * when visit returns non-zero. */

@@ -492,6 +492,12 @@ int polyc__beam_turned(const polyc_ctx *ctx, const polyc__scan *s, uint32_t i, p
  * and `last` set for the end cell; a non-zero return stops the walk. */
 typedef int (*polyc__cell_fn)(void *u, int32_t ix, int32_t iy, float t_enter, int last);
 void polyc__traverse(const polyc__beam *b, polyc__cell_fn visit, void *u);
+/* walk.h's polyc__walk_start, _key_at and _skip_tiles out of line (grid.c:
+ * one copy in the library for the walks that are not the grid's count) */
+void polyc__grid_walk_start(struct polyc__walk *w, const polyc__beam *b);
+int64_t polyc__grid_walk_key_at(const struct polyc__walk *w, float t);
+int polyc__grid_walk_skip_tiles(struct polyc__walk *w, int32_t width, int32_t height, int32_t tiles_x,
+                                const uint32_t *stop);
 
 /* occupancy.c: the grid and contour stages of an occupancy grid, at once */
 polyc_status polyc__occ_add(polyc_ctx *ctx, const polyc_occupancy_grid *grid);

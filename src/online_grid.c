@@ -181,14 +181,14 @@ static int redo_needs(const polyc__records *r, size_t d)
 static void redo_beam(const polyc__grid *g, polyc__records *r, const polyc__beam *b, uint32_t *on_hits)
 {
     polyc__walk w;
-    polyc__walk_start(&w, b);
-    const int64_t miss_key = polyc__walk_key_at(&w, b->miss_end);
+    polyc__grid_walk_start(&w, b);
+    const int64_t miss_key = polyc__grid_walk_key_at(&w, b->miss_end);
     if (w.n > 0 && !polyc__walk_enter(&w, g->width, g->height))
         return;
     while (w.n > 0) {
         size_t d = polyc__dir_index(g, w.ix, w.iy);
         if (!redo_needs(r, d)) {
-            int to = polyc__walk_skip_tiles(&w, g->width, g->height, g->tiles_x, r->redo_need);
+            int to = polyc__grid_walk_skip_tiles(&w, g->width, g->height, g->tiles_x, r->redo_need);
             if (to < 0)
                 return;
             if (to == 0)
