@@ -287,7 +287,7 @@ void polyc__spacing_chamfer(polyc__spacing *sp);
 float polyc__spacing_at(const polyc__spacing *sp, float x, float y);
 
 
-/* ---- points.c: the weighted points' blocks ----
+/* ---- blocks.c: the weighted points' blocks ----
  * Weighted points gather the endpoints of a block of 2 x 2 grid cells (5 cm
  * at the default grid): a quarter of the points to score, while the moments
  * keep each block's squared distances exact (measured in docs/performance.md). */

@@ -5,8 +5,9 @@
  * that owns it: the cell table (online_cells.c), the poses and the backlog
  * (online_scan.c; the rounds take tiles out: online_round.c), the kept
  * scans and their corrections (online_correct.c), the grid's records
- * (online_grid.c), the scratch (online.c), the optimiser's data
- * (online_data.c), the publications (online_changes.c). */
+ * (online_grid.c), the scratch (online_scratch.c), the optimiser's data
+ * (online_data.c; its points made by online_points.c), the publications
+ * (online_changes.c). */
 #ifndef POLYC_ONLINE_H
 #define POLYC_ONLINE_H
 
@@ -101,9 +102,10 @@ typedef struct polyc__kept {
 } polyc__kept;
 
 /* Scratch, carved above the tiles by the step that needs it and given back
- * after it (polyc__online_scratch, online.c): a round's contour cells and,
- * after the trace, its flags; the points made again and their tiles and
- * buckets; the prior's endpoint cache for one scan. NULL while not carved. */
+ * after it (polyc__online_scratch, online_scratch.c): a round's contour
+ * cells and, after the trace, its flags; the points made again and their
+ * tiles and buckets; the prior's endpoint cache for one scan. NULL while
+ * not carved. */
 typedef struct polyc__online_scratch_area {
     int32_t *cells;
     polyc__point *pts_tmp;
@@ -149,7 +151,7 @@ typedef struct polyc__online {
     int opt_ready;                 /* the optimiser holds the map (0 before the first update) */
 } polyc__online;
 
-/* ---- online.c: sizes, the block's layout, the shared scratch ---- */
+/* ---- online.c: sizes, the block's layout, the layer table ---- */
 /* the contour cells a round may list (limits.max_points + 1) */
 static inline uint32_t polyc__online_cells_cap(const polyc__online *on)
 {
@@ -157,8 +159,8 @@ static inline uint32_t polyc__online_cells_cap(const polyc__online *on)
 }
 /* the context's limits for the stages, from the online limits */
 void polyc__online_stage_limits(const polyc_online_limits *ol, polyc_limits *lim);
-/* the scratch of one step (scr), carved from a (the context's arena above
- * the tiles; the caller gives it back); 0: no room */
+/* online_scratch.c: the scratch of one step (scr), carved from a (the
+ * context's arena above the tiles; the caller gives it back); 0: no room */
 typedef enum polyc__online_step {
     POLYC__STEP_TRACE,             /* cells (and the trace's own walk) */
     POLYC__STEP_POINTS,            /* pts_tmp, view_tmp, fresh_tile, fresh_bucket */
@@ -168,6 +170,8 @@ typedef enum polyc__online_step {
     POLYC__STEP_DATALESS
 } polyc__online_step;
 int polyc__online_scratch(polyc__arena *a, polyc__online *on, int32_t points, polyc__online_step step);
+/* the layer's points' scratch (polyc__layer, for polyc__opt_refresh) */
+int polyc__online_points_scratch(polyc_ctx *ctx, int32_t points);
 
 /* ---- online_scan.c: one scan in (or out) ---- */
 /* how a scan goes into the grid, the sums and the rest */
@@ -229,10 +233,18 @@ void polyc__records_redo_begin(polyc_ctx *ctx, polyc__records *r, uint32_t kept_
  * tile_miss), until `beams` (> 0) of their beams are done (UINT32_MAX: all) */
 void polyc__online_redo_records(polyc_ctx *ctx, uint32_t beams);
 
-/* ---- online_data.c: the optimiser's data and books ---- */
+/* ---- online_points.c: the weighted points from the cells' sums ---- */
 /* the layer's collect (polyc__layer): every stored tile's points from the
  * cells' sums, into the points' scratch */
 polyc_status polyc__online_collect(polyc__opt *o, int32_t cap, polyc__points_in *in, int32_t *n_out);
+/* the sums of the cells of the tile at directory entry d into its marked
+ * blocks' points (tmp, view); returns the endpoints taken */
+float polyc__online_sum_tile(const polyc_ctx *ctx, int32_t d, polyc__point *tmp, float *view);
+/* the points of weight 0 (cells with hits but no sums) out, the others
+ * (and their views and tiles) moved up; returns how many are left */
+uint32_t polyc__online_drop_empty(polyc__point *pts, float *view, uint32_t *tile, uint32_t n);
+
+/* ---- online_data.c: the optimiser's data and books ---- */
 /* the points of the n taken tiles (the first n of the backlog, marked)
  * made again from the sums */
 polyc_status polyc__online_refresh_tiles(polyc_ctx *ctx, uint32_t n);
