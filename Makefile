@@ -94,8 +94,8 @@ unit: $(TEST_BIN) $(BUILD)/polyc
 # CHECK_STEPS, each into build-check/STEP.log: one line per step (the log's
 # tail if it failed), and last a line `N passed, N failed` alone (CI reads it).
 CHECK_STEPS = unit test-checks test-cli test-fuzz-replay test-asan test-cxx test-install \
-              test-python test-embedded test-opt-O3 test-opt-Os test-golden test-valgrind cross target \
-              docs-figures
+              test-python test-embedded test-batch-alone test-opt-O3 test-opt-Os test-golden \
+              test-valgrind cross target docs-figures
 check: deps
 	@mkdir -p build-check; pass=0; fail=0; \
 	for s in $(CHECK_STEPS); do \
@@ -152,7 +152,7 @@ deps:
 # the unit suites with the invariant checkers built in (test-checks), and the
 # tool's bytes across optimisation levels (test-golden)
 test: unit test-checks test-cli test-fuzz-replay test-asan test-cxx test-install test-python \
-      test-embedded test-golden
+      test-embedded test-batch-alone test-golden
 # tests/golden.sh: the tool built at -O0, -O2, -O3 and -Os -flto (in
 # build-golden-*/) writes the same bytes on simulated scenes, examples/office.log
 # and its grid as a ROS map
@@ -214,6 +214,22 @@ $(BUILD)/footprint: examples/footprint.c $(BUILD)/libpolyc.a
 	$(CC) $(WARN) $(OPT) $(CFLAGS) -Iinclude $^ -o $@ $(LDLIBS)
 $(BUILD)/footprint8: examples/footprint.c $(EMB_OBJ)
 	$(CC) $(WARN) $(OPT) $(CFLAGS) -Iinclude $^ -o $@ $(LDLIBS)
+
+# The online mode is a layer above the batch library (src/online*.c): the
+# batch objects build and link without it (the one-scan example, linked
+# against every object but online*.o, maps its room), and no batch file
+# includes an online header but opt_setup.c and optimize.c, which declare
+# the optimiser's online entries there (ONLINE_INCLUDERS).
+BATCH_OBJ = $(filter-out $(BUILD)/obj/online%.o,$(LIB_OBJ))
+ONLINE_INCLUDERS = src/opt_setup.c src/optimize.c
+.PHONY: test-batch-alone
+test-batch-alone: $(BATCH_OBJ)
+	$(CC) $(WARN) $(OPT) $(CFLAGS) -Iinclude examples/embedded_scan.c $(BATCH_OBJ) \
+	    -o $(BUILD)/embedded_scan_batch $(LDLIBS)
+	$(BUILD)/embedded_scan_batch | grep -q '^status ok'
+	@bad=$$(grep -l '#include "online' $(filter-out src/online% $(ONLINE_INCLUDERS),$(wildcard src/*.c src/*.h))); \
+	if [ -n "$$bad" ]; then echo "batch files that include an online header: $$bad"; exit 1; fi
+	@echo "test-batch-alone: the batch library links without src/online*.c"
 
 # Robustness (docs/security.md). test-cli: every bad input of the tool
 # (tests/cli_bad_input.sh), where it writes (tests/cli_output.sh: as root,

@@ -1,12 +1,11 @@
-/* api.c - the public entry points on a context: sizing, context, scans,
- * stage order and results. Takes: the caller's block and scans. Gives: the
+/* api.c - the batch entry points on a context: sizing, context, scans,
+ * stage order and results (what the online entry points share with these
+ * is in context.c). Takes: the caller's block and scans. Gives: the
  * pipeline run stage by stage, each stage restartable from its arena mark. */
 #include "context.h"
 
 #include <math.h>
 #include <string.h>
-
-extern inline polyc_status polyc__fail(polyc_ctx *ctx, polyc_status st, const char *msg);
 
 /* ---- sizing and context ---- */
 
@@ -44,50 +43,14 @@ size_t polyc_memory_size(const polyc_config *config, const polyc_limits *limits)
     return n == SIZE_MAX ? 0 : n;
 }
 
-polyc_status polyc__check_ctx(const polyc_ctx *ctx)
-{
-    if (!ctx)
-        return POLYC_ERR_NULL;
-    if (ctx->magic == POLYC__MAGIC_BUSY)
-        return POLYC_ERR_BUSY;
-    return ctx->magic == POLYC__MAGIC ? POLYC_OK : POLYC_ERR_NULL;
-}
-
-polyc_status polyc__place_ctx(void *block, size_t size, size_t need, size_t head,
-                              const polyc_config *config, polyc_ctx **out)
-{
-    if (need == 0)
-        return POLYC_ERR_CONFIG;
-    if (size < need)
-        return POLYC_ERR_NOMEM;
-    uintptr_t p = ((uintptr_t)block + 15u) & ~(uintptr_t)15u;
-    size_t skew = (size_t)(p - (uintptr_t)block);
-    polyc_ctx *ctx = (polyc_ctx *)p;
-    memset(ctx, 0, head);
-    ctx->magic = POLYC__MAGIC;
-    ctx->cfg = *config;
-    ctx->arena.base = (unsigned char *)p + head;
-    ctx->arena.size = size - skew - head;
-    ctx->frame_dir.cos = 1.0f;
-    ctx->stats.memory_size_bytes = size;
-    ctx->err.scan = -1;
-    *out = ctx;
-    return POLYC_OK;
-}
-
 polyc_status polyc_init(void *block, size_t size, const polyc_config *config,
                         const polyc_limits *limits, polyc_ctx **out)
 {
-    if (!out)
-        return POLYC_ERR_NULL;
-    *out = NULL;
-    if (!block || !config || !limits)
-        return POLYC_ERR_NULL;
-    if (polyc_config_check(config, NULL) != POLYC_OK)
-        return POLYC_ERR_CONFIG;
     polyc_ctx *ctx;
-    polyc_status st = polyc__place_ctx(block, size, polyc_memory_size(config, limits),
-                                       polyc__bytes(1, sizeof(polyc_ctx)), config, &ctx);
+    polyc_status st = polyc__init_args(block, config, limits, out);
+    if (st == POLYC_OK)
+        st = polyc__place_ctx(block, size, polyc_memory_size(config, limits),
+                              polyc__bytes(1, sizeof(polyc_ctx)), config, &ctx);
     if (st != POLYC_OK)
         return st;
     ctx->lim = *limits;
@@ -124,61 +87,25 @@ polyc_status polyc_reset(polyc_ctx *ctx)
     return POLYC_OK;
 }
 
-const char *polyc__scan_problem(const polyc_scan *s)
-{
-    if (!polyc__pose_ok(s->pose_x_m, s->pose_y_m, s->pose_theta_rad))
-        return "scan pose is not finite, beyond 1e7 m or turned beyond 1e4 rad";
-    if (!isfinite(s->start_angle_rad) || !isfinite(s->angle_step_rad) ||
-        fabsf(s->angle_step_rad) > 6.2832f || fabsf(s->start_angle_rad) > 100.0f)
-        return "scan angles are not finite or out of range";
-    if (s->beam_count > 1 && s->angle_step_rad == 0.0f)
-        return "scan angle_step_rad is 0";
-    if (!(s->min_range_m >= 0.0f) || !(s->max_range_m > s->min_range_m))
-        return "scan range interval is empty or negative";
-    if (s->reserved != 0)
-        return "scan.reserved must be 0";
-    return NULL;
-}
-
 polyc_status polyc_add_scan(polyc_ctx *ctx, const polyc_scan *s)
 {
-    polyc_status cst = polyc__check_ctx(ctx);
-    if (cst != POLYC_OK || !s)
-        return cst != POLYC_OK ? cst : POLYC_ERR_NULL;
-    ctx->err.msg = NULL;
+    polyc_status st = polyc__enter(ctx, s != NULL);
+    if (st != POLYC_OK)
+        return st;
     if (ctx->from_grid)
         return polyc__fail(ctx, POLYC_ERR_STATE,
                            "the context holds a grid: scans need a context of their own");
     if (ctx->online)
         return polyc__fail(ctx, POLYC_ERR_STATE, "an online context takes scans by polyc_online_add_scan");
-    if (s->beam_count && !s->range_m)
-        return polyc__fail(ctx, POLYC_ERR_NULL, "scan.range_m is NULL with beams");
-    const char *bad = polyc__scan_problem(s);
-    if (bad) {
-        ctx->err.scan = (int32_t)ctx->scan_count;
-        return polyc__fail(ctx, POLYC_ERR_SCAN, bad);
-    }
+    if ((st = polyc__scan_check(ctx, s, ctx->scan_count)) != POLYC_OK)
+        return st;
     if (ctx->scan_count >= ctx->lim.max_scans ||
         s->beam_count > ctx->lim.max_beams - ctx->range_count)
         return polyc__fail(ctx, POLYC_ERR_LIMIT, "more scans or beams than the limits allow");
     if (!ctx->have_frame)
         polyc__frame_set(ctx, s->pose_x_m, s->pose_y_m);
-    polyc__scan *d = &ctx->scans[ctx->scan_count];
-    polyc__frame_scan(ctx, s, d);
-    d->start_rad = s->start_angle_rad;
-    d->step_rad = s->angle_step_rad;
-    d->min_m = s->min_range_m;
-    d->max_m = s->max_range_m;
-    d->first = ctx->range_count;
-    d->count = s->beam_count;
-    for (uint32_t i = 0; i < s->beam_count; i++) {
-        float r = s->range_m[i];
-        if (!(r >= 0.0f)) /* NaN or negative: kept, skipped by every pass */
-            ctx->stats.beams_skipped++;
-        else if (r >= s->min_range_m && r < s->max_range_m)
-            ctx->stats.hits++;
-        ctx->ranges[ctx->range_count + i] = r;
-    }
+    polyc__take_scan(ctx, &ctx->scans[ctx->scan_count], s, ctx->range_count);
+    polyc__tally_beams(ctx, s);
     double box[4] = {ctx->ext.min_x, ctx->ext.min_y, ctx->ext.max_x, ctx->ext.max_y};
     polyc__extent_add(s, ctx->frame_x, ctx->frame_y, box, &ctx->ext.have);
     ctx->ext.min_x = box[0];
@@ -188,20 +115,16 @@ polyc_status polyc_add_scan(polyc_ctx *ctx, const polyc_scan *s)
     ctx->range_count += s->beam_count;
     ctx->scan_count++;
     ctx->stats.scans = ctx->scan_count;
-    ctx->stats.beams += s->beam_count;
     ctx->stage = POLYC__STAGE_SCANS;
     return POLYC_OK;
 }
 
 polyc_status polyc_add_grid(polyc_ctx *ctx, const polyc_occupancy_grid *grid)
 {
-    polyc_status cst = polyc__check_ctx(ctx);
-    if (cst != POLYC_OK || !grid)
-        return cst != POLYC_OK ? cst : POLYC_ERR_NULL;
-    ctx->err.msg = NULL;
-    if (ctx->online)
-        return polyc__fail(ctx, POLYC_ERR_STATE, "an online context: use the polyc_online_* calls");
-    return polyc__occ_add(ctx, grid);
+    polyc_status st = polyc__enter(ctx, grid != NULL);
+    if (st == POLYC_OK && ctx->online)
+        st = polyc__fail(ctx, POLYC_ERR_STATE, "an online context: use the polyc_online_* calls");
+    return st != POLYC_OK ? st : polyc__occ_add(ctx, grid);
 }
 
 /* ---- stages ---- */
@@ -246,16 +169,6 @@ static polyc_status stage_contour(polyc_ctx *ctx)
     polyc_status st = polyc__contour_build(ctx);
     ctx->contour_mark = ctx->arena.used;
     return st;
-}
-
-/* The result form, in the frame of the input poses (an occupancy grid's
- * map frame: its origin pose applied). */
-void polyc__export_result(polyc_ctx *ctx)
-{
-    polyc__flat_from_store(&ctx->flat, &ctx->store);
-    polyc__frame_export(ctx);
-    ctx->stats.polylines = ctx->flat.count;
-    ctx->stats.vertices = ctx->flat.points;
 }
 
 static polyc_status stage_trace(polyc_ctx *ctx)
@@ -312,10 +225,9 @@ static polyc_status need_stage(polyc_ctx *ctx, polyc__stage want)
  * then run up to `want`. */
 static polyc_status redo_stage(polyc_ctx *ctx, polyc__stage from, polyc__stage want)
 {
-    polyc_status cst = polyc__check_ctx(ctx);
+    polyc_status cst = polyc__enter(ctx, 1);
     if (cst != POLYC_OK)
         return cst;
-    ctx->err.msg = NULL;
     if (ctx->online) /* before the stage moves: the map stays readable */
         return polyc__fail(ctx, POLYC_ERR_STATE, "an online context: use the polyc_online_* calls");
     if (ctx->from_grid && from < POLYC__STAGE_CONTOUR)
@@ -340,24 +252,11 @@ polyc_status polyc_trace(polyc_ctx *ctx)
     return redo_stage(ctx, POLYC__STAGE_CONTOUR, POLYC__STAGE_TRACE);
 }
 
-/* The caller's callback, with the context marked busy while it runs: a
- * call back into the library on it is refused (POLYC_ERR_BUSY) instead of
- * changing the model under the optimiser. */
-int polyc__guarded_progress(void *user, const polyc_iteration *it)
-{
-    polyc__guarded *g = (polyc__guarded *)user;
-    g->ctx->magic = POLYC__MAGIC_BUSY;
-    int stop = g->progress(g->user, it);
-    g->ctx->magic = POLYC__MAGIC;
-    return stop;
-}
-
 polyc_status polyc_optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *user)
 {
-    polyc_status cst = polyc__check_ctx(ctx);
+    polyc_status cst = polyc__enter(ctx, 1);
     if (cst != POLYC_OK)
         return cst;
-    ctx->err.msg = NULL;
     polyc_status st = need_stage(ctx, POLYC__STAGE_TRACE);
     if (st != POLYC_OK)
         return st;
@@ -377,10 +276,9 @@ polyc_status polyc_optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *us
 
 polyc_status polyc_build(polyc_ctx *ctx, polyc_progress_fn progress, void *user)
 {
-    polyc_status cst = polyc__check_ctx(ctx);
+    polyc_status cst = polyc__enter(ctx, 1);
     if (cst != POLYC_OK)
         return cst;
-    ctx->err.msg = NULL;
     polyc_status st = need_stage(ctx, POLYC__STAGE_TRACE);
     if (st != POLYC_OK || ctx->cfg.max_iterations == 0)
         return st;
@@ -389,10 +287,9 @@ polyc_status polyc_build(polyc_ctx *ctx, polyc_progress_fn progress, void *user)
 
 polyc_status polyc_score(polyc_ctx *ctx, double *bic, double *err)
 {
-    polyc_status cst = polyc__check_ctx(ctx);
+    polyc_status cst = polyc__enter(ctx, 1);
     if (cst != POLYC_OK)
         return cst;
-    ctx->err.msg = NULL;
     if (ctx->online)
         return polyc__fail(ctx, POLYC_ERR_STATE, "an online context: use the polyc_online_* calls");
     if (ctx->stage < POLYC__STAGE_TRACE)

@@ -73,30 +73,49 @@ struct polyc_ctx {
 
     polyc_stats stats;
     struct polyc__online *online;  /* online.h; NULL for a batch context */
+    const polyc__layer *layer;     /* its hooks into the batch stages (NULL: none) */
 };
 
 #define POLYC__MAGIC 0x706f6c79u   /* "poly" */
 /* While the progress callback runs, the context is lent to the optimiser:
  * its magic reads POLYC__MAGIC_BUSY and every entry point refuses it with
- * POLYC_ERR_BUSY (api.c, guarded_progress). */
+ * POLYC_ERR_BUSY (context.c, guarded_progress). */
 #define POLYC__MAGIC_BUSY 0x62757379u /* "busy" */
+/* context.c: what every entry point, batch (api.c) or online (online*.c),
+ * does on a context. */
+/* an init's preamble: *out cleared (out not NULL), POLYC_ERR_NULL for a
+ * missing argument, POLYC_ERR_CONFIG for an invalid config */
+polyc_status polyc__init_args(const void *block, const polyc_config *config, const void *limits,
+                              polyc_ctx **out);
 /* Places a context at block's first 16-byte boundary: the first `head`
  * bytes zeroed (the context's header and what follows it), the arena after
  * them; POLYC_ERR_CONFIG when `need` (the size query's) is 0, NOMEM when
- * size is under it (api.c) */
+ * size is under it */
 polyc_status polyc__place_ctx(void *block, size_t size, size_t need, size_t head,
                               const polyc_config *config, polyc_ctx **out);
-/* the caller's progress callback, called with the context lent (api.c) */
+/* POLYC_OK for a context an entry point may use */
+polyc_status polyc__check_ctx(const polyc_ctx *ctx);
+/* an entry point's preamble: the context checked, POLYC_ERR_NULL unless
+ * args_ok (its pointer arguments), the last call's error cleared */
+polyc_status polyc__enter(polyc_ctx *ctx, int args_ok);
+/* a scan's ranges and geometry checked (POLYC_ERR_NULL, POLYC_ERR_SCAN
+ * with err.scan = number) */
+polyc_status polyc__scan_check(polyc_ctx *ctx, const polyc_scan *s, uint32_t number);
+/* the stored form of a scan in d (pose relative to the frame), its ranges
+ * at ctx->ranges + first; take: with its ranges copied there */
+void polyc__store_scan(polyc_ctx *ctx, polyc__scan *d, const polyc_scan *s, uint32_t first);
+void polyc__take_scan(polyc_ctx *ctx, polyc__scan *d, const polyc_scan *s, uint32_t first);
+/* its beams into the statistics (beams, hits, skipped) */
+void polyc__tally_beams(polyc_ctx *ctx, const polyc_scan *s);
+/* the caller's progress callback, called with the context lent */
 typedef struct polyc__guarded {
     polyc_ctx *ctx;
     polyc_progress_fn progress;
     void *user;
 } polyc__guarded;
 int polyc__guarded_progress(void *user, const polyc_iteration *it);
-/* the store as the published result, in the input's frame (api.c) */
+/* the store as the published result, in the input's frame */
 void polyc__export_result(polyc_ctx *ctx);
-/* POLYC_OK for a context an entry point may use (api.c) */
-polyc_status polyc__check_ctx(const polyc_ctx *ctx);
 
 /* The kind of input, decided here once: an occupancy grid, a single scan
  * (mapped from its beam order, scan_chains.c, and checked against its
@@ -118,7 +137,7 @@ static inline polyc__input polyc__input_kind(const polyc_ctx *ctx)
 }
 
 /* errors: keep the first message of an operation (C99 inline: its external
- * definition is in api.c) */
+ * definition is in context.c) */
 inline polyc_status polyc__fail(polyc_ctx *ctx, polyc_status st, const char *msg)
 {
     if (ctx && !ctx->err.msg)

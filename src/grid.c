@@ -7,25 +7,6 @@
 #include <math.h>
 #include <string.h>
 
-/* A cell's two counters saturate by halving both, which keeps m = h/(h+m). */
-static void count_inc(polyc__count *a, polyc__count *b)
-{
-    if (*a == POLYC__COUNT_MAX) {
-        *a = (polyc__count)(*a >> 1);
-        *b = (polyc__count)(*b >> 1);
-    }
-    (*a)++;
-}
-
-/* A scan taken back (an online pose correction): exact unless the cell
- * saturated since, then never below 0. */
-static void count_dec(polyc__count *a, polyc__count *b)
-{
-    (void)b;
-    if (*a > 0)
-        (*a)--;
-}
-
 /* bytes of the bit per directory entry that says a tile is wanted */
 static size_t wanted_bytes(size_t dir_n)
 {
@@ -63,18 +44,11 @@ int polyc__cell_occupied(const polyc__tile *t, int idx, float threshold)
     return h > 0 && (float)h > threshold * (float)(h + m);
 }
 
-/* directory entry of the tile of cell (ix, iy), inside the grid */
-static size_t dir_index(const polyc__grid *g, int32_t ix, int32_t iy)
-{
-    size_t tx = (size_t)(ix >> POLYC__TILE_SHIFT), ty = (size_t)(iy >> POLYC__TILE_SHIFT);
-    return ty * (size_t)g->tiles_x + tx;
-}
-
 polyc__tile *polyc__grid_tile(const polyc__grid *g, int32_t ix, int32_t iy)
 {
     if (ix < 0 || iy < 0 || ix >= g->width || iy >= g->height)
         return NULL;
-    uint32_t d = g->dir[dir_index(g, ix, iy)];
+    uint32_t d = g->dir[polyc__dir_index(g, ix, iy)];
     return d ? &g->tiles[d - 1] : NULL;
 }
 
@@ -95,17 +69,12 @@ static int range_is_hit(const polyc__scan *s, float r)
     return r >= s->min_m && r < s->max_m;
 }
 
-/* cos and sin of a scan's angular step, for incidence_sin */
-typedef struct step_rot {
-    float cs, sn;
-} step_rot;
-
 /* sin of the incidence angle of beam i on the surface it hit, from the two
  * neighbouring endpoints when the three are nearly collinear (a surface);
  * 1 when unknown. Done in the beam's own frame: the only trigonometry is
  * the scan's step, given by `rot` or computed when rot is NULL. */
 static float incidence_sin(const polyc_ctx *ctx, const polyc__scan *s, uint32_t i, float r,
-                           const step_rot *rot)
+                           const polyc__step_rot *rot)
 {
     if (i == 0 || i + 1 >= s->count)
         return 1.0f;
@@ -113,7 +82,7 @@ static float incidence_sin(const polyc_ctx *ctx, const polyc__scan *s, uint32_t 
     float rm = rr[i - 1], rp = rr[i + 1];
     if (!range_is_hit(s, rm) || !range_is_hit(s, rp))
         return 1.0f;
-    step_rot own;
+    polyc__step_rot own;
     if (!rot) {
         own.cs = polyc__cosf(s->step_rad);
         own.sn = polyc__sinf(s->step_rad);
@@ -136,7 +105,7 @@ static float incidence_sin(const polyc_ctx *ctx, const polyc__scan *s, uint32_t 
 /* Beam i of scan s in grid coordinates; miss_end only when want_miss_end
  * (else 1). Returns 0 for a beam that is skipped. */
 static int beam_fill(const polyc_ctx *ctx, const polyc__scan *s, uint32_t i, polyc__beam *b,
-                     int want_miss_end, const step_rot *rot)
+                     int want_miss_end, const polyc__step_rot *rot)
 {
     const polyc__grid *g = &ctx->grid;
     float r = ctx->ranges[s->first + i];
@@ -192,6 +161,31 @@ int polyc__beam_path(const polyc_ctx *ctx, const polyc__scan *s, uint32_t i, pol
     return beam_fill(ctx, s, i, b, 0, NULL);
 }
 
+int polyc__beam_turned(const polyc_ctx *ctx, const polyc__scan *s, uint32_t i, polyc__beam *b,
+                       const polyc__step_rot *rot)
+{
+    return beam_fill(ctx, s, i, b, 1, rot);
+}
+
+/* The walk's per-beam and per-tile steps out of line, for the records'
+ * redo (online_grid.c): one copy of them in the library (at -Os, walk.h's
+ * inline steps are a copy per file). */
+void polyc__grid_walk_start(struct polyc__walk *w, const polyc__beam *b)
+{
+    polyc__walk_start(w, b);
+}
+
+int64_t polyc__grid_walk_key_at(const struct polyc__walk *w, float t)
+{
+    return polyc__walk_key_at(w, t);
+}
+
+int polyc__grid_walk_skip_tiles(struct polyc__walk *w, int32_t width, int32_t height, int32_t tiles_x,
+                                const uint32_t *stop)
+{
+    return polyc__walk_skip_tiles(w, width, height, tiles_x, stop);
+}
+
 /* Exact traversal of the cells from (sx, sy) to (ex, ey); `visit` gets each
  * cell with the beam parameter t at which the beam enters it. Returns early
  * when visit returns non-zero. */
@@ -217,127 +211,9 @@ typedef struct count_pass {
     polyc__arena *a;
     const uint32_t *wanted;
     polyc__tile *spill;
-    int records;                   /* online: misses in tiles not stored into their records */
+    const polyc__layer *layer;     /* g->rec's hooks (NULL: no records) */
+    int records;                   /* misses in tiles not stored into their records */
 } count_pass;
-
-/* ---- an online grid's misses in tiles not stored ----
- *
- * A batch knows every scan before it counts, so it stores each tile some
- * beam ends in and every miss there is counted. An online grid stores a
- * tile when the first beam ends in it; the misses beams made there before
- * would be lost, and a person who stops in a hall that the robot has seen
- * through for minutes would look as solid as a wall (the sweep's
- * thinwalls seed 8 drew one 29.7 mm off the walls against the batch's
- * 2.8; freiburg-campus had 3,340 polylines against the batch's 2,540).
- * So a tile not stored that beams cross takes a record from a pool (548
- * bytes, not a tile's 4 KiB; online.c sizes the pool): its misses at half
- * a byte a cell, exact up to POLYC__PRE_FULL, and per block of 8 x 8 cells
- * their sum. (When the pool is spent, a tile's cells start from the misses
- * counted once it is stored.) A tile stored later takes them: a cell below
- * the cap its own count, a cell at the cap its share of what its block's
- * sum holds beyond the cells below the cap. A cell next
- * to a wall, crossed by a few grazing beams, keeps those few (a block's
- * mean there put a wall first seen late under the free cells' misses: the
- * map of intel's first 100 scans scored 1.19 times the batch's BIC). */
-
-static int pre_block(int idx)
-{
-    const int per_tile = POLYC__TILE_SHIFT - POLYC__PRE_SHIFT;
-    return ((idx >> (POLYC__TILE_SHIFT + POLYC__PRE_SHIFT)) << per_tile) |
-           ((idx & (POLYC__TILE_SIDE - 1)) >> POLYC__PRE_SHIFT);
-}
-
-static unsigned pre_cell(const uint8_t *nib, int idx)
-{
-    return (nib[idx >> 1] >> ((idx & 1) * 4)) & 15u;
-}
-
-/* The record of the tile not stored at directory entry d: its number,
- * taken from the pool if `take` (-1: none, or the pool is spent). */
-static int64_t pre_record(polyc__grid *g, size_t d, int take)
-{
-    if (g->pre_of[d])
-        return (int64_t)g->pre_of[d] - 1;
-    if (!take)
-        return -1;
-    uint32_t r;
-    if (g->pre_nfree > 0)
-        r = g->pre_free[--g->pre_nfree];
-    else if (g->pre_high < g->pre_cap)
-        r = g->pre_high++;
-    else
-        return -1; /* (the pool is spent: those misses are lost) */
-    g->pre_of[d] = r + 1;
-    return r;
-}
-
-/* A tile stored now takes its record, which goes back to the pool. */
-static void take_pre_misses(polyc__grid *g, polyc__tile *t, size_t d)
-{
-    int64_t r = pre_record(g, d, 0);
-    if (r < 0)
-        return;
-    uint8_t *nib = g->pre_cells + (size_t)r * (POLYC__TILE_CELLS / 2);
-    uint16_t *sum = g->pre_miss + (size_t)r * POLYC__PRE_BLOCKS;
-    unsigned below[POLYC__PRE_BLOCKS] = {0}, full[POLYC__PRE_BLOCKS] = {0};
-    for (int idx = 0; idx < POLYC__TILE_CELLS; idx++) {
-        unsigned c = pre_cell(nib, idx);
-        if (c == POLYC__PRE_FULL)
-            full[pre_block(idx)]++;
-        else
-            below[pre_block(idx)] += c;
-    }
-    for (int idx = 0; idx < POLYC__TILE_CELLS; idx++) {
-        unsigned c = pre_cell(nib, idx);
-        if (c == POLYC__PRE_FULL) {
-            int k = pre_block(idx);
-            unsigned rest = sum[k] > below[k] ? sum[k] - below[k] : 0;
-            c = (rest + full[k] / 2) / full[k];
-            c = c < POLYC__PRE_FULL ? POLYC__PRE_FULL : c;
-        }
-        t->misses[idx] = (polyc__count)(c > POLYC__COUNT_MAX ? POLYC__COUNT_MAX : c);
-    }
-    memset(nib, 0, POLYC__TILE_CELLS / 2);
-    memset(sum, 0, POLYC__PRE_BLOCKS * sizeof *sum);
-    g->pre_of[d] = 0;
-    g->pre_free[g->pre_nfree++] = (uint32_t)r;
-}
-
-/* The beam's cells in the tile not stored of entry d, from the walk's
- * cell to the tile's edge or the end cell, into its record (take_back: out
- * again, where the count is exact). As count_beam's loop: a cell counts
- * when the walk enters it before miss_end. Returns polyc__walk_step's
- * last result (1: the walk left the tile). */
-static int pre_walk(polyc__grid *g, size_t d, polyc__walk *w, int64_t miss_key, int take_back)
-{
-    int64_t r = pre_record(g, d, !take_back);
-    int left = 0;
-    if (r < 0) {
-        do
-            left = polyc__walk_step(w);
-        while (!left && w->n > 0);
-        return left;
-    }
-    uint8_t *nib = g->pre_cells + (size_t)r * (POLYC__TILE_CELLS / 2);
-    uint16_t *sum = g->pre_miss + (size_t)r * POLYC__PRE_BLOCKS;
-    do {
-        if (w->t_key < miss_key) {
-            uint16_t *s = &sum[pre_block(w->idx)];
-            unsigned c = pre_cell(nib, w->idx), shift = (unsigned)(w->idx & 1) * 4;
-            if (take_back) {
-                *s = (uint16_t)(*s > 0 ? *s - 1 : 0);
-                if (c > 0 && c < POLYC__PRE_FULL)
-                    nib[w->idx >> 1] = (uint8_t)(nib[w->idx >> 1] - (1u << shift));
-            } else {
-                *s = (uint16_t)(*s < 65535u ? *s + 1 : *s);
-                if (c < POLYC__PRE_FULL)
-                    nib[w->idx >> 1] = (uint8_t)(nib[w->idx >> 1] + (1u << shift));
-            }
-        }
-        left = polyc__walk_step(w);
-    } while (!left && w->n > 0);
-    return left;
-}
 
 /* The tile of cell (ix, iy) inside the grid: stored (allocated on first use
  * if wanted) or the spill tile; NULL when the tile budget is spent
@@ -345,7 +221,7 @@ static int pre_walk(polyc__grid *g, size_t d, polyc__walk *w, int64_t miss_key, 
 static polyc__tile *tile_get(const count_pass *p, int32_t ix, int32_t iy)
 {
     polyc__grid *g = p->g;
-    size_t d = dir_index(g, ix, iy);
+    size_t d = polyc__dir_index(g, ix, iy);
     if (g->dir[d] == 0) {
         if (!((p->wanted[d >> 5] >> (d & 31)) & 1u))
             return p->spill;
@@ -359,8 +235,8 @@ static polyc__tile *tile_get(const count_pass *p, int32_t ix, int32_t iy)
             return NULL;
         }
         g->dir[d] = ++g->tile_count;
-        if (g->pre_miss)
-            take_pre_misses(g, t, d);
+        if (p->layer)
+            p->layer->rec_take(g->rec, t, d); /* its record's misses */
     }
     return &g->tiles[g->dir[d] - 1];
 }
@@ -374,9 +250,9 @@ static polyc__tile *tile_get(const count_pass *p, int32_t ix, int32_t iy)
 static inline void count_one(int take_back, polyc__count *a, polyc__count *b)
 {
     if (take_back)
-        count_dec(a, b);
+        polyc__count_dec(a);
     else
-        count_inc(a, b);
+        polyc__count_inc(a, b);
 }
 
 static inline void count_beam(const count_pass *p, const polyc__beam *b, int take_back,
@@ -391,8 +267,9 @@ static inline void count_beam(const count_pass *p, const polyc__beam *b, int tak
         return;
     while (w.n > 0) {
         if (t == p->spill && p->records) {
-            /* online: into the record of this tile not stored */
-            int left = pre_walk(g, dir_index(g, w.ix, w.iy), &w, miss_key, take_back);
+            /* into the record of this tile not stored */
+            size_t d = polyc__dir_index(g, w.ix, w.iy);
+            int left = p->layer->rec_walk(g->rec, d, &w, miss_key, take_back);
             if (left && w.n > 0 &&
                 (!polyc__walk_enter(&w, g->width, g->height) || !(t = tile_get(p, w.ix, w.iy))))
                 return;
@@ -485,14 +362,15 @@ static void want_hits(polyc_ctx *ctx, const polyc__scan *s)
             continue;
         int32_t ix = (int32_t)floorf(b.ex), iy = (int32_t)floorf(b.ey);
         if (ix >= 0 && iy >= 0 && ix < g->width && iy < g->height) {
-            size_t d = dir_index(g, ix, iy);
+            size_t d = polyc__dir_index(g, ix, iy);
             g->wanted[d >> 5] |= 1u << (d & 31);
         }
     }
 }
 
-/* Counts (or takes back) every beam of the scan; with `records`, an online
- * grid's misses in the tiles not stored too. */
+/* Counts (or takes back) every beam of the scan; with `records`, the
+ * misses in the tiles not stored into their records too (a grid with
+ * records, g->rec: a layer's). */
 static polyc_status count_scan(polyc_ctx *ctx, const polyc__scan *s, int take_back,
                                uint32_t *on_hits, int records)
 {
@@ -502,8 +380,9 @@ static polyc_status count_scan(polyc_ctx *ctx, const polyc__scan *s, int take_ba
     p.a = &ctx->arena;
     p.wanted = g->wanted;
     p.spill = g->spill;
-    p.records = records && g->pre_miss;
-    step_rot rot = {polyc__cosf(s->step_rad), polyc__sinf(s->step_rad)};
+    p.layer = g->rec ? ctx->layer : NULL;
+    p.records = records && p.layer;
+    polyc__step_rot rot = {polyc__cosf(s->step_rad), polyc__sinf(s->step_rad)};
     for (uint32_t i = 0; i < s->count; i++) {
         polyc__beam b;
         if (!beam_fill(ctx, s, i, &b, 1, &rot))
@@ -527,92 +406,6 @@ static void grid_stats(polyc_ctx *ctx)
     ctx->stats.grid_height = (uint32_t)g->height;
     ctx->stats.grid_tiles = g->tile_count;
     ctx->stats.grid_bytes = (uint64_t)g->fixed_bytes + (uint64_t)g->tile_count * sizeof(polyc__tile);
-}
-
-/* ---- the records made again after a recount ----
- * Counting every kept scan again (a pose correction of most of them) as
- * the batch counts, over the tiles not stored in one move, saves walking
- * their cells: on intel, 910 scans in 70 ms instead of 105. The records
- * those misses belong to are made again afterwards, a slice of scans at a
- * time (online.c): each scan's beams walk the tiles that were not stored
- * at the recount (redo_need) and skip the others, whose counts are
- * complete. A tile still not stored takes the misses into its record; one
- * stored since (a later scan's hit) into its counts, which hold the later
- * scans' misses and its record's share already. Until every scan is done
- * a tile stored meanwhile misses the rest's misses for a while; nothing
- * else reads the records. */
-
-void polyc__grid_redo_begin(polyc__grid *g)
-{
-    size_t dir_n = (size_t)g->tiles_x * (size_t)g->tiles_y;
-    memset(g->redo_need, 0, (dir_n / 32 + 1) * sizeof *g->redo_need);
-    for (size_t d = 0; d < dir_n; d++)
-        if (g->dir[d] == 0)
-            g->redo_need[d >> 5] |= 1u << (d & 31);
-}
-
-static int redo_needs(const polyc__grid *g, size_t d)
-{
-    return (g->redo_need[d >> 5] >> (d & 31)) & 1u;
-}
-
-static void redo_beam(polyc__grid *g, const polyc__beam *b, uint32_t *on_hits)
-{
-    polyc__walk w;
-    polyc__walk_start(&w, b);
-    const int64_t miss_key = polyc__walk_key_at(&w, b->miss_end);
-    if (w.n > 0 && !polyc__walk_enter(&w, g->width, g->height))
-        return;
-    while (w.n > 0) {
-        size_t d = dir_index(g, w.ix, w.iy);
-        if (!redo_needs(g, d)) {
-            int to = polyc__walk_skip_tiles(&w, g->width, g->height, g->tiles_x, g->redo_need);
-            if (to < 0)
-                return;
-            if (to == 0)
-                break;
-            if (!polyc__walk_enter(&w, g->width, g->height))
-                return;
-            continue;
-        }
-        int left;
-        if (g->dir[d] == 0) {
-            left = pre_walk(g, d, &w, miss_key, 0);
-        } else {
-            polyc__tile *t = &g->tiles[g->dir[d] - 1];
-            do {
-                if (w.t_key < miss_key) {
-                    count_one(0, &t->misses[w.idx], &t->hits[w.idx]);
-                    if (on_hits && t->hits[w.idx])
-                        on_hits[t - g->tiles]++;
-                }
-                left = polyc__walk_step(&w);
-            } while (!left && w.n > 0);
-        }
-        if (left && w.n > 0 && !polyc__walk_enter(&w, g->width, g->height))
-            return;
-    }
-    /* the end cell: a miss past the last reflection's reach, counted only
-     * in a stored tile (as count_beam) */
-    if (b->hit || w.ex < 0 || w.ey < 0 || w.ex >= g->width || w.ey >= g->height ||
-        w.t_key >= miss_key)
-        return;
-    size_t d = dir_index(g, w.ex, w.ey);
-    if (redo_needs(g, d) && g->dir[d] != 0) {
-        polyc__tile *t = &g->tiles[g->dir[d] - 1];
-        int idx = polyc__cell_index(w.ex, w.ey);
-        count_one(0, &t->misses[idx], &t->hits[idx]);
-    }
-}
-
-void polyc__grid_redo_scan(polyc_ctx *ctx, const polyc__scan *s, uint32_t *on_hits)
-{
-    step_rot rot = {polyc__cosf(s->step_rad), polyc__sinf(s->step_rad)};
-    for (uint32_t i = 0; i < s->count; i++) {
-        polyc__beam b;
-        if (beam_fill(ctx, s, i, &b, 1, &rot))
-            redo_beam(&ctx->grid, &b, on_hits);
-    }
 }
 
 polyc_status polyc__grid_recount_scan(polyc_ctx *ctx, const polyc__scan *s)
@@ -658,25 +451,6 @@ polyc_status polyc__grid_online_init(polyc_ctx *ctx, float side_m, uint32_t max_
 void polyc__grid_want(polyc_ctx *ctx, const polyc__scan *s)
 {
     want_hits(ctx, s);
-}
-
-/* Every count to 0, in the stored tiles and in the records of the tiles
- * not stored, which go back to the pool; the tiles stay stored (their
- * contour bits too: the caller casts the contour again). */
-void polyc__grid_clear_counts(polyc__grid *g)
-{
-    for (uint32_t t = 0; t < g->tile_count; t++) {
-        polyc__tile *tile = &g->tiles[t];
-        memset(tile->hits, 0, sizeof tile->hits);
-        memset(tile->misses, 0, sizeof tile->misses);
-    }
-    if (!g->pre_miss)
-        return;
-    memset(g->pre_of, 0, (size_t)g->tiles_x * (size_t)g->tiles_y * sizeof *g->pre_of);
-    memset(g->pre_cells, 0, (size_t)g->pre_high * (POLYC__TILE_CELLS / 2));
-    memset(g->pre_miss, 0, (size_t)g->pre_high * POLYC__PRE_BLOCKS * sizeof *g->pre_miss);
-    g->pre_high = 0;
-    g->pre_nfree = 0;
 }
 
 polyc_status polyc__grid_add_scan(polyc_ctx *ctx, const polyc__scan *s, int take_back,

@@ -71,9 +71,9 @@ static inline int32_t polyc__floori(float x)
 #define POLYC__TILE_SHIFT 5
 #define POLYC__TILE_SIDE 32
 #define POLYC__TILE_CELLS 1024
-/* an online grid's record of misses in tiles not stored: a count per block
- * of POLYC__PRE_SIDE x POLYC__PRE_SIDE cells, POLYC__PRE_BLOCKS a tile
- * (and half a byte per cell) */
+/* the record of misses in a tile not stored that an online grid keeps
+ * (online_grid.c): a count per block of POLYC__PRE_SIDE x POLYC__PRE_SIDE
+ * cells, POLYC__PRE_BLOCKS a tile (and half a byte per cell) */
 #define POLYC__PRE_SHIFT 3
 #define POLYC__PRE_SIDE 8
 #define POLYC__PRE_BLOCKS 16
@@ -89,6 +89,10 @@ typedef struct polyc__tile {
     uint32_t pad[3];                    /* size a multiple of 16 (contiguous tiles) */
 } polyc__tile;
 
+/* (the layer's records and the cell walk: online_grid.c, walk.h) */
+struct polyc__records;
+struct polyc__walk;
+
 typedef struct polyc__grid {
     double origin_x_m, origin_y_m; /* lower-left corner of cell (0, 0) */
     float frame_ox, frame_oy;      /* the same, relative to the frame (first pose) */
@@ -101,17 +105,10 @@ typedef struct polyc__grid {
     int out_of_tiles;              /* set when a beam needed a tile past tile_cap */
     uint32_t *wanted;              /* bit per directory entry: a tile to store */
     polyc__tile *spill;            /* where misses in tiles not stored go */
-    /* online, the misses in tiles not stored (grid.c, POLYC__PRE_*), in a
-     * pool of pre_cap records; pre_miss NULL in a batch */
-    uint32_t *pre_of;              /* per directory entry: its record + 1, or 0 */
-    uint16_t *pre_miss;            /* per record: per block, its cells' misses */
-    uint8_t *pre_cells;            /* per record: each cell's, half a byte, up to POLYC__PRE_FULL */
-    uint32_t *pre_free;            /* records given back */
-    uint32_t pre_cap, pre_high, pre_nfree;
-    /* bit per directory entry: the tile was not stored when the counts were
-     * made again without their records (polyc__grid_recount_scan), whose
-     * misses polyc__grid_redo_scan puts back */
-    uint32_t *redo_need;
+    /* where the misses in tiles not stored are kept, when they are (a
+     * layer's records, online_grid.c, walked by its hooks: polyc__layer;
+     * NULL in a batch) */
+    struct polyc__records *rec;
     size_t fixed_bytes;            /* directory, bits and spill tile */
 } polyc__grid;
 
@@ -291,16 +288,80 @@ typedef struct polyc__spacing {
 /* the table's allocation under the limits, on a counting arena */
 void polyc__spacing_reserve(polyc__arena *a, const polyc_limits *lim);
 polyc_status polyc__spacing_build(polyc_ctx *ctx, polyc__spacing *sp);
+/* the distances of sp->dist made from the tiles at 0 (1e30 elsewhere) */
+void polyc__spacing_chamfer(polyc__spacing *sp);
 /* metres between neighbouring endpoints near (x, y), frame-relative; a lower
  * bound, since the nearest pose is taken (0 without poses) */
 float polyc__spacing_at(const polyc__spacing *sp, float x, float y);
 
 
+/* ---- blocks.c: the weighted points' blocks ----
+ * Weighted points gather the endpoints of a block of 2 x 2 grid cells (5 cm
+ * at the default grid): a quarter of the points to score, while the moments
+ * keep each block's squared distances exact (measured in docs/performance.md). */
+#define POLYC__BLOCK_SHIFT 1
+#define POLYC__BLOCK_SIDE (1 << POLYC__BLOCK_SHIFT)
+/* The blocks of tile t that hold data marked (t->mark), from the counters;
+ * its marked blocks numbered from n (returns the next number). */
+void polyc__block_mark_tile(const polyc_ctx *ctx, polyc__tile *t);
+uint32_t polyc__block_number_tile(polyc__tile *t, uint32_t n);
+/* The number of the marked block (bx, by) of tile t. */
+static inline uint32_t polyc__block_number(const polyc__tile *t, int32_t bx, int32_t by)
+{
+    uint32_t row = t->mark[by & 31], col = (uint32_t)(bx & 31);
+    uint32_t below = row & ((1u << col) - 1u);
+    uint32_t c = 0;
+    while (below) {
+        below &= below - 1;
+        c++;
+    }
+    return t->mark_base + t->mark_row[by & 31] + c;
+}
+/* every tile's blocks marked and numbered, and that many points (and
+ * views, if any) zeroed; POLYC_ERR_NOMEM past cap */
+polyc_status polyc__blocks_begin(polyc_ctx *ctx, polyc__point *tmp, float *view, int32_t cap,
+                                 uint32_t *n);
+/* means and central moments from the sums of the points of the tile at
+ * directory entry d, in the numbering order of its marks (a point of
+ * weight 0 left as it is); of every stored tile */
+void polyc__block_finish_tile(const polyc_ctx *ctx, int32_t d, polyc__point *tmp);
+void polyc__blocks_finish(polyc_ctx *ctx, polyc__point *tmp);
+
+/* ---- what a layer above the batch stages lends them ----
+ * The online mode (online*.c) reuses the batch stages on data of its own:
+ * where a batch stage would compute from the stored scans, it calls these
+ * hooks of ctx->layer (NULL in a batch context; the online table is in
+ * online.c), and knows nothing else of the layer. */
+struct polyc__opt;
+/* the unsorted points a layer collects, and a tag per point that the sort
+ * by bucket carries along (tag[i] to tag_out[its place]) */
+typedef struct polyc__points_in {
+    polyc__point *pts;
+    float *view;                   /* 2 per point: towards the sensors */
+    const uint32_t *tag;
+    uint32_t *tag_out;
+} polyc__points_in;
+typedef struct polyc__layer {
+    /* spacing.c: the layer's spacing table (n directory entries) into sp */
+    polyc_status (*spacing)(polyc_ctx *ctx, polyc__spacing *sp, size_t n);
+    /* opt_setup.c: the scratch of `collect` for this many points, carved
+     * on the context's arena (0: no room; the caller gives it back) */
+    int (*points_scratch)(polyc_ctx *ctx, int32_t points);
+    /* points.c: the weighted points (at most cap) from the layer's data */
+    polyc_status (*collect)(struct polyc__opt *o, int32_t cap, polyc__points_in *in, int32_t *n);
+    /* grid.c: a walk's cells in a tile not stored (directory entry d) into
+     * its record (take_back: out again); returns 1 when the walk left the
+     * tile; and a tile stored now takes its record's misses */
+    int (*rec_walk)(struct polyc__records *r, size_t d, struct polyc__walk *w, int64_t miss_key,
+                    int take_back);
+    void (*rec_take)(struct polyc__records *r, struct polyc__tile *t, size_t d);
+} polyc__layer;
+
 /* config.c: a pose is usable (finite, within 10,000 km); the extent rule
  * (the pose and every reflected endpoint, frame shifted by ox, oy) grows
  * box[4] = min x, min y, max x, max y (have: it holds something) */
 int polyc__pose_ok(double x, double y, double th);
-/* api.c: what is wrong with a scan's geometry (a static message), or NULL */
+/* context.c: what is wrong with a scan's geometry (a static message), or NULL */
 const char *polyc__scan_problem(const polyc_scan *s);
 void polyc__extent_add(const polyc_scan *s, double ox, double oy, double *box, int *have);
 
@@ -325,25 +386,42 @@ size_t polyc__grid_budget_bytes(const polyc_limits *lim);
 /* the budget, on a counting arena */
 void polyc__grid_reserve(polyc__arena *a, const polyc_limits *lim);
 polyc_status polyc__grid_build(polyc_ctx *ctx);
-/* online: a grid over a square of side_m centred on the frame origin, with
- * no tile yet; one scan counted into it, or taken back (a pose correction);
- * on_hits (per tile, may be NULL) counts the misses in cells with hits */
+/* a grid over a square of side_m centred on the frame origin, with no
+ * tile yet (online); one scan counted into it, or taken back (a pose
+ * correction); with on_hits (per tile, may be NULL) the misses in cells
+ * with hits tallied, with records (g->rec) the misses in the tiles not
+ * stored kept there */
 polyc_status polyc__grid_online_init(polyc_ctx *ctx, float side_m, uint32_t max_cells);
 polyc_status polyc__grid_add_scan(polyc_ctx *ctx, const polyc__scan *s, int take_back,
                                   uint32_t *on_hits);
-/* online: the tiles the scan's hits end in wanted (stored when a beam
- * reaches them), before any scan is counted again; every count to 0 (the
- * tiles stay stored, the records go back to the pool) */
+/* the tiles the scan's hits end in wanted (stored when a beam reaches
+ * them), before any scan is counted again */
 void polyc__grid_want(polyc_ctx *ctx, const polyc__scan *s);
-void polyc__grid_clear_counts(polyc__grid *g);
-/* online, counting every kept scan again on cleared counts: one scan in as
- * a batch counts it, its misses in tiles not stored left out; then the
- * tiles not stored at that point noted (redo_need), and later each scan's
- * misses in them put back, into their records or, in those stored since,
- * into their counts (misses on cells with hits tallied in on_hits) */
-polyc_status polyc__grid_recount_scan(polyc_ctx *ctx, const polyc__scan *s); /* (wanted first) */
-void polyc__grid_redo_begin(polyc__grid *g);
-void polyc__grid_redo_scan(polyc_ctx *ctx, const polyc__scan *s, uint32_t *on_hits);
+/* one scan in as a batch counts it, its misses in tiles not stored left
+ * out (the tiles wanted first) */
+polyc_status polyc__grid_recount_scan(polyc_ctx *ctx, const polyc__scan *s);
+/* the directory entry of the tile of cell (ix, iy), inside the grid */
+static inline size_t polyc__dir_index(const polyc__grid *g, int32_t ix, int32_t iy)
+{
+    size_t tx = (size_t)(ix >> POLYC__TILE_SHIFT), ty = (size_t)(iy >> POLYC__TILE_SHIFT);
+    return ty * (size_t)g->tiles_x + tx;
+}
+/* A cell's two counters saturate by halving both, which keeps m = h/(h+m). */
+static inline void polyc__count_inc(polyc__count *a, polyc__count *b)
+{
+    if (*a == POLYC__COUNT_MAX) {
+        *a = (polyc__count)(*a >> 1);
+        *b = (polyc__count)(*b >> 1);
+    }
+    (*a)++;
+}
+/* A scan taken back (an online pose correction): exact unless the cell
+ * saturated since, then never below 0. */
+static inline void polyc__count_dec(polyc__count *a)
+{
+    if (*a > 0)
+        (*a)--;
+}
 polyc__tile *polyc__grid_tile(const polyc__grid *g, int32_t ix, int32_t iy);
 /* NULL for cells outside the grid or in tiles not stored (no beam ends in a
  * hit there: free space or never reached) */
@@ -410,11 +488,24 @@ typedef struct polyc__beam {
 int polyc__beam_get(const polyc_ctx *ctx, const polyc__scan *s, uint32_t i, polyc__beam *b);
 /* the same without miss_end (left at 1): for passes that only follow the path */
 int polyc__beam_path(const polyc_ctx *ctx, const polyc__scan *s, uint32_t i, polyc__beam *b);
+/* cos and sin of a scan's angular step */
+typedef struct polyc__step_rot {
+    float cs, sn;
+} polyc__step_rot;
+/* polyc__beam_get with the step's cos and sin given (a pass over a scan) */
+int polyc__beam_turned(const polyc_ctx *ctx, const polyc__scan *s, uint32_t i, polyc__beam *b,
+                       const polyc__step_rot *rot);
 /* Exact traversal (Amanatides-Woo) of the cells from the sensor to the end;
  * visit gets each cell with the beam parameter at which the beam enters it
  * and `last` set for the end cell; a non-zero return stops the walk. */
 typedef int (*polyc__cell_fn)(void *u, int32_t ix, int32_t iy, float t_enter, int last);
 void polyc__traverse(const polyc__beam *b, polyc__cell_fn visit, void *u);
+/* walk.h's polyc__walk_start, _key_at and _skip_tiles out of line (grid.c:
+ * one copy in the library for the walks that are not the grid's count) */
+void polyc__grid_walk_start(struct polyc__walk *w, const polyc__beam *b);
+int64_t polyc__grid_walk_key_at(const struct polyc__walk *w, float t);
+int polyc__grid_walk_skip_tiles(struct polyc__walk *w, int32_t width, int32_t height, int32_t tiles_x,
+                                const uint32_t *stop);
 
 /* occupancy.c: the grid and contour stages of an occupancy grid, at once */
 polyc_status polyc__occ_add(polyc_ctx *ctx, const polyc_occupancy_grid *grid);
@@ -470,9 +561,10 @@ polyc_status polyc__store_from_flat(polyc__store *s, const polyc__flat *f);
 
 /* trace.c */
 polyc_status polyc__trace_build(polyc_ctx *ctx);
-/* the walks alone: the cells of ctx->contour_xy that are marked in their
- * tiles (t->mark) traced into polylines added to the store (online) */
-polyc_status polyc__trace_more(polyc_ctx *ctx);
+/* the walks alone: the `count` cells of xy (2 a cell) that are marked in
+ * their tiles (t->mark) traced into polylines added to the store (the
+ * batch's: the contour list; an online round's: its unexplained cells) */
+polyc_status polyc__trace_cells(polyc_ctx *ctx, const int32_t *xy, uint32_t count);
 void polyc__trace_reserve(polyc__arena *a, const polyc_limits *lim);
 /* scan_chains.c: a single scan's initial polylines from its beam order */
 void polyc__chains_reserve(polyc__arena *a, const polyc_limits *lim);

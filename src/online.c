@@ -1,45 +1,16 @@
-/* online.c - an online context: sized from an area, it takes scans one at
- * a time into what the batch stages would compute from all of them (the
- * grid's counts, each cell's endpoint sums, the contour, the angle prior
- * and the accuracy), remembers the tiles they changed (the backlog), and
- * keeps the scans the caller asks it to, so that their poses can be
- * corrected. Takes: scans, corrections. Gives: the state online_round.c
- * re-optimises the map from. */
+/* online.c - an online context: its limits and size from an area, its
+ * block's layout (everything the online files carve, in one order, and the
+ * scratch the steps share above the tiles), and the layer table that lends
+ * the batch stages the online data. Takes: the caller's block, config and
+ * online limits. Gives: a context that online_scan.c takes scans into,
+ * online_correct.c corrects and online_update.c maps. */
 #include "online.h"
-#include "walk.h"
 
 #include <math.h>
 #include <string.h>
 
-/* A tile joins the backlog when the endpoints that came in (or went out)
- * since its points were last made reach this share of those it held then:
- * where the map is seen again and again, a scan changes a tile's data by a
- * few per cent, too little to move a vertex, and the update leaves it;
- * where the robot sees something new, the first endpoints count whole. */
-#define CHANGE_SHARE 0.25f
-/* and at least this many endpoints: a few far returns a scan (a sparse
- * tile) wait for the next */
-#define CHANGE_MIN 16u
-/* A sparse tile (far walls seen through a door, a few returns a scan)
- * never gains CHANGE_MIN endpoints at once: it joins the backlog at the
- * periodic check once it holds SPARSE_MIN new endpoints and at least as
- * many as it held when last made. Without this such walls waited for the
- * finishing call: on intel the map of the first 100 scans scored 1.66
- * times the BIC of the batch map of those scans on the batch's data
- * (tools/eval/fairbic.h), 0.995 with it. */
-#define SPARSE_MIN 4u
-
 /* The hash's bound, in beams of 16 buckets: 69,632 buckets. */
 #define ONLINE_HASH_BEAMS 4096u
-
-/* Endpoints and poses must stay this far inside the area: vertices may
- * wander a little past the data (the spatial hash's own margin is 2 m). */
-#define AREA_MARGIN_M 1.0f
-
-/* relabel: the marks pay when the scans' beams times this reach the
- * stored cells (a beam walks some tens of cells in the tiles it does not
- * skip) */
-#define RELABEL_CELLS_PER_BEAM 32u
 
 void polyc__online_stage_limits(const polyc_online_limits *ol, polyc_limits *lim)
 {
@@ -113,18 +84,6 @@ polyc_status polyc_online_limits_for_area(const polyc_config *config, double are
     return POLYC_OK;
 }
 
-/* The grid's records of misses in tiles not stored (grid.c): for four
- * times as many tiles as it stores, and no more than the area holds. On
- * freiburg-campus beams cross 59,893 tiles, 15,405 of them stored; the
- * sweep's halls, seen with a 30 m scanner, spent a pool of twice the
- * tiles (hall seed 6: core precision 10.9 mm against 9.9 with every
- * record it needed), not one of four. */
-static size_t pre_records(uint32_t tile_cap, size_t dir_n)
-{
-    size_t n = 4 * (size_t)tile_cap;
-    return n < dir_n ? n : dir_n;
-}
-
 /* Everything an online context carves, in the block's order, on the block
  * or on the size query's counting arena (nothing is written then); the
  * grid's tiles come last, as beams reach them. ctx->cfg and ctx->lim are set. */
@@ -135,9 +94,9 @@ static int lay_out(polyc_ctx *ctx, polyc__online *on, polyc__arena *a)
     uint32_t slots = ctx->lim.max_scans;
     POLYC__CARVE(ok, a, ctx->scans, slots);
     POLYC__CARVE(ok, a, ctx->ranges, (size_t)ol->max_scan_beams + ol->keep_beams);
-    POLYC__CARVE(ok, a, on->kept_id, ol->keep_scans + 1);
-    POLYC__CARVE_ZERO(ok, a, on->moved, ol->keep_scans / 32u + 1u);
-    POLYC__CARVE(ok, a, on->new_pose, 3 * (size_t)ol->keep_scans + 1u);
+    POLYC__CARVE(ok, a, on->kept.id, ol->keep_scans + 1);
+    POLYC__CARVE_ZERO(ok, a, on->kept.moved, ol->keep_scans / 32u + 1u);
+    POLYC__CARVE(ok, a, on->kept.new_pose, 3 * (size_t)ol->keep_scans + 1u);
     int32_t V = polyc__max_vertices(&ctx->lim);
     if (!ok || !polyc__store_init(a, &ctx->store, V))
         return 0;
@@ -147,7 +106,7 @@ static int lay_out(polyc_ctx *ctx, polyc__online *on, polyc__arena *a)
     else
         polyc__flat_reserve(a, V);
     polyc__online_pub_carve(a, on, lines);
-    ok &= on->pub && on->pub_next && on->gone;
+    ok &= on->pubs.pub && on->pubs.pub_next && on->pubs.gone;
     /* the grid's geometry first (its directory is carved last) */
     polyc__arena probe;
     polyc__arena_counting(&probe);
@@ -160,33 +119,23 @@ static int lay_out(polyc_ctx *ctx, polyc__online *on, polyc__arena *a)
     size_t dir_n = (size_t)ctx->grid.tiles_x * (size_t)ctx->grid.tiles_y;
     uint32_t tile_cap = ctx->grid.tile_cap;
     ok &= polyc__prior_online(ctx, &on->prior, &on->acc, a);
-    ok = ok && polyc__cells_carve(a, on, tile_cap);
-    POLYC__CARVE_ZERO(ok, a, on->pose_bits, dir_n / 32 + 1);
-    POLYC__CARVE(ok, a, on->spacing_dist, dir_n);
-    POLYC__CARVE_ZERO(ok, a, on->dirty_since, dir_n);
-    POLYC__CARVE(ok, a, on->dirty, dir_n);
-    on->cells_cap = ol->max_points + 1;
+    ok = ok && polyc__cells_carve(a, &on->tab, ol->max_points, tile_cap);
+    POLYC__CARVE_ZERO(ok, a, on->poses.pose_bits, dir_n / 32 + 1);
+    POLYC__CARVE(ok, a, on->poses.spacing_dist, dir_n);
+    POLYC__CARVE_ZERO(ok, a, on->backlog.dirty_since, dir_n);
+    POLYC__CARVE(ok, a, on->backlog.dirty, dir_n);
     ok = ok && polyc__opt_carve_online(ctx, a, &on->opt);
     if (!ok)
         return 0;
     size_t P = (size_t)polyc__points_bound(&ctx->cfg, &ctx->lim), nb = (size_t)on->opt.h.bx * (size_t)on->opt.h.by;
     POLYC__CARVE(ok, a, on->pt_tile, P);
     POLYC__CARVE(ok, a, on->bucket_fill, nb);
-    POLYC__CARVE_ZERO(ok, a, on->tile_raw, tile_cap);
-    POLYC__CARVE_ZERO(ok, a, on->tile_new, tile_cap);
-    POLYC__CARVE_ZERO(ok, a, on->tile_miss, tile_cap);
-    /* the grid's records of misses in tiles not stored: carved here, set in
-     * the grid below (its layout clears the grid) */
-    size_t pre_cap = pre_records(tile_cap, dir_n);
-    uint32_t *pre_of = NULL, *pre_free = NULL;
-    uint16_t *pre_miss = NULL;
-    uint8_t *pre_cells = NULL;
-    POLYC__CARVE_ZERO(ok, a, pre_of, dir_n);
-    POLYC__CARVE_ZERO(ok, a, pre_miss, pre_cap * POLYC__PRE_BLOCKS);
-    POLYC__CARVE_ZERO(ok, a, pre_cells, pre_cap * (POLYC__TILE_CELLS / 2));
-    POLYC__CARVE(ok, a, pre_free, pre_cap);
-    uint32_t *redo_need = NULL;
-    POLYC__CARVE_ZERO(ok, a, redo_need, dir_n / 32 + 1);
+    POLYC__CARVE_ZERO(ok, a, on->backlog.tile_raw, tile_cap);
+    POLYC__CARVE_ZERO(ok, a, on->backlog.tile_new, tile_cap);
+    POLYC__CARVE_ZERO(ok, a, on->backlog.tile_miss, tile_cap);
+    /* the grid's records of misses in tiles not stored: carved here, handed
+     * to the grid below (its layout clears the grid) */
+    ok = ok && polyc__records_carve(a, &on->rec, tile_cap, dir_n);
     if (!ok)
         return 0;
     saved = ctx->arena;
@@ -196,56 +145,41 @@ static int lay_out(polyc_ctx *ctx, polyc__online *on, polyc__arena *a)
     ctx->arena = saved;
     if (st != POLYC_OK)
         return 0;
-    ctx->grid.pre_of = pre_of;
-    ctx->grid.pre_miss = pre_miss;
-    ctx->grid.pre_cells = pre_cells;
-    ctx->grid.pre_free = pre_free;
-    ctx->grid.pre_cap = (uint32_t)pre_cap;
-    ctx->grid.redo_need = redo_need;
+    ctx->grid.rec = &on->rec;
     /* the tiles, and above them the largest step's scratch */
     size_t scratch = 0;
     for (int step = POLYC__STEP_TRACE; step <= POLYC__STEP_LEARN; step++) {
         polyc__arena c;
         polyc__arena_counting(&c);
         polyc__online_scratch(&c, on, (int32_t)P, (polyc__online_step)step);
-        if (step == POLYC__STEP_TRACE) /* and the trace's walk, which trace.c carves */
-            c.peak = polyc__add(c.peak, polyc__bytes(2 * (size_t)on->cells_cap + 2, sizeof(int32_t)));
+        if (step == POLYC__STEP_TRACE) { /* and the trace's walk, which trace.c carves, or after it
+                                          * the round's flags */
+            size_t walk = polyc__bytes(2 * (size_t)polyc__online_cells_cap(on) + 2, sizeof(int32_t));
+            size_t flags = polyc__bytes((size_t)polyc__max_vertices(&ctx->lim), 1);
+            c.peak = polyc__add(c.peak, walk > flags ? walk : flags);
+        }
         scratch = c.peak > scratch ? c.peak : scratch;
     }
     size_t cast = polyc__contour_cast_bytes(dir_n); /* relabel's */
     scratch = cast > scratch ? cast : scratch;
-    on->cells = NULL;
-    on->pts_tmp = NULL;
-    on->view_tmp = NULL;
-    on->fresh_tile = NULL;
-    on->fresh_bucket = NULL;
-    on->learn_cache = NULL;
+    on->scr.cells = NULL;
+    on->scr.pts_tmp = NULL;
+    on->scr.view_tmp = NULL;
+    on->scr.fresh_tile = NULL;
+    on->scr.fresh_bucket = NULL;
+    on->scr.learn_cache = NULL;
+    on->scr.seg_data = NULL;
     a->peak = polyc__add(a->used, polyc__add(polyc__bytes(tile_cap, sizeof(polyc__tile)), scratch));
     return 1;
 }
 
-/* A step's scratch lives only while the step runs, so the steps share one
- * region above the tiles: the block holds the largest, not their sum. */
-int polyc__online_scratch(polyc__arena *a, polyc__online *on, int32_t points, polyc__online_step step)
-{
-    int ok = 1;
-    size_t P = (size_t)points;
-    switch (step) {
-    case POLYC__STEP_TRACE:
-        POLYC__CARVE(ok, a, on->cells, 2 * (size_t)on->cells_cap);
-        break;
-    case POLYC__STEP_POINTS:
-        POLYC__CARVE(ok, a, on->pts_tmp, P);
-        POLYC__CARVE(ok, a, on->view_tmp, 2 * P);
-        POLYC__CARVE(ok, a, on->fresh_tile, P);
-        POLYC__CARVE(ok, a, on->fresh_bucket, P);
-        break;
-    case POLYC__STEP_LEARN:
-        POLYC__CARVE(ok, a, on->learn_cache, 3 * (size_t)on->lim.max_scan_beams);
-        break;
-    }
-    return ok;
-}
+
+
+/* What the online layer lends the batch stages it runs on its own data. */
+static const polyc__layer online_layer = {
+    polyc__online_spacing, polyc__online_points_scratch, polyc__online_collect, polyc__records_walk,
+    polyc__records_take,
+};
 
 static size_t header_bytes(void)
 {
@@ -276,21 +210,19 @@ size_t polyc_online_memory_size(const polyc_config *config, const polyc_online_l
 polyc_status polyc_online_init(void *block, size_t size, const polyc_config *config,
                                const polyc_online_limits *limits, polyc_ctx **out)
 {
-    if (!out)
-        return POLYC_ERR_NULL;
-    *out = NULL;
-    if (!block || !config || !limits)
-        return POLYC_ERR_NULL;
-    if (polyc_config_check(config, NULL) != POLYC_OK || !limits_ok(config, limits))
-        return POLYC_ERR_CONFIG;
+    polyc_status st = polyc__init_args(block, config, limits, out);
+    if (st == POLYC_OK && !limits_ok(config, limits))
+        st = POLYC_ERR_CONFIG;
     /* the context's header, then the online state's, then the arena */
     polyc_ctx *ctx;
-    polyc_status st = polyc__place_ctx(block, size, polyc_online_memory_size(config, limits),
-                                       header_bytes(), config, &ctx);
+    if (st == POLYC_OK)
+        st = polyc__place_ctx(block, size, polyc_online_memory_size(config, limits), header_bytes(),
+                              config, &ctx);
     if (st != POLYC_OK)
         return st;
     polyc__online *on = (polyc__online *)((unsigned char *)ctx + polyc__bytes(1, sizeof(polyc_ctx)));
     ctx->online = on;
+    ctx->layer = &online_layer;
     on->lim = *limits;
     polyc__online_stage_limits(limits, &ctx->lim);
     polyc__arena a = ctx->arena;
@@ -304,548 +236,7 @@ polyc_status polyc_online_init(void *block, size_t size, const polyc_config *con
     return POLYC_OK;
 }
 
-/* ---- one scan in (or out) ---- */
-
-static void mark_dirty(polyc__online *on, size_t d)
-{
-    if (on->dirty_since[d] == 0) {
-        on->dirty_since[d] = on->scans + 1;
-        on->dirty[on->dirty_n++] = (uint32_t)d;
-    }
-}
-
-/* A tile also joins the backlog when beams have passed through its cells
- * with hits as often as it held endpoints at its last update: then the
- * data rule may drop them (a person who walked by); and a sparse tile by
- * SPARSE_MIN. Both looked at every MISS_CHECK_SCANS scans (a pass over the
- * directory). */
-#define MISS_CHECK_SCANS 8u
-
-void polyc__online_backlog_misses(polyc_ctx *ctx)
-{
-    polyc__online *on = ctx->online;
-    if (on->scans % MISS_CHECK_SCANS != 0)
-        return;
-    const polyc__grid *g = &ctx->grid;
-    size_t dir_n = (size_t)g->tiles_x * (size_t)g->tiles_y;
-    for (size_t d = 0; d < dir_n; d++) {
-        if (!g->dir[d])
-            continue;
-        uint32_t k = g->dir[d] - 1;
-        if (on->tile_miss[k] >= CHANGE_MIN && (float)on->tile_miss[k] >= on->tile_raw[k])
-            mark_dirty(on, d);
-        else if (on->tile_new[k] >= SPARSE_MIN && on->tile_new[k] >= on->tile_raw[k])
-            mark_dirty(on, d);
-    }
-}
-
-void polyc__online_backlog_all(polyc_ctx *ctx)
-{
-    const polyc__grid *g = &ctx->grid;
-    size_t dir_n = (size_t)g->tiles_x * (size_t)g->tiles_y;
-    for (size_t d = 0; d < dir_n; d++)
-        if (g->dir[d])
-            mark_dirty(ctx->online, d);
-}
-
-/* The tile index of cell (ix, iy) inside the grid, or -1. */
-static int64_t tile_of(const polyc__grid *g, int32_t ix, int32_t iy)
-{
-    if (ix < 0 || iy < 0 || ix >= g->width || iy >= g->height)
-        return -1;
-    return (int64_t)(iy >> POLYC__TILE_SHIFT) * g->tiles_x + (ix >> POLYC__TILE_SHIFT);
-}
-
-/* The sum of the view vectors of cell (ix, iy)'s endpoints (towards their
- * sensors); 0, 0 for a cell without endpoints. */
-void polyc__online_cell_view(const polyc_ctx *ctx, int32_t ix, int32_t iy, float *vx, float *vy)
-{
-    const polyc__online *on = ctx->online;
-    const polyc__grid *g = &ctx->grid;
-    int64_t d = tile_of(g, ix, iy);
-    *vx = *vy = 0.0f;
-    if (d < 0 || g->dir[d] == 0)
-        return;
-    uint32_t e = polyc__cell_find(on, polyc__cell_key(g->dir[d] - 1, polyc__cell_index(ix, iy)));
-    if (e == 0)
-        return;
-    *vx = on->sums[e - 1].vx;
-    *vy = on->sums[e - 1].vy;
-}
-
-/* Each endpoint into its cell's sums (sign -1: out again); the tiles they
- * fall in join the backlog. 0 when the sums are used up. */
-static int sum_endpoints(polyc_ctx *ctx, const polyc__scan *s, float sign)
-{
-    polyc__online *on = ctx->online;
-    const polyc__grid *g = &ctx->grid;
-    int ok = 1;
-    for (uint32_t i = 0; i < s->count; i++) {
-        polyc__beam b;
-        if (!polyc__beam_path(ctx, s, i, &b) || !b.hit)
-            continue;
-        float fx = floorf(b.ex), fy = floorf(b.ey);
-        int32_t ix = (int32_t)fx, iy = (int32_t)fy;
-        int64_t d = tile_of(g, ix, iy);
-        if (d < 0 || g->dir[d] == 0)
-            continue;
-        uint32_t k = g->dir[d] - 1;
-        if (++on->tile_new[k] >= CHANGE_MIN && (float)on->tile_new[k] >= CHANGE_SHARE * on->tile_raw[k])
-            mark_dirty(on, (size_t)d);
-        uint32_t key = polyc__cell_key(k, polyc__cell_index(ix, iy));
-        uint32_t e = sign < 0.0f ? polyc__cell_find(on, key) : polyc__cell_add(on, key);
-        if (e == 0) { /* the entries are used up (or a cell without sums taken back) */
-            if (sign > 0.0f)
-                ok = 0;
-            continue;
-        }
-        polyc__cell_sums *c = &on->sums[e - 1];
-        float ox = (b.ex - fx - 0.5f) * g->cell_m, oy = (b.ey - fy - 0.5f) * g->cell_m;
-        c->fx += sign * ox;
-        c->fy += sign * oy;
-        c->fxx += sign * ox * ox;
-        c->fxy += sign * ox * oy;
-        c->fyy += sign * oy * oy;
-        c->vx += sign * (b.sx - b.ex) * g->cell_m;
-        c->vy += sign * (b.sy - b.ey) * g->cell_m;
-        c->n = sign > 0.0f ? c->n + 1 : (c->n > 0 ? c->n - 1 : 0);
-        if (c->n == 0) /* its last endpoint went (a correction): the entry is free */
-            polyc__cell_drop(on, e);
-    }
-    return ok;
-}
-
-/* Labels the first occupied cell along each beam as contour, or a
- * reflection's end cell by the data fallback (contour.c), on the grid as it
- * stands with this scan counted (the batch casts once more on the final
- * grid). */
-static void label_contour(polyc_ctx *ctx, const polyc__scan *s)
-{
-    const polyc__grid *g = &ctx->grid;
-    float thr = ctx->cfg.contour_threshold;
-    for (uint32_t i = 0; i < s->count; i++) {
-        polyc__beam b;
-        if (!polyc__beam_path(ctx, s, i, &b))
-            continue;
-        polyc__walk w;
-        polyc__walk_start(&w, &b);
-        int32_t cx = w.ex, cy = w.ey;
-        /* tile by tile: over tiles no beam wanted (no hit, so no occupied
-         * cell) in one move, as the grid's count does */
-        const polyc__tile *t = NULL;
-        int in = w.n > 0 && polyc__walk_enter(&w, g->width, g->height);
-        while (in && w.n > 0) {
-            if (!(t = polyc__grid_tile(g, w.ix, w.iy))) {
-                int to = polyc__walk_skip_tiles(&w, g->width, g->height, g->tiles_x, g->wanted);
-                if (to <= 0)
-                    break; /* the end cell next, or out of the grid */
-                in = polyc__walk_enter(&w, g->width, g->height);
-                continue;
-            }
-            int left = 0, found = 0;
-            do {
-                if (polyc__cell_occupied(t, w.idx, thr)) {
-                    found = 1;
-                    break;
-                }
-                left = polyc__walk_step(&w);
-            } while (!left && w.n > 0);
-            if (found) {
-                cx = w.ix;
-                cy = w.iy;
-                break;
-            }
-            if (left && w.n > 0)
-                in = polyc__walk_enter(&w, g->width, g->height);
-        }
-        polyc__tile *e = polyc__grid_tile(g, cx, cy);
-        if (e && (polyc__cell_occupied(e, polyc__cell_index(cx, cy), thr) ||
-                  (b.hit && polyc__contour_data_alone(ctx, cx, cy, 0))))
-            e->contour[cy & (POLYC__TILE_SIDE - 1)] |= 1u << (cx & (POLYC__TILE_SIDE - 1));
-    }
-}
-
-/* How a scan goes into the grid (accumulate): */
-enum {
-    SCAN_NEW,      /* a new scan: its contour and its lines too */
-    SCAN_MOVED,    /* a corrected scan, in again at its new pose */
-    SCAN_OUT,      /* its counts and sums out again */
-    SCAN_RECOUNT   /* in again on cleared counts, as a batch counts it (its
-                    * records later: polyc__online_redo_records); the misses
-                    * on hit cells, which put a tile in the backlog, are
-                    * not tallied (every tile joins it: polyc__online_apply_corrections) */
-};
-
-/* The scan's beams into the grid and its endpoints into the sums; a new
- * scan's first occupied cells into the contour and its lines into the
- * prior. SCAN_OUT takes its counts and sums out again (the prior and the
- * contour keep what it gave: see docs/algorithm.md, "Online"). A corrected
- * scan's contour is cast once every waiting correction is in the grid
- * (polyc__online_apply_corrections). */
-static polyc_status accumulate(polyc_ctx *ctx, const polyc__scan *s, uint32_t number, int how)
-{
-    polyc__online *on = ctx->online;
-    const polyc__grid *g = &ctx->grid;
-    int take_back = how == SCAN_OUT;
-    polyc_status st = how == SCAN_RECOUNT ? polyc__grid_recount_scan(ctx, s)
-                                          : polyc__grid_add_scan(ctx, s, take_back, on->tile_miss);
-    int sums_ok = sum_endpoints(ctx, s, take_back ? -1.0f : 1.0f);
-    if (take_back)
-        return st;
-    /* A new scan whose endpoints outgrow the data cells, or the weighted
-     * points an update collects from them (their 2 x 2 blocks), goes out
-     * again: an update after an accepted add can always run (with blocks
-     * of one or two cells on average, limits.max_points / 2 points filled
-     * long before the cells did, and every update and the finish failed) */
-    if (how == SCAN_NEW && st == POLYC_OK &&
-        (!sums_ok || on->blocks_n > (uint32_t)polyc__points_bound(&ctx->cfg, &ctx->lim))) {
-        polyc__grid_add_scan(ctx, s, 1, on->tile_miss);
-        sum_endpoints(ctx, s, -1.0f);
-        on->refused = 1;
-        return polyc__fail(ctx, POLYC_ERR_NOMEM,
-                           "no room for the scan's endpoints (limits.max_points): not added");
-    }
-    if (how == SCAN_NEW) {
-        label_contour(ctx, s);
-        /* (the block is sized for it; without it, NULL: the same lines,
-         * the endpoints computed twice) */
-        size_t mark = ctx->arena.used;
-        polyc__online_scratch(&ctx->arena, on, 0, POLYC__STEP_LEARN);
-        polyc__prior_learn_scan(ctx, &on->prior, s, number, on->learn_cache, on->lim.max_scan_beams,
-                                &on->acc);
-        ctx->arena.used = mark;
-        on->learn_cache = NULL;
-    }
-    int64_t d = tile_of(g, (int32_t)floorf((s->x_m - g->frame_ox) * g->inv_cell),
-                        (int32_t)floorf((s->y_m - g->frame_oy) * g->inv_cell));
-    if (d >= 0 && !((on->pose_bits[d >> 5] >> (d & 31)) & 1u)) {
-        on->pose_bits[d >> 5] |= 1u << (d & 31);
-        on->spacing_stale = 1;
-    }
-    if (s->count > 1 && (on->min_step_rad == 0.0f || fabsf(s->step_rad) < on->min_step_rad))
-        on->min_step_rad = fabsf(s->step_rad);
-    on->last_x = s->x_m;
-    on->last_y = s->y_m;
-    if (st == POLYC_OK && !sums_ok)
-        st = polyc__fail(ctx, POLYC_ERR_NOMEM, "more cells with endpoints than limits.max_points");
-    return st;
-}
-
-/* Whether the scan at its pose lies inside the area (frame metres). */
-static int inside_area(const polyc_ctx *ctx, const polyc_scan *s)
-{
-    return polyc__frame_inside(ctx, s, 0.5f * polyc__narrow(ctx->online->lim.area_m) - AREA_MARGIN_M);
-}
-
-/* The stored form of a scan (pose relative to the frame). */
-static void store_scan(polyc_ctx *ctx, polyc__scan *d, const polyc_scan *s, uint32_t first)
-{
-    polyc__frame_scan(ctx, s, d);
-    d->start_rad = s->start_angle_rad;
-    d->step_rad = s->angle_step_rad;
-    d->min_m = s->min_range_m;
-    d->max_m = s->max_range_m;
-    d->first = first;
-    d->count = s->beam_count;
-}
-
-/* Kept scan k as the caller gave it, at another pose (frame-free metres). */
-static void moved_scan(const polyc_ctx *ctx, uint32_t k, double x, double y, double theta,
-                       polyc_scan *out)
-{
-    const polyc__scan *d = &ctx->scans[1 + k];
-    memset(out, 0, sizeof *out);
-    out->pose_x_m = x;
-    out->pose_y_m = y;
-    out->pose_theta_rad = theta;
-    out->start_angle_rad = d->start_rad;
-    out->angle_step_rad = d->step_rad;
-    out->min_range_m = d->min_m;
-    out->max_range_m = d->max_m;
-    out->beam_count = d->count;
-    out->range_m = ctx->ranges + d->first;
-}
-
-polyc_status polyc_online_add_scan(polyc_ctx *ctx, const polyc_scan *s, int keep, uint32_t *scan_id)
-{
-    polyc_status cst = polyc__check_ctx(ctx);
-    if (cst != POLYC_OK || !s)
-        return cst != POLYC_OK ? cst : POLYC_ERR_NULL;
-    ctx->err.msg = NULL;
-    polyc__online *on = ctx->online;
-    if (!on)
-        return polyc__fail(ctx, POLYC_ERR_STATE, "not an online context (polyc_online_init)");
-    if (s->beam_count && !s->range_m)
-        return polyc__fail(ctx, POLYC_ERR_NULL, "scan.range_m is NULL with beams");
-    const char *bad = polyc__scan_problem(s);
-    if (bad) {
-        ctx->err.scan = (int32_t)on->scans;
-        return polyc__fail(ctx, POLYC_ERR_SCAN, bad);
-    }
-    if (s->beam_count > on->lim.max_scan_beams)
-        return polyc__fail(ctx, POLYC_ERR_LIMIT, "a scan with more beams than limits.max_scan_beams");
-    if (keep && (on->kept_n >= on->lim.keep_scans || s->beam_count > on->lim.keep_beams - on->kept_beams))
-        return polyc__fail(ctx, POLYC_ERR_LIMIT, "no room to keep the scan (limits.keep_scans, keep_beams)");
-    if (on->moved_n > 0) { /* the waiting corrections go in first */
-        polyc_status cst2 = polyc__online_apply_corrections(ctx, NULL);
-        if (cst2 != POLYC_OK)
-            return cst2;
-    }
-    polyc__online_learn_due(ctx); /* (before this scan's lines join the prior) */
-    if (!ctx->have_frame) { /* the grid was laid out around (0, 0) */
-        polyc__frame_set(ctx, s->pose_x_m, s->pose_y_m);
-        polyc__frame_grid_origin(ctx, &ctx->grid, ctx->grid.frame_ox, ctx->grid.frame_oy);
-    }
-    if (!inside_area(ctx, s))
-        return polyc__fail(ctx, POLYC_ERR_EXTENT, "the scan reaches outside limits.area_m around the first pose");
-    /* the current scan is slot 0; a kept one has its own slot and ranges */
-    polyc__scan *d = &ctx->scans[0];
-    uint32_t first = 0;
-    if (keep) {
-        d = &ctx->scans[1 + on->kept_n];
-        first = on->lim.max_scan_beams + on->kept_beams;
-    }
-    store_scan(ctx, d, s, first);
-    for (uint32_t i = 0; i < s->beam_count; i++)
-        ctx->ranges[first + i] = s->range_m[i];
-    on->refused = 0;
-    polyc_status st = accumulate(ctx, d, on->scans, SCAN_NEW);
-    if (on->refused)
-        return st; /* (nothing of it stays: not counted, not kept) */
-    for (uint32_t i = 0; i < s->beam_count; i++) {
-        float r = s->range_m[i];
-        if (!(r >= 0.0f))
-            ctx->stats.beams_skipped++;
-        else if (r >= s->min_range_m && r < s->max_range_m)
-            ctx->stats.hits++;
-    }
-    if (keep) {
-        on->kept_id[on->kept_n++] = on->scans;
-        on->kept_beams += s->beam_count;
-    }
-    if (scan_id)
-        *scan_id = on->scans;
-    on->scans++;
-    on->pending++;
-    ctx->stats.scans = on->scans;
-    ctx->stats.beams += s->beam_count;
-    return st;
-}
-
-/* ---- pose corrections ----
- * polyc_online_correct only notes the new pose; the next update, finish or
- * add applies every correction waiting, in one of two ways:
- * - when every scan is kept and at least half of them moved, the grid's
- *   counts and the cells' sums are cleared and every kept scan counted
- *   again, as a batch build counts them: the tiles of all their hits
- *   wanted first, then one cast each, over the tiles not stored in one
- *   move; the records of those the updates make again after (grid.c).
- *   Taking each scan out and in again costs two casts a scan (intel: 910
- *   corrections in 288 ms, against 130 counted afresh), and the float sums
- *   come out exact;
- * - otherwise each moved scan's counts and sums are taken out exactly (the
- *   counters are integers; one that saturated is not taken below 0) and
- *   added back at the new pose.
- * Then the contour is cast, on the grid with every correction in it: a
- * scan cast as its correction came would meet, at its new pose, cells that
- * still held the misses of the scans not corrected yet, and see through
- * walls those scans saw (intel's drift row: 1.056 times the batch map's
- * BIC that way, 0.986 cast after all). When every scan is kept, the
- * contour is cleared and cast from all of them: the batch's contour, with
- * the old poses' gone; otherwise the old poses' contour stays (it only
- * seeds the trace). */
-
-polyc_status polyc_online_correct(polyc_ctx *ctx, uint32_t scan_id, double pose_x_m,
-                                  double pose_y_m, double pose_theta_rad)
-{
-    polyc_status cst = polyc__check_ctx(ctx);
-    if (cst != POLYC_OK)
-        return cst;
-    ctx->err.msg = NULL;
-    polyc__online *on = ctx->online;
-    if (!on)
-        return polyc__fail(ctx, POLYC_ERR_STATE, "not an online context (polyc_online_init)");
-    uint32_t lo = 0, hi = on->kept_n;
-    while (lo < hi) { /* kept_id ascends */
-        uint32_t mid = lo + (hi - lo) / 2;
-        if (on->kept_id[mid] < scan_id)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    if (lo >= on->kept_n || on->kept_id[lo] != scan_id)
-        return polyc__fail(ctx, POLYC_ERR_RANGE, "the scan was not kept (polyc_online_add_scan's keep)");
-    if (!polyc__pose_ok(pose_x_m, pose_y_m, pose_theta_rad))
-        return polyc__fail(ctx, POLYC_ERR_SCAN, "scan pose is not finite or beyond 1e7 m");
-    polyc_scan moved;
-    moved_scan(ctx, lo, pose_x_m, pose_y_m, pose_theta_rad, &moved);
-    if (!inside_area(ctx, &moved))
-        return polyc__fail(ctx, POLYC_ERR_EXTENT, "the scan reaches outside limits.area_m around the first pose");
-    on->new_pose[3 * (size_t)lo] = pose_x_m;
-    on->new_pose[3 * (size_t)lo + 1] = pose_y_m;
-    on->new_pose[3 * (size_t)lo + 2] = pose_theta_rad;
-    if (!((on->moved[lo >> 5] >> (lo & 31)) & 1u)) {
-        on->moved[lo >> 5] |= 1u << (lo & 31);
-        on->moved_n++;
-    }
-    on->pending++;
-    return POLYC_OK;
-}
-
-static int is_moved(const polyc__online *on, uint32_t k)
-{
-    return (on->moved[k >> 5] >> (k & 31)) & 1u;
-}
-
-/* Kept scan k at its waiting pose. */
-static void take_new_pose(polyc_ctx *ctx, uint32_t k)
-{
-    polyc__online *on = ctx->online;
-    polyc__scan *d = &ctx->scans[1 + k];
-    const double *p = &on->new_pose[3 * (size_t)k];
-    polyc_scan moved;
-    moved_scan(ctx, k, p[0], p[1], p[2], &moved);
-    store_scan(ctx, d, &moved, d->first);
-}
-
-/* Every kept scan counted afresh (every scan is kept); the records after. */
-static polyc_status count_afresh(polyc_ctx *ctx)
-{
-    polyc__online *on = ctx->online;
-    polyc__grid *g = &ctx->grid;
-    for (uint32_t k = 0; k < on->kept_n; k++)
-        if (is_moved(on, k))
-            take_new_pose(ctx, k);
-    polyc__grid_clear_counts(g);
-    polyc__cells_clear(on, g->tile_count);
-    memset(on->tile_new, 0, (size_t)g->tile_count * sizeof *on->tile_new);
-    memset(on->tile_miss, 0, (size_t)g->tile_count * sizeof *on->tile_miss);
-    for (uint32_t k = 0; k < on->kept_n; k++)
-        polyc__grid_want(ctx, &ctx->scans[1 + k]);
-    polyc_status st = POLYC_OK;
-    for (uint32_t k = 0; k < on->kept_n && st == POLYC_OK; k++)
-        st = accumulate(ctx, &ctx->scans[1 + k], on->kept_id[k], SCAN_RECOUNT);
-    polyc__grid_redo_begin(g);
-    on->redo_next = 0;
-    on->redo_end = on->kept_n;
-    return st;
-}
-
-void polyc__online_redo_records(polyc_ctx *ctx, uint32_t beams)
-{
-    polyc__online *on = ctx->online;
-    uint32_t done = 0;
-    while (on->redo_next < on->redo_end && done < beams) {
-        const polyc__scan *s = &ctx->scans[1 + on->redo_next++];
-        polyc__grid_redo_scan(ctx, s, on->tile_miss);
-        done += s->count > 0 ? s->count : 1;
-    }
-}
-
-/* Each moved scan out at its old pose and in at its new one. */
-static polyc_status move_each(polyc_ctx *ctx)
-{
-    polyc__online *on = ctx->online;
-    polyc_status st = POLYC_OK;
-    for (uint32_t k = 0; k < on->kept_n && st == POLYC_OK; k++) {
-        if (!is_moved(on, k))
-            continue;
-        polyc__scan *d = &ctx->scans[1 + k];
-        st = accumulate(ctx, d, on->kept_id[k], SCAN_OUT);
-        take_new_pose(ctx, k);
-        if (st == POLYC_OK)
-            st = accumulate(ctx, d, on->kept_id[k], SCAN_MOVED); /* (the prior has its lines) */
-    }
-    return st;
-}
-
-/* The contour of the moved scans (all: cleared, and every kept scan's).
- * Many scans are cast as the batch casts, on the tiles' marks (contour.c),
- * which pass over the tiles without an occupied cell in one move: for
- * intel's 910 scans 75 -> 35 ms. The marks cost a test per stored cell,
- * so a few scans are labelled one by one on the counts; the bits are the
- * same either way. */
-static void relabel(polyc_ctx *ctx, int all)
-{
-    polyc__online *on = ctx->online;
-    polyc__grid *g = &ctx->grid;
-    const uint32_t *only = all ? NULL : on->moved;
-    uint64_t beams = (uint64_t)(all ? on->kept_n : on->moved_n) * on->lim.max_scan_beams;
-    if (beams * RELABEL_CELLS_PER_BEAM >= (uint64_t)g->tile_count * POLYC__TILE_CELLS &&
-        polyc__contour_cast(ctx, &ctx->scans[1], on->kept_n, all, only))
-        return;
-    if (all)
-        for (uint32_t t = 0; t < g->tile_count; t++)
-            memset(g->tiles[t].contour, 0, sizeof g->tiles[t].contour);
-    for (uint32_t k = 0; k < on->kept_n; k++)
-        if (all || is_moved(on, k))
-            label_contour(ctx, &ctx->scans[1 + k]);
-}
-
-/* The angle prior's counts and the accuracy's pairs cannot be taken out
- * one scan at a time (a pair's offset is not kept). When every scan is
- * kept, both are forgotten and learned again from all of them at their
- * poses now, and every tile joins the backlog: its points' weights change.
- * Without it the drifted scans' pairs stay, and the weights they give (a
- * band's, where the drift spread a wall) fit the corrected map loosely:
- * intel's drift experiment came out at 1.23 times the batch map's BIC on
- * the true poses' data. The learning waits for the next round or scan
- * (polyc__online_learn_due): nothing reads the two before, and the update
- * that applies the corrections does nothing else. */
-void polyc__online_learn_due(polyc_ctx *ctx)
-{
-    polyc__online *on = ctx->online;
-    if (!on->learn_due)
-        return;
-    on->learn_due = 0;
-    polyc__prior_forget(&on->prior);
-    polyc__accuracy_forget(&on->acc);
-    for (uint32_t k = 0; k < on->kept_n; k++) {
-        size_t mark = ctx->arena.used;
-        polyc__online_scratch(&ctx->arena, on, 0, POLYC__STEP_LEARN);
-        polyc__prior_learn_scan(ctx, &on->prior, &ctx->scans[1 + k], on->kept_id[k], on->learn_cache,
-                                on->lim.max_scan_beams, &on->acc);
-        ctx->arena.used = mark;
-        on->learn_cache = NULL;
-    }
-}
-
-polyc_status polyc__online_apply_corrections(polyc_ctx *ctx, uint64_t *beams_cast)
-{
-    polyc__online *on = ctx->online;
-    if (beams_cast)
-        *beams_cast = 0;
-    if (on->moved_n == 0)
-        return POLYC_OK;
-    int all = on->kept_n == on->scans;
-    float lx = on->last_x, ly = on->last_y;
-    int afresh = all && 2u * on->moved_n >= on->kept_n;
-    if (beams_cast) {
-        uint64_t moved_beams = 0;
-        for (uint32_t k = 0; k < on->kept_n; k++)
-            if (is_moved(on, k))
-                moved_beams += ctx->scans[1 + k].count;
-        /* counted (afresh: every kept scan once; else each moved one out
-         * and in), then their contour cast */
-        *beams_cast = (afresh ? on->kept_beams : 2u * moved_beams) +
-                      (all ? on->kept_beams : moved_beams);
-    }
-    if (!afresh) /* (a scan taken out takes its misses out of the records) */
-        polyc__online_redo_records(ctx, UINT32_MAX);
-    polyc_status st = afresh ? count_afresh(ctx) : move_each(ctx);
-    on->last_x = lx; /* the robot is where the latest scan was */
-    on->last_y = ly;
-    relabel(ctx, all);
-    memset(on->moved, 0, (on->lim.keep_scans / 32u + 1u) * sizeof *on->moved);
-    on->moved_n = 0;
-    if (all) {
-        polyc__online_backlog_all(ctx);
-        on->learn_due = 1;
-    }
-    return st;
-}
-
 uint64_t polyc_online_version(const polyc_ctx *ctx)
 {
-    return polyc__check_ctx(ctx) == POLYC_OK && ctx->online ? ctx->online->version : 0;
+    return polyc__check_ctx(ctx) == POLYC_OK && ctx->online ? ctx->online->pubs.version : 0;
 }

@@ -10,10 +10,10 @@
 
 void polyc__online_pub_carve(polyc__arena *a, polyc__online *on, int32_t lines)
 {
-    on->pub = polyc__alloc(a, (size_t)lines, sizeof(polyc__pub));
-    on->pub_next = polyc__alloc(a, (size_t)lines, sizeof(polyc__pub));
-    on->gone_cap = (uint32_t)lines;
-    on->gone = polyc__alloc(a, on->gone_cap, sizeof(polyc__pub));
+    on->pubs.pub = polyc__alloc(a, (size_t)lines, sizeof(polyc__pub));
+    on->pubs.pub_next = polyc__alloc(a, (size_t)lines, sizeof(polyc__pub));
+    on->pubs.gone_cap = (uint32_t)lines;
+    on->pubs.gone = polyc__alloc(a, on->pubs.gone_cap, sizeof(polyc__pub));
 }
 
 /* FNV-1a over the polyline's coordinates and whether it is closed. */
@@ -63,15 +63,15 @@ static void sort_by_id(polyc__pub *p, uint32_t n)
 
 static void remember_removal(polyc__online *on, const polyc__pub *p, uint64_t version)
 {
-    if (on->gone_n == on->gone_cap) { /* the oldest is forgotten */
-        on->forgot_through = on->gone[on->gone_first].version;
-        on->gone_first = (on->gone_first + 1) % on->gone_cap;
-        on->gone_n--;
+    if (on->pubs.gone_n == on->pubs.gone_cap) { /* the oldest is forgotten */
+        on->pubs.forgot_through = on->pubs.gone[on->pubs.gone_first].version;
+        on->pubs.gone_first = (on->pubs.gone_first + 1) % on->pubs.gone_cap;
+        on->pubs.gone_n--;
     }
-    polyc__pub *c = &on->gone[(on->gone_first + on->gone_n) % on->gone_cap];
+    polyc__pub *c = &on->pubs.gone[(on->pubs.gone_first + on->pubs.gone_n) % on->pubs.gone_cap];
     *c = *p;
     c->version = version;
-    on->gone_n++;
+    on->pubs.gone_n++;
 }
 
 polyc_status polyc__online_publish(polyc_ctx *ctx, uint32_t *changed)
@@ -83,8 +83,8 @@ polyc_status polyc__online_publish(polyc_ctx *ctx, uint32_t *changed)
                                               polyc__bytes(1, sizeof(polyc__online)) + ctx->arena.peak);
     ctx->stage = POLYC__STAGE_OPTIMIZED; /* the results are readable */
     const polyc__flat *f = &ctx->flat;
-    uint64_t v = on->version + 1;
-    polyc__pub *next = on->pub_next;
+    uint64_t v = on->pubs.version + 1;
+    polyc__pub *next = on->pubs.pub_next;
     for (uint32_t i = 0; i < f->count; i++) {
         next[i].id = f->id[i];
         next[i].hash = hash_of(f, i);
@@ -93,29 +93,29 @@ polyc_status polyc__online_publish(polyc_ctx *ctx, uint32_t *changed)
     sort_by_id(next, f->count);
     /* both sorted by id: a merge */
     uint32_t a = 0, b = 0, n = 0;
-    while (a < on->pub_n || b < f->count) {
-        if (b >= f->count || (a < on->pub_n && on->pub[a].id < next[b].id)) {
-            remember_removal(on, &on->pub[a], v);
+    while (a < on->pubs.pub_n || b < f->count) {
+        if (b >= f->count || (a < on->pubs.pub_n && on->pubs.pub[a].id < next[b].id)) {
+            remember_removal(on, &on->pubs.pub[a], v);
             a++;
             n++;
-        } else if (a >= on->pub_n || next[b].id < on->pub[a].id) {
+        } else if (a >= on->pubs.pub_n || next[b].id < on->pubs.pub[a].id) {
             b++; /* added */
             n++;
         } else {
-            next[b].born = on->pub[a].born;
-            if (next[b].hash == on->pub[a].hash)
-                next[b].version = on->pub[a].version;
+            next[b].born = on->pubs.pub[a].born;
+            if (next[b].hash == on->pubs.pub[a].hash)
+                next[b].version = on->pubs.pub[a].version;
             else
                 n++;
             a++;
             b++;
         }
     }
-    on->pub_next = on->pub;
-    on->pub = next;
-    on->pub_n = f->count;
+    on->pubs.pub_next = on->pubs.pub;
+    on->pubs.pub = next;
+    on->pubs.pub_n = f->count;
     if (n > 0) /* else every entry kept its version */
-        on->version = v;
+        on->pubs.version = v;
     *changed = n;
     return POLYC_OK;
 }
@@ -130,14 +130,14 @@ polyc_status polyc_online_changes(const polyc_ctx *ctx, uint64_t since, polyc_ch
     const polyc__online *on = ctx->online;
     if (!on)
         return POLYC_ERR_STATE;
-    if (since < on->forgot_through)
+    if (since < on->pubs.forgot_through)
         return POLYC_ERR_RANGE;
     uint32_t n = 0;
-    for (uint32_t i = 0; i < on->pub_n; i++)
-        n += on->pub[i].version > since;
+    for (uint32_t i = 0; i < on->pubs.pub_n; i++)
+        n += on->pubs.pub[i].version > since;
     /* a removal since `since` of a polyline born after it: never seen there */
-    for (uint32_t k = 0; k < on->gone_n; k++) {
-        const polyc__pub *g = &on->gone[(on->gone_first + k) % on->gone_cap];
+    for (uint32_t k = 0; k < on->pubs.gone_n; k++) {
+        const polyc__pub *g = &on->pubs.gone[(on->pubs.gone_first + k) % on->pubs.gone_cap];
         n += g->version > since && g->born <= since;
     }
     *count = n;
@@ -145,8 +145,8 @@ polyc_status polyc_online_changes(const polyc_ctx *ctx, uint64_t since, polyc_ch
         return POLYC_OK;
     /* the live ones are sorted by id; the removed ones merged in by id */
     uint32_t m = 0;
-    for (uint32_t i = 0; i < on->pub_n; i++) {
-        const polyc__pub *p = &on->pub[i];
+    for (uint32_t i = 0; i < on->pubs.pub_n; i++) {
+        const polyc__pub *p = &on->pubs.pub[i];
         if (p->version <= since)
             continue;
         out[m].id = p->id;
@@ -154,8 +154,8 @@ polyc_status polyc_online_changes(const polyc_ctx *ctx, uint64_t since, polyc_ch
         out[m].version = p->version;
         m++;
     }
-    for (uint32_t k = 0; k < on->gone_n; k++) {
-        const polyc__pub *g = &on->gone[(on->gone_first + k) % on->gone_cap];
+    for (uint32_t k = 0; k < on->pubs.gone_n; k++) {
+        const polyc__pub *g = &on->pubs.gone[(on->pubs.gone_first + k) % on->pubs.gone_cap];
         if (g->version <= since || g->born > since)
             continue;
         uint32_t j = m++;

@@ -25,8 +25,43 @@ static void move_point(polyc__opt *o, polyc__online *on, uint32_t i, uint32_t k)
 /* The taken tiles are marked TAKEN in dirty_since (online_round.c). */
 static int taken(const polyc__online *on, uint32_t d)
 {
-    return on->dirty_since[d] == UINT32_MAX;
+    return on->backlog.dirty_since[d] == UINT32_MAX;
 }
+
+/* The weighted points of the tiles at directory entries dirs (nd of
+ * them), unsorted, into out, view and tile (its directory entry), at most
+ * cap; returns their count (-1: more than cap); tile_raw (by tile storage
+ * index) gets each tile's endpoints. */
+static int32_t points_of_tiles(polyc__opt *o, const uint32_t *dirs, uint32_t nd, polyc__point *out,
+                               float *view, uint32_t *tile, int32_t cap, float *tile_raw)
+{
+    polyc_ctx *ctx = o->ctx;
+    polyc__grid *g = &ctx->grid;
+    uint32_t n = 0;
+    for (uint32_t j = 0; j < nd; j++)
+        if (g->dir[dirs[j]]) {
+            polyc__tile *t = &g->tiles[g->dir[dirs[j]] - 1];
+            polyc__block_mark_tile(ctx, t);
+            uint32_t next = polyc__block_number_tile(t, n);
+            if (next > (uint32_t)cap)
+                return -1;
+            for (uint32_t i = n; i < next; i++)
+                tile[i] = dirs[j];
+            n = next;
+        }
+    memset(out, 0, (size_t)n * sizeof *out);
+    memset(view, 0, (size_t)n * 2 * sizeof *view);
+    for (uint32_t j = 0; j < nd; j++)
+        if (g->dir[dirs[j]]) {
+            tile_raw[g->dir[dirs[j]] - 1] = polyc__online_sum_tile(ctx, (int32_t)dirs[j], out, view);
+            polyc__block_finish_tile(ctx, (int32_t)dirs[j], out);
+        }
+    n = polyc__online_drop_empty(out, view, tile, n);
+    for (uint32_t i = 0; i < n; i++)
+        polyc__point_weigh(&o->prior, &out[i]);
+    return (int32_t)n;
+}
+
 
 static polyc_status refresh(polyc_ctx *ctx, uint32_t n_taken);
 
@@ -41,10 +76,10 @@ polyc_status polyc__online_refresh_tiles(polyc_ctx *ctx, uint32_t n_taken)
     else
         st = refresh(ctx, n_taken);
     ctx->arena.used = mark;
-    on->pts_tmp = NULL;
-    on->view_tmp = NULL;
-    on->fresh_tile = NULL;
-    on->fresh_bucket = NULL;
+    on->scr.pts_tmp = NULL;
+    on->scr.view_tmp = NULL;
+    on->scr.fresh_tile = NULL;
+    on->scr.fresh_bucket = NULL;
     return st;
 }
 
@@ -62,18 +97,18 @@ static polyc_status refresh(polyc_ctx *ctx, uint32_t n_taken)
     int32_t cap = polyc__points_bound(o->cfg, &ctx->lim);
     const polyc__grid *g = &ctx->grid;
     for (uint32_t j = 0; j < n_taken; j++)
-        if (g->dir[on->dirty[j]]) {
-            o->d.n -= on->tile_raw[g->dir[on->dirty[j]] - 1];
-            on->tile_new[g->dir[on->dirty[j]] - 1] = 0;
-            on->tile_miss[g->dir[on->dirty[j]] - 1] = 0;
+        if (g->dir[on->backlog.dirty[j]]) {
+            o->d.n -= on->backlog.tile_raw[g->dir[on->backlog.dirty[j]] - 1];
+            on->backlog.tile_new[g->dir[on->backlog.dirty[j]] - 1] = 0;
+            on->backlog.tile_miss[g->dir[on->backlog.dirty[j]] - 1] = 0;
         }
-    int32_t nf = polyc__points_of_tiles(o, on->dirty, n_taken, on->pts_tmp, on->view_tmp,
-                                        on->fresh_tile, cap, on->tile_raw);
+    int32_t nf = points_of_tiles(o, on->backlog.dirty, n_taken, on->scr.pts_tmp, on->scr.view_tmp, on->scr.fresh_tile,
+                                 cap, on->backlog.tile_raw);
     if (nf < 0)
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "more weighted data points than limits.max_points");
     for (uint32_t j = 0; j < n_taken; j++)
-        if (g->dir[on->dirty[j]])
-            o->d.n += on->tile_raw[g->dir[on->dirty[j]] - 1];
+        if (g->dir[on->backlog.dirty[j]])
+            o->d.n += on->backlog.tile_raw[g->dir[on->backlog.dirty[j]] - 1];
     /* old points of the taken tiles out of the error; the kept ones counted
      * per bucket (nothing moves before the room is known) */
     int32_t nb = h->bx * h->by;
@@ -105,8 +140,8 @@ static polyc_status refresh(polyc_ctx *ctx, uint32_t n_taken)
             move_point(o, on, i, w++);
     memset(h->pt_start, 0, ((size_t)nb + 1) * sizeof(uint32_t));
     for (int32_t j = 0; j < nf; j++) {
-        on->fresh_bucket[j] = polyc__bucket_of(h, on->pts_tmp[j].x, on->pts_tmp[j].y);
-        h->pt_start[on->fresh_bucket[j] + 1]++;
+        on->scr.fresh_bucket[j] = polyc__bucket_of(h, on->scr.pts_tmp[j].x, on->scr.pts_tmp[j].y);
+        h->pt_start[on->scr.fresh_bucket[j] + 1]++;
     }
     for (int32_t b = 0; b < nb; b++)
         h->pt_start[b + 1] += h->pt_start[b] + kept_in[b];
@@ -118,12 +153,12 @@ static polyc_status refresh(polyc_ctx *ctx, uint32_t n_taken)
         kept_in[b] = h->pt_start[b] + n_b; /* where its new points go */
     }
     for (int32_t j = 0; j < nf; j++) {
-        uint32_t k = kept_in[on->fresh_bucket[j]]++;
-        o->d.pts[k] = on->pts_tmp[j];
-        o->d.pt_view[2 * k] = on->view_tmp[2 * j];
-        o->d.pt_view[2 * k + 1] = on->view_tmp[2 * j + 1];
+        uint32_t k = kept_in[on->scr.fresh_bucket[j]]++;
+        o->d.pts[k] = on->scr.pts_tmp[j];
+        o->d.pt_view[2 * k] = on->scr.view_tmp[2 * j];
+        o->d.pt_view[2 * k + 1] = on->scr.view_tmp[2 * j + 1];
         o->d.pt_seg[k] = POLYC__NONE - 1; /* new: assigned below */
-        on->pt_tile[k] = on->fresh_tile[j];
+        on->pt_tile[k] = on->scr.fresh_tile[j];
     }
     o->d.np = kept + nf;
     for (int32_t i = 0; i < o->d.np; i++)

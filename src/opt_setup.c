@@ -162,7 +162,7 @@ polyc_status polyc__opt_refresh(polyc__opt *o)
         return st;
     polyc__hash_clear(o);
     size_t mark = ctx->arena.used; /* the points' scratch, given back below */
-    if (!polyc__online_scratch(&ctx->arena, on, polyc__points_bound(o->cfg, &ctx->lim), POLYC__STEP_POINTS))
+    if (!ctx->layer->points_scratch(ctx, polyc__points_bound(o->cfg, &ctx->lim)))
         st = polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the data points");
     else
         st = polyc__points_collect(o);

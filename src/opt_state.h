@@ -227,12 +227,6 @@ polyc_status polyc__points_collect(polyc__opt *o);
 void polyc__points_spans(polyc__opt *o, int exact);
 /* a point's weight by the accuracy where it lies */
 void polyc__point_weigh(const polyc__prior *prior, polyc__point *p);
-/* online: the weighted points of the tiles at directory entries dirs (nd
- * of them), unsorted, into out, view and tile (its directory entry), at
- * most cap; returns their count (-1: more than cap); tile_raw (by tile
- * storage index) gets each tile's endpoints */
-int32_t polyc__points_of_tiles(polyc__opt *o, const uint32_t *dirs, uint32_t nd, polyc__point *out,
-                               float *view, uint32_t *tile, int32_t cap, float *tile_raw);
 /* online: the points (in o->d), carved once (their unsorted copy is the
  * update's scratch, online.h) */
 int polyc__points_carve_online(polyc__arena *a, polyc__opt *o);

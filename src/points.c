@@ -4,7 +4,7 @@
  * per block of 2 x 2 grid cells (count, mean, second moments: squared distances to a line
  * stay exact) or, with POLYC_FLAG_EXACT_POINTS, one point per endpoint;
  * sorted by spatial-hash bucket. */
-#include "online.h"
+#include "optimize.h"
 
 #include <math.h>
 #include <string.h>
@@ -39,141 +39,16 @@ static float cell_centre(float origin, int32_t i, float cell)
     return (float)(origin + ((float)i + 0.5f) * (float)cell);
 }
 
-/* Weighted points gather the endpoints of a block of 2 x 2 grid cells (5 cm
- * at the default grid): a quarter of the points to score, while the moments
- * keep each block's squared distances exact (measured in docs/performance.md). */
-#define BLOCK_SHIFT 1
-#define BLOCK_SIDE (1 << BLOCK_SHIFT)
-
 /* The block of an endpoint (its lower-left cell) and the offset from the
  * block's centre. */
 static void to_block(const endpoint *e, float cell, int32_t *bx, int32_t *by, float *fx, float *fy)
 {
-    const int32_t mask = ~(int32_t)(BLOCK_SIDE - 1);
-    const float half = 0.5f * (float)(BLOCK_SIDE - 1);
+    const int32_t mask = ~(int32_t)(POLYC__BLOCK_SIDE - 1);
+    const float half = 0.5f * (float)(POLYC__BLOCK_SIDE - 1);
     *bx = e->ix & mask;
     *by = e->iy & mask;
     *fx = e->fx + ((float)(e->ix - *bx) - half) * cell;
     *fy = e->fy + ((float)(e->iy - *by) - half) * cell;
-}
-
-static float block_centre(float origin, int32_t i, float cell)
-{
-    return (float)(origin + ((float)i + 0.5f * BLOCK_SIDE) * (float)cell);
-}
-
-/* Marks the blocks of tile t that hold data, from the counters (the grid
- * counts a hit only in the end cell of a reflection, the cell endpoint_of
- * finds, so a cell with hits that passes the data rule holds an endpoint
- * that endpoint_of accepts, and only such cells do: the same marks as a
- * pass over the beams, without computing every endpoint once more). */
-static void mark_tile(const polyc_ctx *ctx, polyc__tile *t)
-{
-    const int32_t side = POLYC__TILE_SIDE, block = ~(int32_t)(BLOCK_SIDE - 1);
-    memset(t->mark, 0, sizeof t->mark);
-    for (int32_t r = 0; r < side; r++) {
-        /* most rows have no hit at all: one test for the row first */
-        uint64_t any = 0, word;
-        for (size_t at = 0; at < sizeof t->hits / POLYC__TILE_SIDE; at += sizeof word) {
-            memcpy(&word, (const char *)(t->hits + r * side) + at, sizeof word);
-            any |= word;
-        }
-        for (int32_t c = 0; any != 0 && c < side; c++)
-            if (t->hits[r * side + c] != 0 &&
-                polyc__cell_holds_data(t, r * side + c, ctx->cfg.data_min_m))
-                t->mark[r & block] |= 1u << (c & block);
-    }
-}
-
-/* Numbers tile t's marked blocks from n; returns the next number. */
-static uint32_t number_tile(polyc__tile *t, uint32_t n)
-{
-    t->mark_base = n;
-    uint32_t in_tile = 0;
-    for (int r = 0; r < POLYC__TILE_SIDE; r++) {
-        t->mark_row[r] = (uint16_t)in_tile;
-        uint32_t bits = t->mark[r];
-        while (bits) {
-            bits &= bits - 1;
-            in_tile++;
-        }
-    }
-    return n + in_tile;
-}
-
-/* Every tile's blocks marked and numbered in storage order; their count. */
-static uint32_t mark_blocks(polyc_ctx *ctx)
-{
-    polyc__grid *g = &ctx->grid;
-    uint32_t n = 0;
-    for (uint32_t k = 0; k < g->tile_count; k++)
-        mark_tile(ctx, &g->tiles[k]);
-    for (uint32_t k = 0; k < g->tile_count; k++)
-        n = number_tile(&g->tiles[k], n);
-    return n;
-}
-
-/* The number of the marked block (bx, by) of tile t. */
-static uint32_t block_number(const polyc__tile *t, int32_t bx, int32_t by)
-{
-    uint32_t row = t->mark[by & 31], col = (uint32_t)(bx & 31);
-    uint32_t below = row & ((1u << col) - 1u);
-    uint32_t c = 0;
-    while (below) {
-        below &= below - 1;
-        c++;
-    }
-    return t->mark_base + t->mark_row[by & 31] + c;
-}
-
-/* Means and central moments from the sums of the points of the tile at
- * directory entry d, in the numbering order of its marks. */
-static void finish_tile(const polyc_ctx *ctx, int32_t d, polyc__point *tmp)
-{
-    const polyc__grid *g = &ctx->grid;
-    float ox = g->frame_ox, oy = g->frame_oy;
-    const polyc__tile *t = &g->tiles[g->dir[d] - 1];
-    int32_t tx = (d % g->tiles_x) << POLYC__TILE_SHIFT, ty = (d / g->tiles_x) << POLYC__TILE_SHIFT;
-    uint32_t k = t->mark_base;
-    for (int r = 0; r < POLYC__TILE_SIDE; r++)
-        for (int c = 0; t->mark[r] != 0 && c < POLYC__TILE_SIDE; c++) { /* most rows: none */
-            if (!((t->mark[r] >> c) & 1u))
-                continue;
-            polyc__point *p = &tmp[k++];
-            if (p->w <= 0.0f)
-                continue; /* online: cells with hits but no sums (they ran out) */
-            float mx = p->x / p->w, my = p->y / p->w;
-            p->cxx -= p->w * mx * mx;
-            p->cxy -= p->w * mx * my;
-            p->cyy -= p->w * my * my;
-            if (p->cxx < 0.0f) p->cxx = 0.0f;
-            if (p->cyy < 0.0f) p->cyy = 0.0f;
-            p->x = block_centre(ox, tx + c, g->cell_m) + mx;
-            p->y = block_centre(oy, ty + r, g->cell_m) + my;
-        }
-}
-
-static void finish_moments(polyc_ctx *ctx, polyc__point *tmp)
-{
-    const polyc__grid *g = &ctx->grid;
-    int32_t dir_n = g->tiles_x * g->tiles_y;
-    for (int32_t d = 0; d < dir_n; d++)
-        if (g->dir[d])
-            finish_tile(ctx, d, tmp);
-}
-
-/* Every tile's blocks marked and numbered, and that many points (and
- * views, if any) zeroed; POLYC_ERR_NOMEM past cap. */
-static polyc_status begin_blocks(polyc_ctx *ctx, polyc__point *tmp, float *view, int32_t cap,
-                                 uint32_t *n)
-{
-    *n = mark_blocks(ctx);
-    if (*n > (uint32_t)cap)
-        return polyc__fail(ctx, POLYC_ERR_NOMEM, "more weighted data points than limits.max_points");
-    memset(tmp, 0, (size_t)*n * sizeof *tmp);
-    if (view)
-        memset(view, 0, (size_t)*n * 2 * sizeof *view);
-    return POLYC_OK;
 }
 
 /* One weighted point per marked block, from the endpoints. */
@@ -183,7 +58,7 @@ static polyc_status collect_cells(polyc__opt *o, polyc__point *tmp, float *view,
     polyc_ctx *ctx = o->ctx;
     polyc__grid *g = &ctx->grid;
     uint32_t n;
-    polyc_status st = begin_blocks(ctx, tmp, view, cap, &n);
+    polyc_status st = polyc__blocks_begin(ctx, tmp, view, cap, &n);
     if (st != POLYC_OK)
         return st;
     endpoint e;
@@ -194,7 +69,7 @@ static polyc_status collect_cells(polyc__opt *o, polyc__point *tmp, float *view,
             int32_t bx, by;
             float fx, fy;
             to_block(&e, g->cell_m, &bx, &by, &fx, &fy);
-            uint32_t at = block_number(polyc__grid_tile(g, e.ix, e.iy), bx, by); /* the block's tile too */
+            uint32_t at = polyc__block_number(polyc__grid_tile(g, e.ix, e.iy), bx, by); /* the block's tile too */
             polyc__point *p = &tmp[at];
             if (view) {
                 view[2 * at] += e.vx;
@@ -208,118 +83,9 @@ static polyc_status collect_cells(polyc__opt *o, polyc__point *tmp, float *view,
             p->cxy += fx * fy;
             p->cyy += fy * fy;
         }
-    finish_moments(ctx, tmp);
+    polyc__blocks_finish(ctx, tmp);
     *n_out = (int32_t)n;
     return POLYC_OK;
-}
-
-/* The sums of the cells of the tile at directory entry d (online: the
- * scans are not kept) into its marked blocks' points. A cell's offsets
- * move to its block's centre by (dx, dy): the sums of products gain the
- * cross terms. Returns the endpoints taken. */
-static float sum_tile(const polyc_ctx *ctx, int32_t d, polyc__point *tmp, float *view)
-{
-    const polyc__online *on = ctx->online;
-    const polyc__grid *g = &ctx->grid;
-    const float half = 0.5f * (float)(BLOCK_SIDE - 1);
-    uint32_t k = g->dir[d] - 1;
-    const polyc__tile *t = &g->tiles[k];
-    float raw = 0.0f;
-    for (int idx = 0; idx < POLYC__TILE_CELLS; idx++) {
-        if (!t->hits[idx] || !polyc__cell_holds_data(t, idx, ctx->cfg.data_min_m))
-            continue;
-        uint32_t e = polyc__cell_find(on, polyc__cell_key(k, idx));
-        if (!e)
-            continue;
-        const polyc__cell_sums *c = &on->sums[e - 1];
-        int32_t ix = idx & (POLYC__TILE_SIDE - 1), iy = idx >> POLYC__TILE_SHIFT;
-        int32_t bx = ix & ~(int32_t)(BLOCK_SIDE - 1), by = iy & ~(int32_t)(BLOCK_SIDE - 1);
-        float dx = ((float)(ix - bx) - half) * g->cell_m, dy = ((float)(iy - by) - half) * g->cell_m;
-        float w = (float)c->n;
-        uint32_t at = block_number(t, bx, by);
-        polyc__point *p = &tmp[at];
-        view[2 * at] += c->vx;
-        view[2 * at + 1] += c->vy;
-        p->w += w;
-        p->x += c->fx + w * dx;
-        p->y += c->fy + w * dy;
-        p->cxx += c->fxx + 2.0f * dx * c->fx + w * dx * dx;
-        p->cxy += c->fxy + dx * c->fy + dy * c->fx + w * dx * dy;
-        p->cyy += c->fyy + 2.0f * dy * c->fy + w * dy * dy;
-        raw += (float)w;
-    }
-    return raw;
-}
-
-/* Online, a block whose cells hold hits but no sums (limits.max_points ran
- * out as they came) has no point: the others move up. */
-static uint32_t drop_empty(polyc__point *pts, float *view, uint32_t *tile, uint32_t n)
-{
-    uint32_t m = 0;
-    for (uint32_t i = 0; i < n; i++) {
-        if (pts[i].w <= 0.0f)
-            continue;
-        pts[m] = pts[i];
-        view[2 * m] = view[2 * i];
-        view[2 * m + 1] = view[2 * i + 1];
-        tile[m++] = tile[i];
-    }
-    return m;
-}
-
-static polyc_status collect_sums(polyc__opt *o, polyc__point *tmp, float *view, int32_t cap,
-                                 int32_t *n_out)
-{
-    polyc_ctx *ctx = o->ctx;
-    polyc__grid *g = &ctx->grid;
-    uint32_t n;
-    polyc_status st = begin_blocks(ctx, tmp, view, cap, &n);
-    if (st != POLYC_OK)
-        return st;
-    int32_t dir_n = g->tiles_x * g->tiles_y;
-    polyc__online *on = ctx->online;
-    for (int32_t d = 0; d < dir_n; d++)
-        if (g->dir[d]) {
-            /* tile k's points are numbered up to tile k + 1's first */
-            uint32_t k = g->dir[d] - 1;
-            uint32_t end = k + 1 < g->tile_count ? g->tiles[k + 1].mark_base : n;
-            for (uint32_t i = g->tiles[k].mark_base; i < end; i++)
-                on->fresh_tile[i] = (uint32_t)d;
-            on->tile_raw[k] = sum_tile(ctx, d, tmp, view);
-        }
-    finish_moments(ctx, tmp);
-    *n_out = (int32_t)drop_empty(tmp, view, on->fresh_tile, n);
-    return POLYC_OK;
-}
-
-int32_t polyc__points_of_tiles(polyc__opt *o, const uint32_t *dirs, uint32_t nd, polyc__point *out,
-                               float *view, uint32_t *tile, int32_t cap, float *tile_raw)
-{
-    polyc_ctx *ctx = o->ctx;
-    polyc__grid *g = &ctx->grid;
-    uint32_t n = 0;
-    for (uint32_t j = 0; j < nd; j++)
-        if (g->dir[dirs[j]]) {
-            polyc__tile *t = &g->tiles[g->dir[dirs[j]] - 1];
-            mark_tile(ctx, t);
-            uint32_t next = number_tile(t, n);
-            if (next > (uint32_t)cap)
-                return -1;
-            for (uint32_t i = n; i < next; i++)
-                tile[i] = dirs[j];
-            n = next;
-        }
-    memset(out, 0, (size_t)n * sizeof *out);
-    memset(view, 0, (size_t)n * 2 * sizeof *view);
-    for (uint32_t j = 0; j < nd; j++)
-        if (g->dir[dirs[j]]) {
-            tile_raw[g->dir[dirs[j]] - 1] = sum_tile(ctx, (int32_t)dirs[j], out, view);
-            finish_tile(ctx, (int32_t)dirs[j], out);
-        }
-    n = drop_empty(out, view, tile, n);
-    for (uint32_t i = 0; i < n; i++)
-        polyc__point_weigh(&o->prior, &out[i]);
-    return (int32_t)n;
 }
 
 static polyc_status collect_raw(polyc__opt *o, polyc__point *tmp, float *view, int32_t cap,
@@ -450,11 +216,12 @@ void polyc__points_spans(polyc__opt *o, int exact)
     const polyc_ctx *ctx = o->ctx;
     o->d.point_span_m = ctx->from_grid ? ctx->grid.cell_m
                       : exact        ? 0.0f
-                                     : ctx->grid.cell_m * (float)BLOCK_SIDE;
+                                     : ctx->grid.cell_m * (float)POLYC__BLOCK_SIDE;
     o->d.support_m = polyc__maxf(POLYC__SUPPORT_M, o->d.point_span_m);
 }
 
-/* online: the points, carved once */
+/* the points and their views carved once, for an optimiser that lives
+ * across updates (a layer's, whose collect fills them) */
 int polyc__points_carve_online(polyc__arena *a, polyc__opt *o)
 {
     int32_t cap = polyc__points_bound(o->cfg, &o->ctx->lim);
@@ -480,31 +247,31 @@ polyc_status polyc__points_collect(polyc__opt *o)
      * where the endpoints were seen from: scans (more than one) only */
     int viewed = polyc__points_viewed(ctx);
     size_t mark = ctx->arena.used;
-    polyc__point *tmp;
-    float *tmp_view;
-    if (ctx->online) { /* the points carved once, the copy by the caller (online.h) */
-        tmp = ctx->online->pts_tmp;
-        tmp_view = ctx->online->view_tmp;
-    } else {
-        int ok = points_carve(&ctx->arena, cap, viewed, &o->d.pts, &o->d.pt_view);
-        mark = ctx->arena.used;
-        if (!ok || !points_carve(&ctx->arena, cap, viewed, &tmp, &tmp_view))
-            return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the data points");
-    }
+    polyc__points_in in = {NULL, NULL, NULL, NULL};
     int32_t n = 0;
     /* one scan: a point per return, whose beam the ends are set by (a
      * weighted point of several near returns would set them by their mean);
      * but a scan with more returns than the points bound (a dense scan
      * close to its walls: 100,000 beams at 1 m put 40 returns in a 2.5 cm
      * cell) has its returns summed by cell, as many scans' are */
-    int exact = !ctx->online && ((o->cfg->flags & POLYC_FLAG_EXACT_POINTS) ||
-                                 (o->rays.on && ctx->stats.hits <= (uint64_t)cap));
-    polyc_status st = ctx->from_grid ? collect_occupied(o, tmp, cap, &n)
-                      : ctx->online  ? collect_sums(o, tmp, tmp_view, cap, &n)
-                      : exact        ? collect_raw(o, tmp, tmp_view, cap, &n)
-                                     : collect_cells(o, tmp, tmp_view, cap, &n);
+    int exact = !ctx->layer && ((o->cfg->flags & POLYC_FLAG_EXACT_POINTS) ||
+                                (o->rays.on && ctx->stats.hits <= (uint64_t)cap));
+    polyc_status st;
+    if (ctx->layer) { /* a layer's points: its data, its scratch (the points carved once) */
+        st = ctx->layer->collect(o, cap, &in, &n);
+    } else {
+        int ok = points_carve(&ctx->arena, cap, viewed, &o->d.pts, &o->d.pt_view);
+        mark = ctx->arena.used;
+        if (!ok || !points_carve(&ctx->arena, cap, viewed, &in.pts, &in.view))
+            return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the data points");
+        st = ctx->from_grid ? collect_occupied(o, in.pts, cap, &n)
+             : exact        ? collect_raw(o, in.pts, in.view, cap, &n)
+                            : collect_cells(o, in.pts, in.view, cap, &n);
+    }
     if (st != POLYC_OK)
         return st;
+    polyc__point *tmp = in.pts;
+    const float *tmp_view = in.view;
     /* counting sort by bucket: points of one bucket are contiguous */
     polyc__hash *h = &o->h;
     int32_t nb = h->bx * h->by;
@@ -521,8 +288,8 @@ polyc_status polyc__points_collect(polyc__opt *o)
         int32_t b = polyc__bucket_of(h, tmp[i].x, tmp[i].y);
         uint32_t at = h->pt_start[b]++;
         o->d.pts[at] = tmp[i];
-        if (ctx->online)
-            ctx->online->pt_tile[at] = ctx->online->fresh_tile[i];
+        if (in.tag)
+            in.tag_out[at] = in.tag[i];
         if (tmp_view) {
             o->d.pt_view[2 * at] = tmp_view[2 * i];
             o->d.pt_view[2 * at + 1] = tmp_view[2 * i + 1];

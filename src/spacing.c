@@ -7,7 +7,7 @@
  * distance is measured to each pose when asked. The table's two passes
  * over every tile of the extent would take 5-6 % of a freiburg-campus
  * scan's time (13,000 tiles for its 80 m returns), for a handful of queries. */
-#include "online.h"
+#include "context.h"
 
 #include <math.h>
 
@@ -25,7 +25,7 @@ void polyc__spacing_reserve(polyc__arena *a, const polyc_limits *lim)
 }
 
 /* two chamfer passes, weights 1 and sqrt 2 tiles, from the tiles at 0 */
-static void chamfer(polyc__spacing *sp)
+void polyc__spacing_chamfer(polyc__spacing *sp)
 {
     const float a = sp->tile_m, b = sp->tile_m * 1.41421356f;
     for (int32_t y = 0; y < sp->h; y++)
@@ -52,30 +52,6 @@ static void chamfer(polyc__spacing *sp)
         }
 }
 
-/* Online, from the tiles where some pose was (the poses are not kept);
- * made again when a pose fell in a new tile, at most once in this many
- * scans (a pass over the area's tiles: on freiburg-campus's 300 m square,
- * at every new pose tile, 30 % of the updates' time): meanwhile a new
- * tile's spacing is measured from the poses before it. */
-#define REMAKE_SCANS 32u
-
-static polyc_status online_table(polyc_ctx *ctx, polyc__spacing *sp, size_t n)
-{
-    polyc__online *on = ctx->online;
-    sp->min_step_rad = on->min_step_rad;
-    sp->dist = on->spacing_dist;
-    if (!on->spacing_stale || (!on->spacing_now && on->spacing_scans != 0 &&
-                               on->scans - on->spacing_scans < REMAKE_SCANS))
-        return POLYC_OK;
-    for (size_t i = 0; i < n; i++)
-        sp->dist[i] = (on->pose_bits[i >> 5] >> (i & 31)) & 1u ? 0.0f : 1e30f;
-    chamfer(sp);
-    on->spacing_stale = 0;
-    on->spacing_scans = on->scans;
-    return POLYC_OK;
-}
-
-
 polyc_status polyc__spacing_build(polyc_ctx *ctx, polyc__spacing *sp)
 {
     const polyc__grid *g = &ctx->grid;
@@ -91,8 +67,8 @@ polyc_status polyc__spacing_build(polyc_ctx *ctx, polyc__spacing *sp)
     size_t n = (size_t)sp->w * (size_t)sp->h;
     if (n == 0)
         return POLYC_OK;
-    if (ctx->online)
-        return online_table(ctx, sp, n);
+    if (ctx->layer) /* a layer's table (its poses are not kept) */
+        return ctx->layer->spacing(ctx, sp, n);
     float step = 1e30f;
     for (uint32_t k = 0; k < ctx->scan_count; k++)
         if (ctx->scans[k].count > 1 && fabsf(ctx->scans[k].step_rad) < step)
@@ -115,7 +91,7 @@ polyc_status polyc__spacing_build(polyc_ctx *ctx, polyc__spacing *sp)
         if (tx >= 0 && ty >= 0 && tx < sp->w && ty < sp->h)
             sp->dist[(size_t)ty * (size_t)sp->w + (size_t)tx] = 0.0f;
     }
-    chamfer(sp);
+    polyc__spacing_chamfer(sp);
     return POLYC_OK;
 }
 

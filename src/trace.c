@@ -135,20 +135,20 @@ static int zs_deletable(const polyc__grid *g, int32_t ix, int32_t iy, int sub)
     return !(p[0] && p[2] && p[6]) && !(p[0] && p[4] && p[6]);
 }
 
-static void thin(const polyc_ctx *ctx, int32_t *del, uint32_t cap)
+static void thin(const polyc_ctx *ctx, const int32_t *xy, uint32_t count, int32_t *del, uint32_t cap)
 {
     const polyc__grid *g = &ctx->grid;
     for (int changed = 1; changed;) {
         changed = 0;
         for (int sub = 0; sub < 2; sub++) {
             uint32_t n = 0;
-            for (uint32_t i = 0; i < ctx->contour_count && n < cap; i++) {
-                int32_t ix = ctx->contour_xy[2 * i], iy = ctx->contour_xy[2 * i + 1];
+            for (uint32_t i = 0; i < count && n < cap; i++) {
+                int32_t ix = xy[2 * i], iy = xy[2 * i + 1];
                 if (mark_at(g, ix, iy) && zs_deletable(g, ix, iy, sub))
                     del[n++] = (int32_t)i;
             }
             for (uint32_t k = 0; k < n; k++)
-                set_visited(g, ctx->contour_xy[2 * del[k]], ctx->contour_xy[2 * del[k] + 1]);
+                set_visited(g, xy[2 * del[k]], xy[2 * del[k] + 1]);
             changed |= n > 0;
         }
     }
@@ -347,21 +347,21 @@ polyc_status polyc__trace_build(polyc_ctx *ctx)
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the polylines");
     for (uint32_t k = 0; k < g->tile_count; k++)
         memcpy(g->tiles[k].mark, g->tiles[k].contour, sizeof g->tiles[k].mark);
-    return polyc__trace_more(ctx);
+    return polyc__trace_cells(ctx, ctx->contour_xy, ctx->contour_count);
 }
 
-polyc_status polyc__trace_more(polyc_ctx *ctx)
+polyc_status polyc__trace_cells(polyc_ctx *ctx, const int32_t *xy, uint32_t count)
 {
     const polyc__grid *g = &ctx->grid;
     polyc_status st;
     size_t after_store = ctx->arena.used; /* the walk scratch is released at the end */
     walk w;
-    w.cap = ctx->contour_count + 1;
+    w.cap = count + 1;
     w.n = 0;
     w.xy = walk_cells(&ctx->arena, w.cap);
     if (!w.xy)
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for tracing");
-    thin(ctx, w.xy, w.cap); /* the walk buffer is free until the walks start */
+    thin(ctx, xy, count, w.xy, w.cap); /* the walk buffer is free until the walks start */
 
     tracer tr;
     float link_f = ctx->cfg.merge_dist_m / g->cell_m;
@@ -379,8 +379,8 @@ polyc_status polyc__trace_more(polyc_ctx *ctx)
         int found = 1;
         while (found) {
             found = 0;
-            for (uint32_t i = 0; i < ctx->contour_count; i++) {
-                int32_t ix = ctx->contour_xy[2 * i], iy = ctx->contour_xy[2 * i + 1];
+            for (uint32_t i = 0; i < count; i++) {
+                int32_t ix = xy[2 * i], iy = xy[2 * i + 1];
                 if (!unvisited(g, ix, iy) || (phase == 0 && unvisited_degree(g, ix, iy) > 1))
                     continue;
                 w.n = 0;

@@ -25,7 +25,7 @@ static void open_cells(polyc__online *on, uint32_t max_points)
     memset(on, 0, sizeof *on);
     on->lim.max_points = max_points;
     polyc__arena a = {mem, sizeof mem, 0, 0};
-    assert_true(polyc__cells_carve(&a, on, TILES));
+    assert_true(polyc__cells_carve(&a, &on->tab, max_points, TILES));
     memset(ref, 0, sizeof ref);
 }
 
@@ -33,11 +33,11 @@ static void check_all(const polyc__online *on)
 {
     uint32_t count[TILES] = {0};
     for (uint32_t k = 0; k < KEYS; k++) {
-        assert_int_equal(polyc__cell_find(on, k), ref[k]);
+        assert_int_equal(polyc__cell_find(&on->tab, k), ref[k]);
         count[k / POLYC__TILE_CELLS] += ref[k] != 0;
     }
     for (uint32_t t = 0; t < TILES; t++)
-        assert_int_equal(on->tile_cells[t], count[t]);
+        assert_int_equal(on->tab.tile_cells[t], count[t]);
 }
 
 static uint32_t next(uint32_t *s)
@@ -57,20 +57,20 @@ static void test_random_adds_and_drops(void **state)
         for (int step = 0; step < 20000; step++) {
             uint32_t key = next(&seed) % KEYS;
             if (next(&seed) % 3 != 0) {
-                uint32_t e = polyc__cell_add(&on, key);
+                uint32_t e = polyc__cell_add(&on.tab, key);
                 if (ref[key]) {
                     assert_int_equal(e, ref[key]); /* there already: the same entry */
                 } else if (live < caps[c]) {
                     assert_true(e != 0);
-                    assert_int_equal(on.sums[e - 1].cell, key);
-                    assert_true(on.sums[e - 1].n == 0 && on.sums[e - 1].fx == 0.0f);
+                    assert_int_equal(on.tab.sums[e - 1].cell, key);
+                    assert_true(on.tab.sums[e - 1].n == 0 && on.tab.sums[e - 1].fx == 0.0f);
                     ref[key] = e;
                     live++;
                 } else {
                     assert_int_equal(e, 0); /* limits.max_points reached */
                 }
             } else if (ref[key]) {
-                polyc__cell_drop(&on, ref[key]);
+                polyc__cell_drop(&on.tab, ref[key]);
                 ref[key] = 0;
                 live--;
             }
@@ -89,23 +89,23 @@ static void test_fill_drop_refill(void **state)
     polyc__online on;
     open_cells(&on, 300);
     for (uint32_t i = 0; i < 300; i++)
-        ref[i * 17] = polyc__cell_add(&on, i * 17);
-    assert_int_equal(polyc__cell_add(&on, 1), 0);
+        ref[i * 17] = polyc__cell_add(&on.tab, i * 17);
+    assert_int_equal(polyc__cell_add(&on.tab, 1), 0);
     check_all(&on);
     for (uint32_t i = 0; i < 300; i += 2) {
-        polyc__cell_drop(&on, ref[i * 17]);
+        polyc__cell_drop(&on.tab, ref[i * 17]);
         ref[i * 17] = 0;
     }
     check_all(&on);
     for (uint32_t i = 1; i < 300; i += 2) {
-        polyc__cell_drop(&on, ref[i * 17]);
+        polyc__cell_drop(&on.tab, ref[i * 17]);
         ref[i * 17] = 0;
     }
     check_all(&on);
-    assert_int_equal(on.sums_n, 300); /* entries are reused, not handed out anew */
+    assert_int_equal(on.tab.sums_n, 300); /* entries are reused, not handed out anew */
     for (uint32_t i = 0; i < 300; i++)
-        assert_true((ref[i * 5] = polyc__cell_add(&on, i * 5)) != 0);
-    assert_int_equal(on.sums_n, 300);
+        assert_true((ref[i * 5] = polyc__cell_add(&on.tab, i * 5)) != 0);
+    assert_int_equal(on.tab.sums_n, 300);
     check_all(&on);
 }
 

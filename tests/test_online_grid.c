@@ -466,7 +466,7 @@ static void check_records_after_recount(int mode)
         const polyc_scan *more = room_scan(&r);
         assert_int_equal(polyc_online_add_scan(fixed.ctx, more, 1, NULL), POLYC_OK);
         assert_int_equal(polyc_online_add_scan(truth.ctx, more, 0, NULL), POLYC_OK);
-        assert_true(fixed.ctx->online->redo_next < fixed.ctx->online->redo_end); /* waiting */
+        assert_true(fixed.ctx->online->rec.redo_next < fixed.ctx->online->rec.redo_end); /* waiting */
         assert_int_equal(polyc_online_correct(fixed.ctx, LEFT, 0.0, 0.0, 0.0), POLYC_OK);
         assert_int_equal(polyc_online_update(fixed.ctx, POLYC_ONLINE_WORK_DEFAULT, &rep), POLYC_OK);
     }
@@ -522,10 +522,10 @@ static void test_pool_spent(void **state)
         assert_int_equal(polyc_online_add_scan(o.ctx, room_scan(&r), 0, NULL), POLYC_OK);
         assert_int_equal(polyc_online_update(o.ctx, POLYC_ONLINE_WORK_DEFAULT, &rep), POLYC_OK);
     }
-    const polyc__grid *g = &o.ctx->grid;
-    print_message("pool: %u of %u records, %u tiles stored\n", g->pre_high, g->pre_cap,
-                  g->tile_count);
-    assert_int_equal(g->pre_high, g->pre_cap);
+    const polyc__records *rec = &o.ctx->online->rec;
+    print_message("pool: %u of %u records, %u tiles stored\n", rec->pre_high, rec->pre_cap,
+                  o.ctx->grid.tile_count);
+    assert_int_equal(rec->pre_high, rec->pre_cap);
     r.person = 1;
     assert_int_equal(polyc_online_add_scan(o.ctx, room_scan(&r), 0, NULL), POLYC_OK);
     assert_int_equal(polyc_online_finish(o.ctx, NULL, NULL, &rep), POLYC_OK);
