@@ -124,7 +124,7 @@ static int lay_out(polyc_ctx *ctx, polyc__online *on, polyc__arena *a)
     POLYC__CARVE(ok, a, on->poses.spacing_dist, dir_n);
     POLYC__CARVE_ZERO(ok, a, on->backlog.dirty_since, dir_n);
     POLYC__CARVE(ok, a, on->backlog.dirty, dir_n);
-    ok = ok && polyc__opt_carve_online(ctx, a, &on->opt);
+    ok = ok && polyc__opt_carve_lasting(ctx, a, &on->opt);
     if (!ok)
         return 0;
     size_t P = (size_t)polyc__points_bound(&ctx->cfg, &ctx->lim), nb = (size_t)on->opt.h.bx * (size_t)on->opt.h.by;

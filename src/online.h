@@ -282,12 +282,4 @@ void polyc__cell_drop(polyc__cell_table *tab, uint32_t entry);
 /* every entry out: the table empty (tiles: the grid's stored tiles) */
 void polyc__cells_clear(polyc__cell_table *tab, uint32_t tiles);
 
-/* ---- the batch optimiser's online entries (opt_setup.c, optimize.c) ---- */
-/* the optimiser of an online context, carved once; and its data refreshed
- * from the sums before the finishing search (opt_setup.c) */
-int polyc__opt_carve_online(polyc_ctx *ctx, polyc__arena *a, polyc__opt *o);
-polyc_status polyc__opt_refresh(polyc__opt *o);
-/* the search on a set-up optimiser (optimize.c: the batch loop) */
-polyc_status polyc__search(polyc__opt *o, polyc_progress_fn progress, void *user);
-
 #endif

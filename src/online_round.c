@@ -95,38 +95,34 @@ static int explained(const polyc__opt *o, float x, float y, float near, float fa
 {
     const polyc__hash *h = &o->h;
     const polyc__store *s = o->s;
-    int32_t bx, by, around[9];
-    polyc__bucket_xy(h, x, y, &bx, &by);
-    int n = polyc__buckets_around(h, bx, by, around);
-    for (int k = 0; k < n; k++)
-        for (int32_t e = h->seg_head[around[k]]; e != POLYC__NONE; e = h->entries[e].next) {
-            int32_t sg = h->entries[e].seg;
-            const polyc__vertex *a = &s->v[sg], *b = &s->v[a->next];
-            float d2 = polyc__seg_dist2(x, y, a->x, a->y, b->x, b->y);
-            if (d2 <= near * near)
-                return 1;
-            if (d2 > far * far || (sides && polyc__two_sided(o, sg)))
-                continue;
-            float dx = b->x - a->x, dy = b->y - a->y, len = sqrtf(dx * dx + dy * dy);
-            if (!(len > 0.0f))
-                continue;
-            /* the foot's distance from a along the segment */
-            float u = ((x - a->x) * dx + (y - a->y) * dy) / len;
-            float from_a = a->prev == POLYC__NONE ? near : 0.0f;
-            float from_b = b->next == POLYC__NONE ? near : 0.0f;
-            if (u < from_a || u > len - from_b)
-                continue;
-            /* the sides along the segment's left normal (-dy, dx), each
-             * taken only when seen clearly across the segment: a wall seen
-             * at a grazing angle has no side to speak of (on fhw, a wall
-             * seen along its length got lines on both "sides", a wedge) */
-            float sx = o->seg_side ? o->seg_side[2 * sg] : 0.0f;
-            float sy = o->seg_side ? o->seg_side[2 * sg + 1] : 0.0f;
-            float seen = -sx * dy + sy * dx, cell = -vx * dy + vy * dx;
-            if (seen * cell >= 0.0f || fabsf(seen) < CLEAR_SIDE * len * sqrtf(sx * sx + sy * sy) ||
-                fabsf(cell) < CLEAR_SIDE * len * sqrtf(vx * vx + vy * vy))
-                return 1;
-        }
+    polyc__near_segs w;
+    POLYC__FOR_NEAR_SEGS(w, h, x, y, sg) {
+        const polyc__vertex *a = &s->v[sg], *b = &s->v[a->next];
+        float d2 = polyc__seg_dist2(x, y, a->x, a->y, b->x, b->y);
+        if (d2 <= near * near)
+            return 1;
+        if (d2 > far * far || (sides && polyc__two_sided(o, sg)))
+            continue;
+        float dx = b->x - a->x, dy = b->y - a->y, len = sqrtf(dx * dx + dy * dy);
+        if (!(len > 0.0f))
+            continue;
+        /* the foot's distance from a along the segment */
+        float u = ((x - a->x) * dx + (y - a->y) * dy) / len;
+        float from_a = a->prev == POLYC__NONE ? near : 0.0f;
+        float from_b = b->next == POLYC__NONE ? near : 0.0f;
+        if (u < from_a || u > len - from_b)
+            continue;
+        /* the sides along the segment's left normal (-dy, dx), each
+         * taken only when seen clearly across the segment: a wall seen
+         * at a grazing angle has no side to speak of (on fhw, a wall
+         * seen along its length got lines on both "sides", a wedge) */
+        float sx = o->seg_side ? o->seg_side[2 * sg] : 0.0f;
+        float sy = o->seg_side ? o->seg_side[2 * sg + 1] : 0.0f;
+        float seen = -sx * dy + sy * dx, cell = -vx * dy + vy * dx;
+        if (seen * cell >= 0.0f || fabsf(seen) < CLEAR_SIDE * len * sqrtf(sx * sx + sy * sy) ||
+            fabsf(cell) < CLEAR_SIDE * len * sqrtf(vx * vx + vy * vy))
+            return 1;
+    }
     return 0;
 }
 
@@ -185,7 +181,8 @@ static uint32_t unexplained_cells(polyc_ctx *ctx, uint32_t taken, float near, in
             np = taken_points(ctx, taken);
             list = o->region_pt;
         }
-        polyc__find_sides(o, list, np, o->size.seg_sum, o->size.seg_w);
+        polyc__side_scratch sd = polyc__sides(o);
+        polyc__find_sides(o, list, np, sd.left_w, sd.right_w);
     }
     float thr = ctx->cfg.contour_threshold;
     float ox = g->frame_ox, oy = g->frame_oy;
@@ -318,22 +315,18 @@ static uint32_t stamp_near_ends(polyc__opt *o, uint32_t since)
             continue;
         const polyc__vertex *f = &s->v[e->prev != POLYC__NONE ? e->prev : e->next];
         float ex = f->x - e->x, ey = f->y - e->y, el = sqrtf(ex * ex + ey * ey);
-        int32_t bx, by, around[9];
-        polyc__bucket_xy(h, e->x, e->y, &bx, &by);
-        int nb = polyc__buckets_around(h, bx, by, around);
-        for (int i = 0; i < nb; i++)
-            for (int32_t en = h->seg_head[around[i]]; en != POLYC__NONE; en = h->entries[en].next) {
-                int32_t sg = h->entries[en].seg;
-                const polyc__vertex *c = &s->v[sg], *d = &s->v[c->next];
-                if (c->line == e->line || polyc__edited_since(o, sg, since) ||
-                    polyc__seg_dist2(e->x, e->y, c->x, c->y, d->x, d->y) > lim2)
-                    continue;
-                float dx = d->x - c->x, dy = d->y - c->y, dl = sqrtf(dx * dx + dy * dy);
-                if (fabsf(ex * dx + ey * dy) < ALONG_COS * el * dl)
-                    continue;
-                o->v_touch[sg] = stamp;
-                n++;
-            }
+        polyc__near_segs w;
+        POLYC__FOR_NEAR_SEGS(w, h, e->x, e->y, sg) {
+            const polyc__vertex *c = &s->v[sg], *d = &s->v[c->next];
+            if (c->line == e->line || polyc__edited_since(o, sg, since) ||
+                polyc__seg_dist2(e->x, e->y, c->x, c->y, d->x, d->y) > lim2)
+                continue;
+            float dx = d->x - c->x, dy = d->y - c->y, dl = sqrtf(dx * dx + dy * dy);
+            if (fabsf(ex * dx + ey * dy) < ALONG_COS * el * dl)
+                continue;
+            o->v_touch[sg] = stamp;
+            n++;
+        }
     }
     return n;
 }
@@ -352,7 +345,7 @@ static int link_left_ends(polyc__opt *o)
     if (!o->pol.restructure)
         return 0;
     uint32_t mark = ++o->touch_stamp;
-    int linked = polyc__op_merge_folds(o, 0);
+    int linked = polyc__op_merge_folds(o, POLYC__HAIRPINS_REFUSED);
     if (linked > 0) {
         polyc__op_remove_vertices(o, mark);
         polyc__op_adjust(o, POLYC__ADJUST_ROUNDS, mark);
@@ -425,9 +418,15 @@ static polyc_status remap_taken_tiles(polyc_ctx *ctx, uint64_t work, int all, ui
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the round's scratch");
     stamp_region(ctx, taken, since);
     o->region_since = since;
-    uint8_t add = o->pol.add_vertices;
-    o->pol.add_vertices = 0;
-    polyc__operators(o, since, since);
+    /* the batch iteration's operators from the table, without additions:
+     * the finishing search adds vertices, and with them in every round
+     * intel's updates took twice as long for the same final map */
+    polyc__op_args ops;
+    memset(&ops, 0, sizeof ops);
+    ops.since = ops.climb = since;
+    ops.skip = POLYC__OPF_ADDS;
+    ops.status = POLYC_OK;
+    polyc__run_ops(o, POLYC__SEQ_ITERATION, &ops);
     drop_dataless(o, on->scr.seg_data);
     int merged = link_left_ends(o);
     /* the operators' zip came before their crossing repair and the drop of
@@ -443,7 +442,6 @@ static polyc_status remap_taken_tiles(polyc_ctx *ctx, uint64_t work, int all, ui
         polyc__op_untangle(o);
         polyc__op_end_gaps(o);
     }
-    o->pol.add_vertices = add;
     o->region_since = 0;
     POLYC__CHECKS_ITERATION(o);
     for (uint32_t i = 0; i < taken; i++)

@@ -217,7 +217,7 @@ polyc_status polyc_online_finish(polyc_ctx *ctx, polyc_progress_fn progress, voi
      * stands now, the books from scratch */
     on->poses.spacing_now = 1;
     if (st == POLYC_OK)
-        st = polyc__opt_refresh(o);
+        st = polyc__opt_refresh(o, &on->prior);
     on->poses.spacing_now = 0;
     if (st == POLYC_OK && ctx->cfg.max_iterations > 0) {
         polyc__guarded g = {ctx, progress, user};

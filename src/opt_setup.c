@@ -4,7 +4,7 @@
  * prior, the spacing, the spatial hash, the points and the model's terms.
  * Takes: the context after the trace. Gives: a polyc__opt ready to search
  * (optimize.c) or to score. */
-#include "online.h"
+#include "optimize.h"
 
 #include <math.h>
 #include <string.h>
@@ -121,11 +121,11 @@ static void opt_begin(polyc_ctx *ctx, polyc__opt *o)
     o->rng.state = ctx->cfg.seed;
 }
 
-/* Online: the optimiser lives across updates, its arrays carved once for
- * the limits (on the block, or on the size query's counting arena): the
- * spatial hash over the whole grid, the points, its own arrays, the best
- * map. The prior and the spacing are the context's (online.h). */
-int polyc__opt_carve_online(polyc_ctx *ctx, polyc__arena *a, polyc__opt *o)
+/* An optimiser that lives across calls (an online context's), its arrays
+ * carved once for the limits (on the block, or on the size query's
+ * counting arena): the spatial hash over the whole grid, the points, its
+ * own arrays, the best map. The prior and the spacing are the caller's. */
+int polyc__opt_carve_lasting(polyc_ctx *ctx, polyc__arena *a, polyc__opt *o)
 {
     opt_begin(ctx, o);
     int32_t V = polyc__max_vertices(&ctx->lim), P = polyc__points_bound(o->cfg, &ctx->lim);
@@ -152,11 +152,10 @@ int polyc__opt_carve_online(polyc_ctx *ctx, polyc__arena *a, polyc__opt *o)
 
 /* Before an update's search: the prior's totals and weights, the spacing,
  * the points from the cells' sums, the hash and every point's segment. */
-polyc_status polyc__opt_refresh(polyc__opt *o)
+polyc_status polyc__opt_refresh(polyc__opt *o, const polyc__prior *prior)
 {
     polyc_ctx *ctx = o->ctx;
-    polyc__online *on = ctx->online;
-    o->prior = on->prior; /* its totals and weights are kept as scans come */
+    o->prior = *prior; /* (an online context keeps its totals and weights as scans come) */
     polyc_status st = polyc__spacing_build(ctx, &o->spacing);
     if (st != POLYC_OK)
         return st;
