@@ -385,11 +385,13 @@ FIGURES = [
         lambda o: g(r'embedded_online: library\s+total\s+(\d+)')(o) * 2, scale=INSTR_MS),
     Fig(P, 'which the largest add and update\ntake {} % of at that', 'target',
         g(r'largest add \+ update \(scan \d+\) (\d+)'), scale=100 / 16.8e6),
-    Fig(P, '| one scan | {} | {} % | `polyc__walk_step` {} %, `count_beam` {} %, `prepare` {} %, `beam_fill` {} % |',
-        'profile', prof('embedded_scan', 'polyc__walk_step', 'count_beam', 'prepare', 'beam_fill')),
-    Fig(P, '| online | {} | {} % | `prepare` {} %, `polyc__buckets_around` {} %, `smoothed` {} %, '
-        '`polyc__seg_pre_cost` {} % |',
-        'profile', prof('embedded_online', 'prepare', 'polyc__buckets_around', 'smoothed', 'polyc__seg_pre_cost')),
+    Fig(P, '| one scan | {} | {} % | `polyc__walk_step` {} %, `count_beam` {} %, `list_near_points` {} %, '
+        '`beam_fill` {} % |',
+        'profile', prof('embedded_scan', 'polyc__walk_step', 'count_beam', 'list_near_points', 'beam_fill')),
+    Fig(P, '| online | {} | {} % | `list_near_points` {} %, `polyc__buckets_around` {} %, '
+        '`polyc__segment_region` {} %, `smoothed` {} % |',
+        'profile', prof('embedded_online', 'list_near_points', 'polyc__buckets_around',
+                        'polyc__segment_region', 'smoothed')),
     # docs/performance.md: the sweep's summary, every column but ms
     Table(P, 'sweep', 'sweep', skip_cols=(4,)),
 
@@ -599,7 +601,19 @@ def check_table(t, text, runner):
     return n, bad
 
 
-def check(figs, runner, band, compare_times):
+def quote_like(quoted, value):
+    """value written as quoted is: its decimals, its thousands commas"""
+    _, dec = as_number(quoted)
+    out = '%.*f' % (dec, value)
+    if ',' in quoted:
+        whole, _, frac = out.partition('.')
+        out = '{:,}'.format(int(whole)) + ('.' + frac if frac else '')
+    return out
+
+
+def check(figs, runner, band, compare_times, fixes=None):
+    """(failures, figures checked, timings); with a list `fixes`, each differing
+    figure outside the tables also as (document, start, end, measured as quoted)"""
     docs = {}
     fails, checked, times = [], 0, []
     for fig in figs:
@@ -649,6 +663,8 @@ def check(figs, runner, band, compare_times):
                                  % (where, q, dec, meas, band, cmd))
                 continue
             if not same(quoted, meas, dec):
+                if fixes is not None:
+                    fixes.append((fig.doc, m.start(i + 1), m.end(i + 1), quote_like(q, meas)))
                 desc = getattr(fig.read, 'desc', None)
                 fails.append('%s: figure %d: %s quoted, %.*f measured%s by `%s`'
                              % (where, i + 1, q, max(dec, 1) if meas != int(meas) else 0, meas,
@@ -665,6 +681,9 @@ def main():
     ap.add_argument('--band', type=float, default=2.0,
                     help='with --data: timings within BAND x or 1/BAND x the quoted (default 2)')
     ap.add_argument('--list', action='store_true', help='print each figure\'s document, text and command')
+    ap.add_argument('--fix', action='store_true',
+                    help='write each differing figure outside the tables into its document as '
+                         'measured (as the document writes it: decimals, commas); read the diff')
     args = ap.parse_args()
     data = bool(args.data)
     if data and not os.path.isdir(args.data):
@@ -678,7 +697,17 @@ def main():
             print('%s\t"%s"\t`%s`' % (f.doc, ' '.join(f.text.split()), runner.command(f.src)))
         return 0
     t0 = time.time()
-    fails, checked, times = check(figs, runner, args.band, data)
+    fixes = [] if args.fix else None
+    fails, checked, times = check(figs, runner, args.band, data, fixes)
+    for doc in sorted({d for d, _, _, _ in fixes or []}):
+        path = os.path.join(ROOT, doc)
+        with open(path, encoding='utf-8') as f:
+            text = f.read()
+        for _, a, b, new in sorted((x for x in fixes if x[0] == doc), key=lambda x: -x[1]):
+            text = text[:a] + new + text[b:]
+        with open(path, 'w', encoding='utf-8') as f:
+            f.write(text)
+        print('docs-figures: wrote %d figures into %s' % (sum(1 for x in fixes if x[0] == doc), doc))
     name = 'docs-figures-data' if data else 'docs-figures'
     for t in times:
         print('%s: timing%s: %s' % (name, '' if data else ' (not compared)', t))

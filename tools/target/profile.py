@@ -22,7 +22,8 @@ import sys
 SOFT_DOUBLE = re.compile(r"^__(aeabi_(d|[fil]2d|d2|ui2d|ul2d)\w*|\w+df[23]|extendsfdf2|truncdfsf2|"
                          r"fix\w*df\w*|float\w*df|(eq|ne|lt|le|gt|ge|un|cmp)df2|"
                          r"aeabi_cdc\w+|aeabi_cdrc\w+|clzdi2|muldi3|udivmoddi4|aeabi_[lu]?ldivmod)$")
-DOUBLE_LIBM = re.compile(r"^(__ieee754_\w+|__kernel_\w+|sin|cos|tan|atan2?|asin|acos|exp|log|log10|pow|sqrt|"
+# (newlib's float kernels, __ieee754_rem_pio2f, __kernel_cosf, ..., end in f)
+DOUBLE_LIBM = re.compile(r"^(__ieee754_\w*[^f\W]|__kernel_\w*[^f\W]|sin|cos|tan|atan2?|asin|acos|exp|log|log10|pow|sqrt|"
                          r"hypot|floor|ceil|fabs|fmod|round|lround|copysign|scalbn|frexp|ldexp|modf|"
                          r"rint|nearbyint|trunc)$")
 
