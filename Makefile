@@ -10,7 +10,7 @@ CFLAGS  ?=
 ALL_CFLAGS = $(WARN) $(OPT) $(CFLAGS) -Iinclude -fPIC -fvisibility=hidden -fno-math-errno -DPOLYC_BUILD_SHARED
 LDLIBS  = -lm
 
-LIB_SRC  = $(wildcard src/*.c)
+LIB_SRC  = $(wildcard src/*.c src/*/*.c)
 LIB_OBJ  = $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
 # tools/: the shipped tool (POLYC_SRC: main, command line, input, run,
 # the online replay, messages) and its modules (log reader, map files, SVG/JSON/TXT output,
@@ -79,10 +79,10 @@ $(BUILD)/tests/%: tests/%.c $(TOOL_OBJ) $(EVAL_OBJ) $(BUILD)/libpolyc.a $(wildca
 	$(CC) $(EVAL_CFLAGS) -Isrc -Itests $< $(TOOL_OBJ) $(EVAL_OBJ) $(BUILD)/libpolyc.a -o $@ -lcmocka $(LDLIBS)
 
 # the optimiser's suites share their harness (tests/opt_harness.c), whose
-# oracles are the library's invariant checkers (src/checks.c): compiled in
+# oracles are the library's invariant checkers (src/search/checks.c): compiled in
 # here when the library was built without them
-OPT_CHECKS = $(if $(findstring -DPOLYC_CHECKS,$(CFLAGS)),,-DPOLYC_CHECKS src/checks.c)
-$(BUILD)/tests/test_opt_%: tests/test_opt_%.c tests/opt_harness.c src/checks.c $(TOOL_OBJ) $(EVAL_OBJ) $(BUILD)/libpolyc.a $(wildcard tests/*.h src/*.h)
+OPT_CHECKS = $(if $(findstring -DPOLYC_CHECKS,$(CFLAGS)),,-DPOLYC_CHECKS src/search/checks.c)
+$(BUILD)/tests/test_opt_%: tests/test_opt_%.c tests/opt_harness.c src/search/checks.c $(TOOL_OBJ) $(EVAL_OBJ) $(BUILD)/libpolyc.a $(wildcard tests/*.h src/*.h)
 	@mkdir -p $(dir $@)
 	$(CC) $(EVAL_CFLAGS) -Isrc -Itests $< tests/opt_harness.c $(OPT_CHECKS) $(TOOL_OBJ) $(EVAL_OBJ) $(BUILD)/libpolyc.a -o $@ -lcmocka $(LDLIBS)
 
@@ -130,7 +130,7 @@ docs-figures-data: $(BUILD)/polyc
 	fi
 
 # The unit suites on a library with its invariant checkers built in
-# (src/checks.c): the optimiser asserts its store, hash and arena after
+# (src/search/checks.c): the optimiser asserts its store, hash and arena after
 # every iteration, and its unit tests check the books from scratch.
 .PHONY: test-checks
 test-checks:
@@ -215,19 +215,19 @@ $(BUILD)/footprint: examples/footprint.c $(BUILD)/libpolyc.a
 $(BUILD)/footprint8: examples/footprint.c $(EMB_OBJ)
 	$(CC) $(WARN) $(OPT) $(CFLAGS) -Iinclude $^ -o $@ $(LDLIBS)
 
-# The online mode is a layer above the batch library (src/online*.c): the
+# The online mode is a layer above the batch library (src/online/): the
 # batch objects build and link without it (the one-scan example, linked
-# against every object but online*.o, maps its room), and no batch file
+# against every object of src/online/ left out, maps its room), and no batch file
 # includes an online header.
-BATCH_OBJ = $(filter-out $(BUILD)/obj/online%.o,$(LIB_OBJ))
+BATCH_OBJ = $(filter-out $(BUILD)/obj/online/%.o,$(LIB_OBJ))
 .PHONY: test-batch-alone
 test-batch-alone: $(BATCH_OBJ)
 	$(CC) $(WARN) $(OPT) $(CFLAGS) -Iinclude examples/embedded_scan.c $(BATCH_OBJ) \
 	    -o $(BUILD)/embedded_scan_batch $(LDLIBS)
 	$(BUILD)/embedded_scan_batch | grep -q '^status ok'
-	@bad=$$(grep -l '#include "online' $(filter-out src/online%,$(wildcard src/*.c src/*.h))); \
+	@bad=$$(grep -lE '#include "(\.\./)?online' $(filter-out src/online/%,$(wildcard src/*.c src/*.h src/*/*.c))); \
 	if [ -n "$$bad" ]; then echo "batch files that include an online header: $$bad"; exit 1; fi
-	@echo "test-batch-alone: the batch library links without src/online*.c"
+	@echo "test-batch-alone: the batch library links without src/online/"
 
 # Robustness (docs/security.md). test-cli: every bad input of the tool
 # (tests/cli_bad_input.sh), where it writes (tests/cli_output.sh: as root,

@@ -280,7 +280,7 @@ int close_rel(double a, double b, double rel)
     return fabs(a - b) <= rel * (1.0 + fmax(fabs(a), fabs(b)));
 }
 
-/* The oracles: the library's invariant checkers (src/checks.c, linked into
+/* The oracles: the library's invariant checkers (src/search/checks.c, linked into
  * every tests/test_opt_* suite with POLYC_CHECKS), failing the test with
  * the first violation. */
 static void fail_if(const char *why, int32_t at, const char *where)

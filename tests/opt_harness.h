@@ -4,7 +4,7 @@
  * optimiser state set up by polyc__opt_setup as polyc_optimize does; data
  * points and polylines replaced by hand-made ones; and the oracles, which
  * compare the incremental books with a recomputation from scratch: the
- * library's checkers (src/checks.c, compiled into every test_opt_* suite). */
+ * library's checkers (src/search/checks.c, compiled into every test_opt_* suite). */
 #ifndef OPT_HARNESS_H
 #define OPT_HARNESS_H
 
@@ -128,7 +128,7 @@ void check_store(const polyc__opt *o, const char *where);
 void check_hash(polyc__opt *o, const char *where);
 
 /* The incremental books against a recomputation from scratch: the
- * library's checkers (src/checks.c) where they are built in, then the
+ * library's checkers (src/search/checks.c) where they are built in, then the
  * test's own, which say more about a failure. */
 void check_books(polyc__opt *o, const char *where);
 

@@ -1,4 +1,4 @@
-/* test_contour_data.c - the contour's data fallback (src/contour.c): a wall
+/* test_contour_data.c - the contour's data fallback (src/grid/contour.c): a wall
  * whose cells hold data (m >= data_min_m) but never reach the contour
  * threshold, far from any occupied cell, is traced and drawn; below the data
  * rule, or shorter than the trace's minimum for such cells, it is not.

@@ -210,7 +210,7 @@ static void print_score(const char *what, const gtscore_map_score *sc)
 }
 
 /* A crossing this near a segment end is a junction, not a crossing: the
- * library's own rule (src/topology.c, CROSS_END_M), under which the batch
+ * library's own rule (src/search/topology.c, CROSS_END_M), under which the batch
  * map has none either. */
 #define JUNCTION_M 0.002
 

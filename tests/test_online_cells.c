@@ -1,5 +1,5 @@
 /* test_online_cells.c - an online context's cells with endpoints
- * (src/online_cells.c): the open-addressed table finds every cell added and
+ * (src/online/online_cells.c): the open-addressed table finds every cell added and
  * no other, through random adds and drops that fill it to its limit
  * (backward-shift deletion, wrap-around at the table's end); the entries
  * run out at limits.max_points and come back when dropped; and each tile's

@@ -1,5 +1,5 @@
 /* test_online_grid.c - an online grid's misses in tiles it has not stored
- * yet (src/grid.c, "an online grid's misses in tiles not stored"): a person
+ * yet (src/grid/grid.c, "an online grid's misses in tiles not stored"): a person
  * who steps into a round room that the robot has been seeing through is
  * free in the grid once the person's tile is stored, as in a batch grid of
  * the same scans; its tile has the batch's counts, cell by cell; and when

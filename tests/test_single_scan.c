@@ -1,6 +1,6 @@
 /* test_single_scan.c - maps from one scan: initial polylines from the beam
- * order (src/scan_chains.c) and the beams as constraints on the optimiser
- * (src/ray_check.c). Scenes come from tools/eval/scansim, scored along the beams
+ * order (src/trace/scan_chains.c) and the beams as constraints on the optimiser
+ * (src/search/ray_check.c). Scenes come from tools/eval/scansim, scored along the beams
  * by tools/eval/gtscore (f and ray RMSE, as docs/evaluation.md defines them).
  */
 #include <stdarg.h>

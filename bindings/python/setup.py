@@ -1,7 +1,7 @@
 """setup.py - builds the polyc package: polyc/__init__.py and polyc/libpolyc.so.
 
 libpolyc.so is a plain shared library (loaded with ctypes, not a CPython
-extension module): the library (src/*.c), the polyc tool's readers
+extension module): the library (src/*.c, src/*/*.c), the polyc tool's readers
 (tools/scanlog.c, tools/scanlog_noreturn.c, tools/mapfile.c, tools/mapfile_pgm.c,
 tools/mapfile_png.c, tools/mapfile_image.c, tools/inflate.c,
 tools/gridimage.c, tools/readfile.c, tools/textesc.c) and the binding's glue
@@ -37,7 +37,8 @@ def _version():
 # The repository's C sources, given to the compiler as absolute paths at
 # build time (setup() takes only paths inside its own folder; the objects go
 # under build_temp, never into src/)
-REPO_SOURCES = (sorted(glob.glob(os.path.join(REPO, "src", "*.c"))) +
+REPO_SOURCES = (sorted(glob.glob(os.path.join(REPO, "src", "*.c")) +
+                       glob.glob(os.path.join(REPO, "src", "*", "*.c"))) +
                 [os.path.join(REPO, "tools", n)
                  for n in ("scanlog.c", "scanlog_noreturn.c", "mapfile.c", "mapfile_pgm.c",
                            "mapfile_png.c", "mapfile_image.c", "inflate.c", "gridimage.c",
