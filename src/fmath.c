@@ -9,6 +9,11 @@
  * host and target compute the same bits. */
 #include "internal.h"
 
+/* the external definitions of internal.h's and stages.h's inline functions
+ * (C99: one copy where a caller does not inline them, as at -Os) */
+extern inline int32_t polyc__floori(float x);
+extern inline int polyc__cell_index(int32_t ix, int32_t iy);
+
 #include <math.h> /* NAN only */
 #include <string.h>
 

@@ -61,7 +61,7 @@ float polyc__logf(float x);
 /* floor(x) as an integer for |x| < 2^31 (callers keep cell and bucket
  * coordinates there): a conversion and a compare, where newlib's floorf is
  * a library call of some 40 instructions on a Cortex-M */
-static inline int32_t polyc__floori(float x)
+inline int32_t polyc__floori(float x)
 {
     int32_t i = (int32_t)x;
     return i - (x < (float)i);

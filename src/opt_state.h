@@ -189,7 +189,7 @@ int polyc__change_carve(polyc__arena *a, polyc__change *c, int32_t V);
 /* change.c: lists the buckets a segment's points can be in for rescoring */
 void polyc__chg_mark_region(polyc__opt *o, int32_t seg);
 /* Whether segment v is in the online update's region (always, without one). */
-static inline int polyc__in_region(const polyc__opt *o, int32_t v)
+inline int polyc__in_region(const polyc__opt *o, int32_t v)
 {
     return o->region_since == 0 || o->v_touch[v] >= o->region_since ||
            o->v_touch[o->s->v[v].next] >= o->region_since;

@@ -75,7 +75,7 @@ static inline void polyc__count_dec(polyc__count *a)
 polyc__tile *polyc__grid_tile(const polyc__grid *g, int32_t ix, int32_t iy);
 /* NULL for cells outside the grid or in tiles not stored (no beam ends in a
  * hit there: free space or never reached) */
-static inline int polyc__cell_index(int32_t ix, int32_t iy)
+inline int polyc__cell_index(int32_t ix, int32_t iy)
 {
     return ((iy & (POLYC__TILE_SIDE - 1)) << POLYC__TILE_SHIFT) | (ix & (POLYC__TILE_SIDE - 1));
 }

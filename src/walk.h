@@ -40,7 +40,7 @@ static inline int64_t polyc__fixed(float v, float scale)
     return (int64_t)polyc__floori(v * scale);
 }
 
-static inline float polyc__max_abs(float a, float b)
+inline float polyc__max_abs(float a, float b)
 {
     a = a < 0.0f ? -a : a;
     b = b < 0.0f ? -b : b;
@@ -123,7 +123,7 @@ static inline int64_t polyc__walk_key_at(const polyc__walk *w, float t)
 
 /* To the next cell. Returns 1 when it left the tile (or the grid): then
  * polyc__walk_enter must run before idx is used again. */
-static inline int polyc__walk_step(polyc__walk *w)
+inline int polyc__walk_step(polyc__walk *w)
 {
     w->n--;
     if (w->kx < w->ky) {
@@ -142,7 +142,7 @@ static inline int polyc__walk_step(polyc__walk *w)
 
 /* Sets idx and the steps left before the walk leaves the current cell's
  * tile or the width x height grid; 0 when the cell is outside the grid. */
-static inline int polyc__walk_enter(polyc__walk *w, int32_t width, int32_t height)
+inline int polyc__walk_enter(polyc__walk *w, int32_t width, int32_t height)
 {
     if (w->ix < 0 || w->iy < 0 || w->ix >= width || w->iy >= height)
         return 0;

@@ -4,6 +4,12 @@
  * of the data, stored only where some beam ends in a hit. */
 #include "../walk.h"
 
+/* the external definitions of walk.h's inline functions (C99: one copy
+ * where a caller does not inline them, as at -Os) */
+extern inline float polyc__max_abs(float a, float b);
+extern inline int polyc__walk_step(polyc__walk *w);
+extern inline int polyc__walk_enter(polyc__walk *w, int32_t width, int32_t height);
+
 #include <math.h>
 #include <string.h>
 

@@ -5,6 +5,10 @@
  * scratch. Takes: the optimiser state. Gives: the updated terms. */
 #include "../cost.h"
 
+/* the external definition of opt_state.h's polyc__in_region (C99: one
+ * copy for the callers that take its address or do not inline it) */
+extern inline int polyc__in_region(const polyc__opt *o, int32_t v);
+
 int polyc__change_carve(polyc__arena *a, polyc__change *c, int32_t V)
 {
     int ok = 1;
