@@ -76,10 +76,11 @@ static int occupied(const polyc__tile *t, int idx)
  * returns are data that no contour cell explains. Such a wall, metres long
  * with a thousand returns yet free in the grid, was drawn only when the
  * search happened to lay a segment along it, so the map (and its BIC)
- * depended on the seed. Within one search radius (15 cm at the defaults)
- * the edges of wide bands beside occupied cells were labelled too and
- * traced as a second line beside the wall's; two (30 cm) leave bands to
- * their walls. The trace drops short walks on such cells alone (trace.c). */
+ * depended on the seed: the same log gave maps with and without the wall.
+ * Within one search radius (15 cm at the defaults) the edges of wide bands
+ * beside occupied cells were labelled too and traced as a second line
+ * beside the wall's; two (30 cm) leave bands to their walls. The trace
+ * drops short walks on such cells alone (trace.c). */
 #define DATA_ALONE_RADII 2.0f
 
 /* Whether an occupied cell lies in columns c0..c1 (within one tile) of row

@@ -48,8 +48,8 @@ static void moved_scan(const polyc_ctx *ctx, uint32_t k, double x, double y, dou
  * scan cast as its correction came would meet, at its new pose, cells that
  * still held the misses of the scans not corrected yet, and see through
  * walls those scans saw: a drifted log corrected that way kept a map
- * clearly worse than the batch map, cast after all it scores as well as
- * the batch map. When every scan is kept, the
+ * clearly worse than the batch map; cast after all, a map as good as the
+ * batch map. When every scan is kept, the
  * contour is cleared and cast from all of them: the batch's contour, with
  * the old poses' gone; otherwise the old poses' contour stays (it only
  * seeds the trace). */
@@ -148,9 +148,8 @@ static polyc_status move_each(polyc_ctx *ctx)
  * Many scans are cast as the batch casts, on the tiles' marks (contour.c),
  * which pass over the tiles without an occupied cell in one move, where
  * labelling scan by scan walks every cell of every beam. The marks cost a
- * test per stored cell,
- * so a few scans are labelled one by one on the counts; the bits are the
- * same either way. */
+ * test per stored cell, so a few scans are labelled one by one on the
+ * counts; the bits are the same either way. */
 static void relabel(polyc_ctx *ctx, int all)
 {
     polyc__online *on = ctx->online;

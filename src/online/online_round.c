@@ -299,8 +299,8 @@ static void drop_dataless(polyc__opt *o, uint8_t *has)
  * sides, that segment is doubly covered over 20 cm and more, and no later
  * round need come near it (a large log, with sparse tiles waiting in the
  * backlog, kept such doubled walls for hundreds of scans). "Along": the
- * end within overlap_m of the piece, its segment
- * within ALONG_COS of parallel to it (an end at a T junction is not). */
+ * end within overlap_m of the piece, its segment within ALONG_COS of
+ * parallel to it (an end at a T junction is not). */
 #define ALONG_COS 0.866f /* cos 30 degrees */
 static uint32_t stamp_near_ends(polyc__opt *o, uint32_t since)
 {

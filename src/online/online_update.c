@@ -16,8 +16,8 @@
  * near the robot are then paid once for several scans, not for each.
  * Twice these (8 tiles or 16 scans) took less time in all but left the
  * online map's precision further behind the batch map's on the worst
- * simulated scenes; four times these saved nothing, as each round grew,
- * and made the slowest updates slower. */
+ * simulated scenes; four times these saved no time, as each round grew
+ * larger. */
 #define ROUND_TILES 4u
 #define ROUND_WAIT_SCANS 8u
 /* After a recount (pose corrections), each update puts back the records of

@@ -53,10 +53,10 @@
  * learning. (Dense rows for every cell would be zeroed, summed and smoothed
  * cell by cell: a single long-range scan's extent holds a hundred times the
  * cells its returns touch, and those passes were a visible share of its
- * time.) The prior grid is the tile grid; if that grid has
- * more cells than polyc__prior_bytes allows for (a long diagonal extent
- * under a tight limits.max_grid_cells), prior cells are made K x K tiles for
- * the smallest K that fits. */
+ * time.) The prior grid is the tile grid; if that grid has more cells than
+ * polyc__prior_bytes allows for (a long diagonal extent under a tight
+ * limits.max_grid_cells), prior cells are made K x K tiles for the
+ * smallest K that fits. */
 #include "../context.h"
 
 #include <math.h>

@@ -276,8 +276,8 @@ int polyc__op_zigzag(polyc__opt *o)
  * double cover do (a wall that runs a hand's breadth past its corner and
  * comes back at under a degree; a short end folded back at a sharp angle;
  * two legs of a few decimetres turning through two vertices a few cm
- * apart). Such folds escaped band15 and
- * double cover alike when short, and the zigzag's BIC test kept them. A
+ * apart). Such folds escaped band15 and double cover alike when short,
+ * and the zigzag's BIC test kept them. A
  * thin wall's end drawn round has its faces farther apart and stays. Run
  * on the map the search keeps (and after each online round), not in its
  * iterations, whose folds the next moves often undo: removing them there

@@ -309,11 +309,11 @@ static int drop_stretch(polyc__opt *o, int32_t v, float t0, float t1)
  * of the wall's next piece. Nothing in the BIC pulls it back (the points it
  * overlaps cost the same on either piece), and band15 counts the stretch
  * with its 15 cm reach: an end a decimetre past a T junction, a few cm off
- * the other line, counts as a run of twice that (its covered stretch, just
- * under ZIP_RUN_M, is too short for the zip's runs; one just over it goes
- * whole to the zip, which leaves the end short of the junction). Only
- * where the two are seen from the same side:
- * a thin wall's other face is not the wall's next piece. The end is pulled
+ * the other line, counts as a run of over twice that (its covered
+ * stretch, just under ZIP_RUN_M, is too short for the zip's runs; one just
+ * over it goes whole to the zip, which leaves the end short of the
+ * junction). Only where the two are seen from the same side: a thin
+ * wall's other face is not the wall's next piece. The end is pulled
  * back to where the other piece begins: the covered stretch's inner end
  * plus the cover's reach (overlap_m, or the stretch if shorter). Returns
  * the new end's fraction along segment v in *t, and which end in *tail
@@ -374,8 +374,8 @@ static int zip_pass(polyc__opt *o, uint32_t since)
     polyc__store *s = o->s;
     int zipped = 0;
     if (o->seg_side) {
-        /* in an online round, from the region's points: from every point
-         * each round, the sides cost each round as much as the whole map */
+        /* in an online round, from the region's points: taken from every
+         * point, the sides cost each round in proportion to the whole map */
         int32_t np = polyc__region_points(o, polyc__in_region);
         const polyc__side_scratch sd = polyc__sides(o);
         polyc__find_sides(o, np >= 0 ? o->region_pt : NULL, np, sd.left_w, sd.right_w);
