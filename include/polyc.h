@@ -366,10 +366,11 @@ typedef struct polyc_change {
 #define POLYC_CHANGE_MODIFIED 2u
 #define POLYC_CHANGE_REMOVED 3u
 
-/* The default work budget of an update: about 20 ms of one core of the
- * bench machine when the backlog is long (docs/performance.md); most
- * updates need far less. A unit is one weighted data point taken into a
- * re-optimised region (docs/api.md). */
+/* The default work budget of an update, in units: an update with a long
+ * backlog uses it up; most updates need far less. A unit is one weighted
+ * data point taken into a re-optimised region (docs/api.md). What a unit
+ * costs in time depends on the machine: measure it, or see the times at
+ * this default in docs/performance.md, "Online". */
 #define POLYC_ONLINE_WORK_DEFAULT 8000u
 
 /* Limits for an area of side area_m (metres) and scans of up to
@@ -386,8 +387,9 @@ POLYC_API size_t polyc_online_memory_size(const polyc_config *config,
  * (polyc_add_scan, polyc_build, ...) refuse it with POLYC_ERR_STATE. */
 POLYC_API polyc_status polyc_online_init(void *block, size_t size, const polyc_config *config,
                                          const polyc_online_limits *limits, polyc_ctx **out);
-/* Adds one scan to the grid, the data and the prior (a few hundred
- * microseconds for 180 beams); the map changes only at the next update.
+/* Adds one scan to the grid, the data and the prior (a cast of its beams,
+ * no search: docs/performance.md, "Online", gives the time an add takes);
+ * the map changes only at the next update.
  * The scan's pose and endpoints must lie more than 1 m inside the area's
  * square (vertices may wander past the data).
  * keep != 0 keeps the scan for polyc_online_correct (POLYC_ERR_LIMIT when

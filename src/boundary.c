@@ -29,7 +29,7 @@ float polyc__heading(double theta_rad)
 {
     /* whole turns off, by additions (|theta| <= 1e4 rad, polyc__pose_ok:
      * at most 1,592 of them): libm's remainder() and a multiply would
-     * bring 1.3 KB of software double into every firmware */
+     * bring a kilobyte and more of software double into every firmware */
     while (theta_rad > PI)
         theta_rad -= TWO_PI;
     while (theta_rad < -PI)

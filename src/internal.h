@@ -298,7 +298,8 @@ float polyc__spacing_at(const polyc__spacing *sp, float x, float y);
 /* ---- blocks.c: the weighted points' blocks ----
  * Weighted points gather the endpoints of a block of 2 x 2 grid cells (5 cm
  * at the default grid): a quarter of the points to score, while the moments
- * keep each block's squared distances exact (measured in docs/performance.md). */
+ * keep each block's squared distances exact (docs/algorithm.md, "The
+ * score", its departure "weighted points"). */
 #define POLYC__BLOCK_SHIFT 1
 #define POLYC__BLOCK_SIDE (1 << POLYC__BLOCK_SHIFT)
 /* The blocks of tile t that hold data marked (t->mark), from the counters;

@@ -33,8 +33,9 @@ typedef struct polyc__eval_scratch {
      * across; agg_t: its direction), so that a trial costs O(1) for them:
      * listed in agg_pt, those of segment 0 from the front (agg_n[0]), of
      * segment 1 from the back. (In x and y, the small sum across a long
-     * wall is the difference of large ones: in float, a map of ten passes
-     * over a log lost it to rounding and kept 120 vertices for 68.) */
+     * wall is the difference of large ones: in float, a map of a log seen
+     * in many passes lost it to rounding and kept far more vertices than
+     * its walls need.) */
     int32_t *agg_pt, agg_cap, agg_n[2];
     /* the segments (other than the old ones) near the prepared region, for
      * the points whose own segment goes: cand_n < 0 not gathered yet,

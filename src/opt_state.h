@@ -211,8 +211,8 @@ int polyc__size_carve(polyc__arena *a, polyc__size_scratch *sz, int32_t V);
 /* a data point supports the stretch of map within this distance of it:
  * splits and end trimming count only such points (not in the paper) */
 #define POLYC__SUPPORT_M 0.05f
-/* listed points copied by field for the trials (intel: all but 170 of
- * 524,000 trials list fewer) */
+/* listed points copied by field for the trials (nearly every trial on a
+ * real log lists fewer) */
 #define POLYC__LOC_SOA 256
 /* segments one edit replaces, at most (corners: a chain of 3 and its two ends) */
 #define POLYC__EDIT_SEGS 6
@@ -271,7 +271,7 @@ inline int polyc__buckets_around(const polyc__hash *h, int32_t bx, int32_t by, i
  * two of them comes twice): the walk of every query near a point (a search
  * radius is at most a bucket). Two loops, so that the walk costs what the
  * loops written out did (an iterator function, inlined or not, cost the
- * embedded online example 1.7 to 2.8 % more instructions at -Os): in the
+ * embedded online example measurably more instructions at -Os): in the
  * body, `continue` goes to the next segment, `break` only to the next
  * bucket (leave the walk with return or goto). The hash must not change
  * during the walk.

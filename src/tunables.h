@@ -87,9 +87,9 @@
 #define POLYC__POLISH_SPLITS 8
 /* An iteration still coming down from the noise by more than this share of
  * the BIC does not use up the patience: where a band's points weigh less
- * (accuracy.c) the climb back is slower, and belgioioso's search stopped at
- * iteration 0's map (958 vertices) while each iteration still gained 1-2 %
- * (760 vertices when it may go on). */
+ * (accuracy.c) the climb back is slower, and a log's search stopped at
+ * iteration 0's map while each iteration still gained a percent or two
+ * (allowed to go on, it ends with a fifth fewer vertices). */
 #define POLYC__RECOVER_GAIN 5e-3f
 
 #endif

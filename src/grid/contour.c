@@ -73,14 +73,14 @@ static int occupied(const polyc__tile *t, int idx)
  * search radii of it (a square). A wall seen only at grazing angles, or
  * through a band of pose error, has cells that the beams running along it
  * cross more often than they end in: none reaches the threshold, and its
- * returns are data that no contour cell explains. On intel a 2.5 m wall at
- * (7.3, 1.9) - (9.2, 0.7) m with some 1,300 returns, free in the grid, was
- * drawn only when the search happened to lay a segment along it (the BIC
- * over seeds 1-11 ranged from 71,700 to 81,800). Within one search radius
- * (15 cm) the edges of wide bands beside occupied cells were labelled too
- * and traced as a second line (freiburg-079's band15 0.22 -> 1.21 %); two
- * (30 cm) leave bands to their walls. The trace drops short walks on such
- * cells alone (trace.c). */
+ * returns are data that no contour cell explains. Such a wall, metres long
+ * with a thousand returns yet free in the grid, was drawn only when the
+ * search happened to lay a segment along it, so the map (and its BIC)
+ * depended on the seed: the same log gave maps with and without the wall.
+ * Within one search radius (15 cm at the defaults) the edges of wide bands
+ * beside occupied cells were labelled too and traced as a second line
+ * beside the wall's; two (30 cm) leave bands to their walls. The trace
+ * drops short walks on such cells alone (trace.c). */
 #define DATA_ALONE_RADII 2.0f
 
 /* Whether an occupied cell lies in columns c0..c1 (within one tile) of row

@@ -5,8 +5,9 @@
  * which a gap between points is just sampling, not a gap in the wall.
  * With at most DIRECT_POSES poses (a single scan) there is no table: the
  * distance is measured to each pose when asked. The table's two passes
- * over every tile of the extent would take 5-6 % of a freiburg-campus
- * scan's time (13,000 tiles for its 80 m returns), for a handful of queries. */
+ * over every tile of the extent would cost a single scan with long-range
+ * returns (tens of thousands of tiles) a noticeable share of its time, for
+ * a handful of queries. */
 #include "../context.h"
 
 #include <math.h>

@@ -21,14 +21,14 @@ void polyc__online_stage_limits(const polyc_online_limits *ol, polyc_limits *lim
     /* the spatial hash takes at most 16 buckets a beam of max_beams (and
      * fewer for a small grid): an update's pass over the points' order
      * walks every bucket, so their count stays bounded whatever the area
-     * (on a 500 m square, a bucket per 0.4 m made intel's updates 7 times
-     * slower than on its 50 m one) */
+     * (buckets sized by the area made the same building's updates several
+     * times slower in a large square than in one that just holds it) */
     lim->max_beams = ONLINE_HASH_BEAMS;
     lim->max_grid_cells = ol->max_grid_cells;
     lim->max_vertices = ol->max_vertices;
     /* a weighted point gathers the data cells of a 2 x 2 block: half of
-     * them is room for blocks of under two cells on average (intel's hold
-     * 2.5, freiburg-079's 7) */
+     * them is room for blocks of under two cells on average (a wall's
+     * blocks usually hold more, long-range data many more) */
     lim->max_points = ol->max_points / 2 > 16 ? ol->max_points / 2 : 16;
 }
 
@@ -63,22 +63,23 @@ polyc_status polyc_online_limits_for_area(const polyc_config *config, double are
         return POLYC_ERR_CONFIG;
     float side = ceilf(area / config->cell_m / POLYC__TILE_SIDE);
     float tiles = side * side;
-    /* the tiles a building's walls reach: intel 851 of its 50 m square's
-     * 3,906, freiburg-campus 15,399 of its 524 m square's 429,025; a small
-     * square is taken whole, a large one for a sixteenth (at least 1,024) */
+    /* the tiles a building's walls reach: a share of its square's tiles,
+     * a few percent of a campus's where most of the square is open ground
+     * or never seen; a small square is taken whole, a large one for a
+     * sixteenth (at least 1,024) */
     float stored = tiles <= 1024.0f ? tiles : fmaxf(1024.0f, ceilf(tiles / 16.0f));
     float cells = fminf(stored * POLYC__TILE_CELLS, 0x40000000);
-    /* endpoints fall in one cell in 15 of a stored tile on intel (57,712
-     * cells in 851 tiles), one in 5 on freiburg-079 (143,127 in 720, long
-     * range in a small building): room for one in 4 (the tool doubles the
-     * limits of a map that needs more) */
+    /* endpoints fall in a small share of a stored tile's cells (those
+     * along its walls; more where long-range returns spread them in a small
+     * building): room for one in 4 (the tool doubles the limits of a map
+     * that needs more) */
     float points = fminf(fmaxf(cells / 4.0f, 4096.0f), 0x10000000);
     out->area_m = area_m;
     out->max_grid_cells = (uint32_t)cells;
     out->max_points = (uint32_t)points;
     /* vertices: the map and what the rounds and the finishing call trace
      * into it, a vertex per 16 data cells (room for a whole contour traced
-     * at once: intel's batch trace is 15,000 of them) */
+     * at once, as the batch traces it) */
     out->max_vertices = (uint32_t)(points / 16.0f) + 4096;
     out->max_scan_beams = max_scan_beams;
     return POLYC_OK;

@@ -30,8 +30,8 @@ static uint32_t hash_of(const polyc__flat *f, uint32_t i)
 /* Sorts by id (ids are unique), in place: a heap sort. The store hands
  * out slots in order but a new polyline takes a freed slot with a fresh
  * id, so on a large map the ids come far out of order: an insertion sort
- * took most of the publication's time on freiburg-campus (2,850
- * polylines). */
+ * (quadratic then) took most of the publication's time on a map of
+ * thousands of polylines. */
 static void sift_down(polyc__pub *p, uint32_t root, uint32_t n)
 {
     polyc__pub x = p[root];

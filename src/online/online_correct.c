@@ -38,17 +38,18 @@ static void moved_scan(const polyc_ctx *ctx, uint32_t k, double x, double y, dou
  *   again, as a batch build counts them: the tiles of all their hits
  *   wanted first, then one cast each, over the tiles not stored in one
  *   move; the records of those the updates make again after (online_grid.c).
- *   Taking each scan out and in again costs two casts a scan (intel: 910
- *   corrections in 288 ms, against 130 counted afresh), and the float sums
- *   come out exact;
+ *   Taking each scan out and in again costs two casts a scan, counting
+ *   afresh one and a pass over the tiles, and the float sums come out
+ *   exact;
  * - otherwise each moved scan's counts and sums are taken out exactly (the
  *   counters are integers; one that saturated is not taken below 0) and
  *   added back at the new pose.
  * Then the contour is cast, on the grid with every correction in it: a
  * scan cast as its correction came would meet, at its new pose, cells that
  * still held the misses of the scans not corrected yet, and see through
- * walls those scans saw (intel's drift row: 1.056 times the batch map's
- * BIC that way, 0.986 cast after all). When every scan is kept, the
+ * walls those scans saw: a drifted log corrected that way kept a map
+ * clearly worse than the batch map; cast after all, a map as good as the
+ * batch map. When every scan is kept, the
  * contour is cleared and cast from all of them: the batch's contour, with
  * the old poses' gone; otherwise the old poses' contour stays (it only
  * seeds the trace). */
@@ -145,10 +146,10 @@ static polyc_status move_each(polyc_ctx *ctx)
 
 /* The contour of the moved scans (all: cleared, and every kept scan's).
  * Many scans are cast as the batch casts, on the tiles' marks (contour.c),
- * which pass over the tiles without an occupied cell in one move: for
- * intel's 910 scans 75 -> 35 ms. The marks cost a test per stored cell,
- * so a few scans are labelled one by one on the counts; the bits are the
- * same either way. */
+ * which pass over the tiles without an occupied cell in one move, where
+ * labelling scan by scan walks every cell of every beam. The marks cost a
+ * test per stored cell, so a few scans are labelled one by one on the
+ * counts; the bits are the same either way. */
 static void relabel(polyc_ctx *ctx, int all)
 {
     polyc__online *on = ctx->online;
@@ -172,8 +173,8 @@ static void relabel(polyc_ctx *ctx, int all)
  * poses now, and every tile joins the backlog: its points' weights change.
  * Without it the drifted scans' pairs stay, and the weights they give (a
  * band's, where the drift spread a wall) fit the corrected map loosely:
- * intel's drift experiment came out at 1.23 times the batch map's BIC on
- * the true poses' data. The learning waits for the next round or scan
+ * a drifted log corrected without it ended well above the batch map's BIC
+ * on the true poses' data. The learning waits for the next round or scan
  * (polyc__online_learn_due): nothing reads the two before, and the update
  * that applies the corrections does nothing else. */
 void polyc__online_learn_due(polyc_ctx *ctx)

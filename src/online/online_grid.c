@@ -12,9 +12,9 @@
  * beam ends in and every miss there is counted. An online grid stores a
  * tile when the first beam ends in it; the misses beams made there before
  * would be lost, and a person who stops in a hall that the robot has seen
- * through for minutes would look as solid as a wall (the sweep's
- * thinwalls seed 8 drew one 29.7 mm off the walls against the batch's
- * 2.8; freiburg-campus had 3,340 polylines against the batch's 2,540).
+ * through for minutes would look as solid as a wall (online maps drew
+ * lines through open halls that the batch map leaves empty, and a campus
+ * log's map kept far more polylines than the batch's).
  * So a tile not stored that beams cross takes a record from a pool (548
  * bytes, not a tile's 4 KiB; sized below): its misses at half
  * a byte a cell, exact up to POLYC__PRE_FULL, and per block of 8 x 8 cells
@@ -23,8 +23,8 @@
  * the cap its own count, a cell at the cap its share of what its block's
  * sum holds beyond the cells below the cap. A cell next
  * to a wall, crossed by a few grazing beams, keeps those few (a block's
- * mean there put a wall first seen late under the free cells' misses: the
- * map of intel's first 100 scans scored 1.19 times the batch's BIC). */
+ * mean there put a wall first seen late under the free cells' misses, and
+ * the early map lost walls that the batch map of the same scans has). */
 
 static int pre_block(int idx)
 {
@@ -127,10 +127,10 @@ int polyc__records_walk(polyc__records *rec, size_t d, polyc__walk *w, int64_t m
 
 
 /* The pool: for four times as many tiles as the grid stores, and no more
- * than the area holds. On freiburg-campus beams cross 59,893 tiles, 15,405
- * of them stored; the sweep's halls, seen with a 30 m scanner, spent a
- * pool of twice the tiles (hall seed 6: core precision 10.9 mm against 9.9
- * with every record it needed), not one of four. */
+ * than the area holds. On a large log the beams cross about four times
+ * the tiles that end up stored; a hall seen with a long-range scanner
+ * spent a pool of twice the tiles, and its map lost precision against one
+ * with every record it needed, but not a pool of four. */
 static size_t pool_records(uint32_t tile_cap, size_t dir_n)
 {
     size_t n = 4 * (size_t)tile_cap;
@@ -154,7 +154,7 @@ int polyc__records_carve(polyc__arena *a, polyc__records *r, uint32_t tile_cap, 
 /* ---- the records made again after a recount ----
  * Counting every kept scan again (a pose correction of most of them) as
  * the batch counts, over the tiles not stored in one move, saves walking
- * their cells: on intel, 910 scans in 70 ms instead of 105. The records
+ * their cells one by one, the larger part of a recount's time. The records
  * those misses belong to are made again afterwards, a slice of scans at a
  * time (polyc__online_redo_records): each scan's beams walk the tiles that were not stored
  * at the recount (redo_need) and skip the others, whose counts are

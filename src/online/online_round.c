@@ -114,8 +114,8 @@ static int explained(const polyc__opt *o, float x, float y, float near, float fa
             continue;
         /* the sides along the segment's left normal (-dy, dx), each
          * taken only when seen clearly across the segment: a wall seen
-         * at a grazing angle has no side to speak of (on fhw, a wall
-         * seen along its length got lines on both "sides", a wedge) */
+         * at a grazing angle has no side to speak of (a wall seen along
+         * its length got lines on both "sides", a wedge) */
         float sx = o->seg_side ? o->seg_side[2 * sg] : 0.0f;
         float sy = o->seg_side ? o->seg_side[2 * sg + 1] : 0.0f;
         float seen = -sx * dy + sy * dx, cell = -vx * dy + vy * dx;
@@ -129,8 +129,8 @@ static int explained(const polyc__opt *o, float x, float y, float near, float fa
 /* The points of the buckets within a bucket of the taken tiles, listed in
  * o->region_pt: those that give the sides of the segments near the tiles'
  * cells (their sides there). Returns their count. (From every point in
- * every round, as the zip took them too, the sides were a tenth of
- * freiburg-campus's update time.) */
+ * every round, as the zip took them too, the sides cost each round in
+ * proportion to the whole map, not to its region.) */
 static int32_t taken_points(polyc_ctx *ctx, uint32_t taken)
 {
     polyc__online *on = ctx->online;
@@ -259,9 +259,9 @@ static void stamp_region(polyc_ctx *ctx, uint32_t taken, uint32_t since)
  * walking by), their points left the data when the tile was made again.
  * (In a batch build every polyline starts on contour cells that hold data.)
  * Requiring the support to lie in occupied cells as well dropped the
- * people's lines on the sweep's halls (full-map RMS median 22.6 to 9.3 mm)
- * but also walls drawn through bands, whose cells fall under the contour
- * threshold: intel's final BIC 67,795 to 76,137, orebro's 45,582 to 47,449. */
+ * people's lines in open halls but also walls drawn through bands, whose
+ * cells fall under the contour threshold, and the real logs' final maps
+ * came out clearly worse for it. */
 static void drop_dataless(polyc__opt *o, uint8_t *has)
 {
     const polyc__store *s = o->s;
@@ -297,9 +297,10 @@ static void drop_dataless(polyc__opt *o, uint8_t *has)
  * round's climb can bring an end along a piece outside the region that the
  * round did not edit: where two ends reach into one segment from both
  * sides, that segment is doubly covered over 20 cm and more, and no later
- * round need come near it (acapulco, scans 250 to 800, with sparse tiles in
- * the backlog). "Along": the end within overlap_m of the piece, its segment
- * within ALONG_COS of parallel to it (an end at a T junction is not). */
+ * round need come near it (a large log, with sparse tiles waiting in the
+ * backlog, kept such doubled walls for hundreds of scans). "Along": the
+ * end within overlap_m of the piece, its segment within ALONG_COS of
+ * parallel to it (an end at a T junction is not). */
 #define ALONG_COS 0.866f /* cos 30 degrees */
 static uint32_t stamp_near_ends(polyc__opt *o, uint32_t since)
 {
@@ -336,10 +337,9 @@ static uint32_t stamp_near_ends(polyc__opt *o, uint32_t since)
  * the data; returns how many links. The operators merge first, and their
  * split, climbs and trims leave some ends within reach again; a batch
  * build's next iteration links those, an update's next round does only if
- * its region holds them. Left, they piled up: edmonton's maps after 200
- * and 300 scans had 169 and 194 pairs of ends of two polylines within
- * 15 cm (most of them two-vertex pieces of one wall), the batch map 8;
- * with the links 30 and 36. */
+ * its region holds them. Left, they piled up: the online maps of a log
+ * held many times the batch map's pairs of ends of two polylines within
+ * 15 cm, most of them two-vertex pieces of one wall. */
 static int link_left_ends(polyc__opt *o)
 {
     if (!o->pol.restructure)
@@ -420,7 +420,7 @@ static polyc_status remap_taken_tiles(polyc_ctx *ctx, uint64_t work, int all, ui
     o->region_since = since;
     /* the batch iteration's operators from the table, without additions:
      * the finishing search adds vertices, and with them in every round
-     * intel's updates took twice as long for the same final map */
+     * the updates took far longer for the same final map */
     polyc__op_args ops;
     memset(&ops, 0, sizeof ops);
     ops.since = ops.climb = since;

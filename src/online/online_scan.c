@@ -24,9 +24,9 @@
  * never gains CHANGE_MIN endpoints at once: it joins the backlog at the
  * periodic check once it holds SPARSE_MIN new endpoints and at least as
  * many as it held when last made. Without this such walls waited for the
- * finishing call: on intel the map of the first 100 scans scored 1.66
- * times the BIC of the batch map of those scans on the batch's data
- * (tools/eval/fairbic.h), 0.995 with it. */
+ * finishing call, and the map between updates lacked walls that a batch
+ * map of the same scans has (its BIC on the batch's data far above the
+ * batch map's, tools/eval/fairbic.h; level with it with this rule). */
 #define SPARSE_MIN 4u
 
 /* Endpoints and poses must stay this far inside the area: vertices may
@@ -36,9 +36,9 @@
 /* The layer's spacing table (polyc__layer): from the tiles where some pose
  * was (the poses are not kept);
  * made again when a pose fell in a new tile, at most once in this many
- * scans (a pass over the area's tiles: on freiburg-campus's 300 m square,
- * at every new pose tile, 30 % of the updates' time): meanwhile a new
- * tile's spacing is measured from the poses before it. */
+ * scans (a pass over the area's tiles: on a large square, made at every
+ * new pose tile, it took a large share of the updates' time): meanwhile a
+ * new tile's spacing is measured from the poses before it. */
 #define REMAKE_SCANS 32u
 
 polyc_status polyc__online_spacing(polyc_ctx *ctx, polyc__spacing *sp, size_t n)

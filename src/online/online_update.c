@@ -13,21 +13,21 @@
  * tile in it has waited this many scans, when no scan came since the last
  * update, or when there is no map yet. A round's fixed costs (the passes
  * over the map's ends, the region's books) and the climbs of the vertices
- * near the robot are then paid once for several scans, not for each. On
- * intel, 4 tiles or 8 scans made 666 rounds and 1.06 s of updates; 8 or 16
- * made 371 rounds and 0.70 s, but the sweep's worst row (online against
- * batch core precision) went from 2.73 to 3.13 times; 16 or 32, 180 rounds
- * and 1.05 s (the rounds grew), a p99 of 8 ms. */
+ * near the robot are then paid once for several scans, not for each.
+ * Twice these (8 tiles or 16 scans) took less time in all but left the
+ * online map's precision further behind the batch map's on the worst
+ * simulated scenes; four times these saved no time, as each round grew
+ * larger. */
 #define ROUND_TILES 4u
 #define ROUND_WAIT_SCANS 8u
 /* After a recount (pose corrections), each update puts back the records of
- * this many of the kept scans' beams (online_grid.c): intel's 910 scans in 10
- * updates, some 4 ms each. */
+ * this many of the kept scans' beams (online_grid.c): a log's records come
+ * back over several updates, a small part of each one's time. */
 #define REDO_BEAMS 16384u
 /* Corrections count against an update's budget: a unit for every two
- * beams they cast (a beam through the grid costs about half a tile cell's
- * unit: intel's recount, 163,800 beams in 47 ms). An update whose
- * corrections spent its budget does nothing else. */
+ * beams they cast (a beam cast through the grid costs about half of what
+ * a unit stands for). An update whose corrections spent its budget does
+ * nothing else. */
 #define CAST_BEAMS_PER_UNIT 2u
 
 static polyc_status online_ctx(polyc_ctx *ctx)
@@ -77,8 +77,9 @@ polyc_status polyc_online_update(polyc_ctx *ctx, uint64_t work, polyc_online_rep
     uint64_t corrections = cast / CAST_BEAMS_PER_UNIT; /* their units */
     if (corrections >= work) {
         /* the corrections spent the budget: the rounds come in the next
-         * updates (intel's 910 at once: some 90 ms; a round and the
-         * records' first slice after them took another 16) */
+         * updates (a whole log corrected at once already takes several
+         * budgets' time; a round and the records' first slice on top would
+         * make that one update longer still) */
         on->pending = 0;
         report(ctx, corrections, 0, out);
         return POLYC_OK;
@@ -107,9 +108,9 @@ polyc_status polyc_online_update(polyc_ctx *ctx, uint64_t work, polyc_online_rep
  * the finishing search: the batch traces only cells occupied at the end,
  * and could not have drawn it. The updates traced it when its cells were
  * occupied, a person standing or walking by, and its points (the person's
- * returns) keep it (the sweep's thinwalls seed 3: a 12 cm piece 0.3 m from
- * a wall, core precision 12.0 mm against the batch's 4.5). Longer polylines
- * stay: a wall drawn through a band may have no occupied cell under it. */
+ * returns) keep it: a short piece standing free beside a wall, which the
+ * batch map of the same scans does not have. Longer polylines stay: a
+ * wall drawn through a band may have no occupied cell under it. */
 #define UNOCCUPIED_MAX_M 0.5f
 
 /* Whether a cell within one of (x, y) is occupied now. */
@@ -175,25 +176,22 @@ static void drop_unoccupied(polyc_ctx *ctx)
  * defaults): the updates have fitted every piece of the map to its data,
  * and the batch's 5 cm, meant to shake a traced contour out of its cells,
  * undoes that fit faster than the search's patience lets it come back.
- * With 5 cm, fhw's noisy iterations settled at a BIC 0.8-1.3 % above the
- * map the updates left, which the search then kept (1.037 times the batch
- * map's on the batch's data); from 0.0245 m they went below it. On twelve
- * real logs the final BIC on the batch's data fell on eleven (fhw 1.037 ->
- * 1.021, acapulco 1.020 -> 1.000, infinite-corridor 1.010 -> 0.991,
- * seattle 1.017 -> 1.014) and rose on orebro (0.965 -> 0.973); from
- * 0.012 m it fell on ten. The sweep's online core precision came within
- * 10 % of the batch's on 88 of 120 scenes, against 85 (its worst row in
- * those runs, hall seed 12, 1.77 -> 2.08 times). */
+ * With 5 cm, the noisy iterations could settle at a BIC above the map the
+ * updates left, and the search then kept that worse map; from 0.0245 m
+ * they go below it. Started there, the final map's BIC on the batch's data
+ * came out lower on nearly every real log, and the simulated scenes' online
+ * precision nearer the batch's, than from 5 cm or from one decay further
+ * (0.012 m). */
 #define FINISH_NOISE_SKIP 2
 
 /* The finishing call: every tile's data made again, what no polyline
  * explains traced (explained: the finishing round's rule), then the batch
  * search from the map. With the rounds' 10 cm everywhere, the search has
- * nothing to start a thin wall's far face or a door jamb from: the sweep's
- * online core precision within 10 % of batch on 40 of 60 scenes (worst
- * 4.45 times, thin walls) against 43 (3.03) with the finishing rule. A
- * second search from the contour traced afresh doubled the finishing time
- * and won on no real log. */
+ * nothing to start a thin wall's far face or a door jamb from: the online
+ * maps of simulated scenes, thin walls the worst, fell further behind the
+ * batch maps' precision than with the finishing rule. A second search from
+ * the contour traced afresh made the finishing call much longer and gave
+ * no better map on the real logs. */
 polyc_status polyc_online_finish(polyc_ctx *ctx, polyc_progress_fn progress, void *user,
                                  polyc_online_report *out)
 {

@@ -43,8 +43,8 @@
 #define PAIR_TRIES 16          /* other samples of the cell each sample is compared with */
 #define MIN_PAIRS 8            /* fewer pairs say nothing */
 #define CORRELATION_M 0.5f     /* one scan's points along this much wall share an error */
-/* the sample budget: one per SAMPLE_BEAMS beams of the limits (the real logs
- * take one per 3 to 11 beams: freiburg-campus 227,864 for 722,880 beams) */
+/* the sample budget: one per SAMPLE_BEAMS beams of the limits (room to
+ * spare: the real logs take one per several beams) */
 #define SAMPLE_BEAMS 2
 
 typedef struct acc_sample {

@@ -218,9 +218,8 @@ int polyc__op_adjust(polyc__opt *o, int max_rounds, uint32_t since)
                 continue;
             /* a single scan's ends are placed by end trimming (where the
              * end return's beam crosses the end segment's line), so a climb
-             * could only turn the end segment about its neighbour: on 100
-             * freiburg-campus scans that is a third of the climbs' trials
-             * for a tenth of their gain */
+             * could only turn the end segment about its neighbour: a large
+             * share of the climbs' trials for little of their gain */
             if (o->rays.on && (s->v[v].prev == POLYC__NONE || s->v[v].next == POLYC__NONE))
                 continue;
             int how = polyc__hill_climb(o, v);
@@ -230,10 +229,9 @@ int polyc__op_adjust(polyc__opt *o, int max_rounds, uint32_t since)
             if (how == 2 || !o->rays.on)
                 o->climb.v_work[v] = next;
             /* a single scan's neighbours are not climbed again for a move:
-             * on the 10 slowest freiburg-campus scans four climbs in five
-             * come from the first adjustment, and over 200 scans a log the
-             * re-climbs of neighbours lowered the ray RMSE by at most
-             * 0.5 mm for 3-16 % of the time (docs/performance.md) */
+             * on slow scans most climbs come from the first adjustment, and
+             * the re-climbs of neighbours bought well under a millimetre of
+             * ray RMSE for a noticeable share of the time */
             if (o->rays.on)
                 continue;
             int32_t nb[4] = {s->v[v].prev, s->v[v].next, POLYC__NONE, POLYC__NONE};

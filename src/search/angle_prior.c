@@ -51,11 +51,12 @@
  * rows handed out in the order cells get their first observation. The budget
  * is a row for every cell; what is not used is given back to the block after
  * learning. (Dense rows for every cell would be zeroed, summed and smoothed
- * cell by cell: 13,000 cells for a freiburg-campus scan whose returns touch
- * 100, 4 % of its time.) The prior grid is the tile grid; if that grid has
- * more cells than polyc__prior_bytes allows for (a long diagonal extent
- * under a tight limits.max_grid_cells), prior cells are made K x K tiles for
- * the smallest K that fits. */
+ * cell by cell: a single long-range scan's extent holds a hundred times the
+ * cells its returns touch, and those passes were a visible share of its
+ * time.) The prior grid is the tile grid; if that grid has more cells than
+ * polyc__prior_bytes allows for (a long diagonal extent under a tight
+ * limits.max_grid_cells), prior cells are made K x K tiles for the
+ * smallest K that fits. */
 #include "../context.h"
 
 #include <math.h>

@@ -63,11 +63,10 @@ static int in_region(const polyc__opt *o, int32_t e)
  * segments: its two vertices and points along it, at most overlap_m apart,
  * all lie within overlap_m of segments of other polylines (or of its own,
  * away from it). The ends alone are not enough: a wall between two corners
- * traced as separate polylines has both ends within reach of them. On
- * intel that test takes segments of up to 3.3 m (median 1.3 m) bridging two
- * other polylines for overlaps, and zipping them away raises the BIC by
- * 4,000 to 14,000 an iteration, which the rest of the iteration has to win
- * back. */
+ * traced as separate polylines has both ends within reach of them. On a
+ * real log that test takes segments a metre or more long, bridging two
+ * other polylines, for overlaps, and zipping them away raises the BIC each
+ * iteration by much more than the rest of the iteration wins back. */
 static int runs_along(const polyc__opt *o, int32_t e, int32_t e2, float lim)
 {
     const polyc__vertex *a = &o->s->v[e], *b = &o->s->v[e2];
@@ -274,16 +273,16 @@ int polyc__op_zigzag(polyc__opt *o)
 
 /* A fold whose shorter leg ends within overlap_m of the longer leg draws
  * that stretch of wall twice: it goes whatever the BIC, as crossings and
- * double cover do (acapulco's batch map had a wall run 14 cm past its
- * corner and come back at 0.8 degrees; intel's a 13 cm end folded back at
- * 18 degrees; an online map of freiburg-079 two legs of 37 and 46 cm,
- * turning through two vertices 3 cm apart). Such folds escaped band15 and
- * double cover alike when short, and the zigzag's BIC test kept them. A
+ * double cover do (a wall that runs a hand's breadth past its corner and
+ * comes back at under a degree; a short end folded back at a sharp angle;
+ * two legs of a few decimetres turning through two vertices a few cm
+ * apart). Such folds escaped band15 and double cover alike when short,
+ * and the zigzag's BIC test kept them. A
  * thin wall's end drawn round has its faces farther apart and stays. Run
  * on the map the search keeps (and after each online round), not in its
  * iterations, whose folds the next moves often undo: removing them there
- * too moved the search's path (the sweep's batch maps on target 62 -> 59
- * of 120, the summed core precision 910 -> 904 mm). */
+ * too moved the search's path, and the simulated scenes' batch maps came
+ * out no better, fewer of them on target. */
 static int is_fold(const polyc__vertex *a, const polyc__vertex *c, const polyc__vertex *b)
 {
     float ux = c->x - a->x, uy = c->y - a->y, wx = b->x - c->x, wy = b->y - c->y;
@@ -376,8 +375,8 @@ int polyc__op_unfold(polyc__opt *o)
         if (f == POLYC__NONE)
             continue;
         /* the fold's vertex, or the leg's far end where that keeps the map
-         * nearer its data (a corner's vertex at the fold: intel's 13 cm
-         * end) */
+         * nearer its data (a corner's vertex at the fold: a short end
+         * folded back past the corner) */
         float dv = polyc__removal_delta_below(o, v, FLT_MAX);
         float df = unfolds(o, v, f) ? polyc__removal_delta_below(o, f, FLT_MAX) : HUGE_VALF;
         int32_t go = df < dv ? f : v;

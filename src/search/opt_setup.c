@@ -64,8 +64,8 @@ void polyc__optimizer_reserve(polyc__arena *a, const polyc_config *cfg, const po
 /* An occupancy grid's data are cell centres, not noisy endpoints
  * (docs/algorithm.md, "From an occupancy grid"): its squared distances are
  * weighed as in 5 cm cells, alpha (GRID_CELL_M / r)^2 (alpha itself at 5 cm,
- * the maps ROS users keep: the sweep's occupancy maps 23 of 48 scenes on
- * target against 20 with alpha / 4; a room at 2.5, 5, 10 or 15 cm comes out
+ * the maps ROS users keep: with alpha / 4 fewer of the simulated scenes'
+ * occupancy maps came out on target; a room at 2.5, 5, 10 or 15 cm comes out
  * with its corner count of vertices); the search radius is at least
  * GRID_RADIUS_CELLS cells (at 5 cm, 2 cells lost pillars of the turtlebot3
  * map, at 15 cm 1 cell lost a box); and there is no angle prior (gamma 0:
@@ -75,10 +75,10 @@ void polyc__optimizer_reserve(polyc__arena *a, const polyc_config *cfg, const po
 #define GRID_RADIUS_CELLS 3.0f
 /* A grid's search: an iteration gains only if its BIC is lower by more
  * than GRID_GAIN of it, and noisy iterations count towards the patience. A
- * grid's data are exact cell centres: on the bench's 2,000 x 2,000-cell
- * maze the first iteration's map stayed the best through 12 more (its noise
- * a whole cell), and the search took 1.4 of the 1.5 s; with these rules 6
- * iterations, 0.85 s, the same map. */
+ * grid's data are exact cell centres: on a large maze grid the first
+ * iteration's map stayed the best through a dozen more (its noise a whole
+ * cell), which took most of the search's time; with these rules the
+ * search stops after half as many iterations, with the same map. */
 #define GRID_GAIN 2e-3f
 
 static polyc__policy policy_for(polyc__input kind)

@@ -120,9 +120,8 @@ static int keep_best(polyc__opt *o, polyc__op_args *a)
  * (clean) repeats these while they edit. A single scan's later iterations
  * climb only what the previous one edited after its first climbs (`climb`;
  * removals, zigzags, corners, trims): the vertices those climbs left at an
- * optimum stay there (on 200 freiburg-campus scans, with ends not climbed,
- * climbing them again takes a sixth of the time and lowers the BIC by
- * 0.15 %).
+ * optimum stay there (climbing them again costs a good share of the time
+ * and lowers the BIC by a fraction of a percent).
  * A NEW OPERATOR goes here, once: a row at the place in the order where it
  * runs, with its name, its call (o: the optimiser, a: the run's
  * polyc__op_args), the sequences it is a step of and its flags; its
@@ -280,8 +279,8 @@ polyc_status polyc__search(polyc__opt *o, polyc_progress_fn progress, void *user
          * cycle between maps that differ by a vertex and a fraction of it.
          * Iterations with noise do not use it up: their maps are perturbed
          * on purpose, and a run of them all worse than iteration 0 stopped
-         * infinite-corridor at iteration 5 with 5,766 vertices (3,793 when
-         * the noise is allowed to decay) */
+         * a long log's search early, with half as many vertices again as
+         * when the noise is allowed to decay */
         int gained = bic < best - (o->pol.gain_share > 0.0f ? fmaxf(1.0f, o->pol.gain_share * fabsf(best)) : 1.0f);
         /* Nor do iterations that are still coming down from the noise by
          * more than POLYC__RECOVER_GAIN of the BIC each (tunables.h) */
@@ -318,8 +317,8 @@ polyc_status polyc__search(polyc__opt *o, polyc_progress_fn progress, void *user
             break;
         /* A single scan has no noise either: an iteration that gained less
          * than one BIC unit leaves so little edited that the next ones gain
-         * nothing measurable (the 130 bench scans: 4 vertices more in
-         * all, the same f and ray RMSE, 4 % fewer instructions) */
+         * nothing measurable (over many scans a few vertices more in all,
+         * the same f and ray RMSE, for less work) */
         if (o->pol.stop_without_gain && !gained)
             break;
     }

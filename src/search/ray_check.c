@@ -115,7 +115,7 @@ static int met_by_any(const polyc__rays *rays, float c, float sn, float r, const
  * met within the tolerance by a segment the edit replaces. Without the
  * second rule a removal on a wall seen at a grazing angle can leave a
  * return 15-20 cm off the new line, and its beam then meets the map metres
- * behind it (freiburg-079: one beam 2 m off made most of the ray RMSE). */
+ * behind it (one such beam can make most of a scan's ray RMSE). */
 static int beam_blocked(const polyc__rays *rays, int32_t i, float c, float sn,
                         const beam_query *q)
 {
@@ -143,10 +143,10 @@ static int beam_blocked(const polyc__rays *rays, int32_t i, float c, float sn,
 /* Beam i meets segment a-b within the tolerance of its return: a return
  * the segment holds, at any range and incidence. Together with the rule on
  * the returns of replaced segments (beam_blocked) and polyc__loses_returns
- * that keeps every reflected beam on the map at no ray error: on 10 scans
- * of each real log, f >= 0.999 and ray RMSE <= 34 mm. (Without beam_blocked's
- * rule, holding far or flat returns raised acapulco's ray RMSE from 115 to
- * 188 mm, with ends kept decimetres off along beams 25-40 m long.) */
+ * that keeps every reflected beam on the map at no ray error. (Without
+ * beam_blocked's rule, holding far or flat returns raised the ray RMSE of
+ * a log with long beams by half, with ends kept decimetres off along beams
+ * tens of metres long.) */
 static int beam_own(const polyc__rays *rays, int32_t i, float c, float sn, const beam_query *q)
 {
     float ax = q->ax, ay = q->ay, bx = q->bx, by = q->by;
@@ -243,8 +243,8 @@ static int beam_newly_blocked(const polyc__rays *rays, int32_t i, float c, float
  * (the store still holds v where it is). A vertex that already blocks a
  * beam (an end near the sensor, where the range noise is as large as the
  * beam spacing) may still move, but not onto other beams: with any move of
- * such a vertex allowed, one climb on csail put a segment 5.3 m in front of
- * a return. */
+ * such a vertex allowed, one climb put a segment metres in front of a
+ * return. */
 int polyc__vertex_blocks(const polyc__opt *o, int32_t v, float x, float y)
 {
     if (!o->rays.on)

@@ -56,14 +56,14 @@ void polyc__find_sides(polyc__opt *o, const int32_t *list, int32_t n, float *lef
  * least this ratio (their unit views across it, by weight): a line drawn
  * between the two faces of a thin wall, each face 3 cm off it. Its summed
  * view nearly cancels, and the side rule of explained() left both faces to
- * it: on the sweep's thin walls, one line between the faces for most of a
- * wall's length, core precision 3 times the batch map's (seeds 2 and 6:
- * 7.0 and 6.4 mm; 1.9 and 2.8 mm with the rule, the batch's 2.3 and 2.8).
+ * it: on simulated thin walls the online map kept one line between the
+ * faces for most of a wall's length, several times the batch map's error;
+ * with the rule it is as precise as the batch map.
  * (online_round.c's explained(); and zip.c's band rule) */
 #define TWO_SIDED_RATIO 0.25f
 /* Only segments this long: on short ones (furniture, chair legs seen from
- * all round) the rule traced bits of clutter, orebro's finished map 523 ->
- * 624 polylines, 57 of them under 10 cm long against 23. */
+ * all round) the rule traced bits of clutter, a cluttered log's finished
+ * map a fifth more polylines, many of them under 10 cm long. */
 #define TWO_SIDED_MIN_M 0.5f
 
 /* Whether segment sg is seen from both sides, from the weights of views

@@ -25,8 +25,8 @@ int32_t polyc__hash_bucket_cap(const polyc_limits *lim)
     size_t cap = 4 * (tiles * 4 + 64) + 1024; /* wider buckets when the map is larger */
     /* and wider when the data are few for the area (one scan's 361 returns
      * over 80 m x 80 m): clearing and counting 160,000 buckets took more
-     * than the queries saved (30 bench single scans 384 -> 356 M
-     * instructions at 16 buckets a beam, the same maps' figures) */
+     * than the queries saved (at 16 buckets a beam single scans take fewer
+     * instructions for the same maps) */
     size_t by_beams = (size_t)lim->max_beams * HASH_BUCKETS_PER_BEAM + 4096;
     if (by_beams < cap)
         cap = by_beams;

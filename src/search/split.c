@@ -110,9 +110,9 @@ static int supports(const polyc__opt *o, int32_t i, int32_t sg)
 /* How much of the stretch [g0, g0 + len_gap] of segment a-b (of length
  * len) lies in free cells of an occupancy grid: only there does the grid
  * show that no wall stands (a stretch through unknown cells is a wall seen
- * in pieces, as through a door, not a gap: the sweep's occupancy maps of
- * the office scene keep 0.62 of its seen walls when unknown stretches are
- * cut too). Sampled every half cell. */
+ * in pieces, as through a door, not a gap: when unknown stretches are cut
+ * too, an office's occupancy map loses a large part of its seen walls).
+ * Sampled every half cell. */
 static float free_length(const polyc__opt *o, const polyc__vertex *a, const polyc__vertex *b,
                          float len, float g0, float len_gap)
 {
@@ -345,9 +345,8 @@ int polyc__op_split(polyc__opt *o)
 /* Whether pulling end vertex v back to (x, y) on its segment loses a
  * return the segment holds now (single scans only): on a segment that runs
  * along the beams the farthest projection of its points can fall short of
- * where the last beam crosses it (without this test edmonton,
- * infinite-corridor and csail each have a scan whose end beam then meets
- * the map metres behind its return). */
+ * where the last beam crosses it (without this test, scans of several real
+ * logs had an end beam that then meets the map metres behind its return). */
 static int trim_loses_returns(const polyc__opt *o, int32_t v, float x, float y)
 {
     const polyc__vertex *V = o->s->v;

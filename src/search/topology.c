@@ -219,7 +219,7 @@ int polyc__op_untangle(polyc__opt *o)
  * wall, lies on the other segment up to float's rounding, a tenth of a
  * millimetre through it or short of it, which the crossings' end rule lets
  * pass; printed to 0.1 mm a strict test finds a crossing or a touch
- * (shapely's validity on acapulco, edmonton). An end moves back along its
+ * (shapely's validity on real logs' maps). An end moves back along its
  * segment, a corner across the line. With p and q on two sides the
  * polyline crosses c-d at v: v goes 1.5 CROSS_END_M further its own way,
  * so that the crossing is one untangle sees. 0: unmoved, 1: cleared, 2:

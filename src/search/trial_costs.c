@@ -4,7 +4,7 @@
  * minimum. The loop has no branches, so that the compiler can vectorise it;
  * it is built with -fno-trapping-math (Makefile), without which gcc keeps
  * the comparisons as branches. The same flag on trial.c made its branchy
- * per-point code slower (single scans 3 %), hence a file of its own. */
+ * per-point code slower, hence a file of its own. */
 #include "../opt_state.h"
 
 /* Each value is the one trial.h's polyc__seg_pre_cost computes, operation for

@@ -94,10 +94,9 @@ static int parallel(const polyc__opt *o, int32_t v, int32_t sg)
  * Or, when v is seen from both sides (`v_two`), a parallel one seen from
  * both sides too: a thin wall seen from both sides through a band of pose
  * error, its two sides' points mixed over the band's width, which the BIC
- * draws as two lines each with points of both sides (csail at (8.7 ..
- * 10.1, -3.3 .. -3.6) m: a closed loop 1.3 m long and 12 cm wide round a
- * band whose returns from either side lie 1.3 and -1.8 cm off its middle,
- * 6 cm apart at one standard deviation). The faces of a partition seen
+ * draws as two lines each with points of both sides (a closed loop a
+ * metre long and a hand wide round a band whose returns from either side
+ * lie within two centimetres of its middle). The faces of a partition seen
  * cleanly are each seen from one side. At most BAND_CANDIDATES (the first
  * found), into cand; returns how many. */
 #define BAND_CANDIDATES 16
@@ -309,12 +308,12 @@ static int drop_stretch(polyc__opt *o, int32_t v, float t0, float t1)
  * where that piece begins: an end that overshoots a T junction or the start
  * of the wall's next piece. Nothing in the BIC pulls it back (the points it
  * overlaps cost the same on either piece), and band15 counts the stretch
- * with its 15 cm reach: on intel's online map an end 11 cm past a T
- * junction, a few cm off the other line, made a 27 cm run (its covered
- * stretch, 14 cm, was too short for the zip's runs; one colinear with the
- * other line, 16 cm covered, went whole to the zip, which left the end 5 cm
- * short of the junction). Only where the two are seen from the same side:
- * a thin wall's other face is not the wall's next piece. The end is pulled
+ * with its 15 cm reach: an end a decimetre past a T junction, a few cm off
+ * the other line, counts as a run of over twice that (its covered
+ * stretch, just under ZIP_RUN_M, is too short for the zip's runs; one just
+ * over it goes whole to the zip, which leaves the end short of the
+ * junction). Only where the two are seen from the same side: a thin
+ * wall's other face is not the wall's next piece. The end is pulled
  * back to where the other piece begins: the covered stretch's inner end
  * plus the cover's reach (overlap_m, or the stretch if shorter). Returns
  * the new end's fraction along segment v in *t, and which end in *tail
@@ -375,8 +374,8 @@ static int zip_pass(polyc__opt *o, uint32_t since)
     polyc__store *s = o->s;
     int zipped = 0;
     if (o->seg_side) {
-        /* in an online round, from the region's points: from every point
-         * each round, the sides took a tenth of freiburg-campus's updates */
+        /* in an online round, from the region's points: taken from every
+         * point, the sides cost each round in proportion to the whole map */
         int32_t np = polyc__region_points(o, polyc__in_region);
         const polyc__side_scratch sd = polyc__sides(o);
         polyc__find_sides(o, np >= 0 ? o->region_pt : NULL, np, sd.left_w, sd.right_w);

@@ -132,8 +132,8 @@ static float drop_cost(const chains *c, int32_t i, int32_t j, int32_t k)
  * along its beam. Douglas-Peucker alone keeps a vertex wherever the range
  * noise puts a return a cell off the chord, and the search's removals (one
  * vertex at a time, the chord of its neighbours, the beams as constraints)
- * leave many of them: from this start the 130 bench scans end with a
- * lower BIC, fewer vertices, and in less time (docs/performance.md). */
+ * leave many of them: from this start single scans end with a lower BIC,
+ * fewer vertices, and in less time. */
 void polyc__chain_merge_spans(chains *c, int32_t a, int32_t b)
 {
     int32_t inner = 0;

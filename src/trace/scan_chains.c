@@ -82,8 +82,8 @@ static polyc_status append(chains *c, int32_t line, float x, float y)
 /* Half a beam spacing at the endpoint of beam i: an end reaches that far
  * past its hit, so that its beam meets the map and the next beam does not.
  * (A floor of half a cell would make near returns, where a cell spans
- * several beams, block the neighbouring beams that saw through: csail's ray
- * RMSE 741 mm, against 22 mm without the floor.) */
+ * several beams, block the neighbouring beams that saw through, whose ray
+ * errors then swamp the scan's.) */
 static float half_spacing(const chains *c, int32_t i)
 {
     float dx = c->xy[2 * i] - c->ox, dy = c->xy[2 * i + 1] - c->oy;
@@ -335,7 +335,7 @@ static int links(const chains *c, const open_chain *h, int32_t i, int32_t n)
         return 1;
     /* (not behind occluders: hits receding along the beams behind a near
      * object, three of them in a line, are not a wall seen at a grazing
-     * angle; such a link ran 1.2 m along a beam of csail's) */
+     * angle; such a link ran a metre along a beam) */
     if (occluders > 0 || d2 > GRAZING_REACH * GRAZING_REACH * reach * reach)
         return 0;
     /* a wall seen at a grazing angle: three points in a line, the chain's

@@ -249,10 +249,9 @@ static uint32_t simplify(int32_t *xy, uint32_t n)
 /* A walk on none but the contour's data cells (contour.c: returns no
  * occupied cell explains) that spans less than this (the larger side of
  * its cells' bounding box) is not traced: a chair, a person who stood still
- * for a while (the sweep's shelves seed 4: a ring round a standing person,
- * 0.4 m across, a 0.6 m walk, took the map's RMS from 2.4 to 94 mm when
- * the walk's length was the measure). A wall seen at grazing angles is
- * longer. */
+ * for a while (a ring round a standing person, 0.4 m across, is a longer
+ * walk than that: with the walk's length as the measure it was traced, a
+ * line far off every wall). A wall seen at grazing angles is longer. */
 #define DATA_ONLY_MIN_M 0.5f
 
 /* Whether the walk holds no occupied cell and spans less than
