@@ -34,7 +34,7 @@ all: $(BUILD)/libpolyc.a $(BUILD)/libpolyc.so $(BUILD)/polyc
 
 # comparisons that may not trap: the only way gcc vectorises this loop (the
 # values are the same)
-$(BUILD)/obj/trial_costs.o: ALL_CFLAGS += -fno-trapping-math
+$(BUILD)/obj/search/trial_costs.o: ALL_CFLAGS += -fno-trapping-math
 $(BUILD)/obj/%.o: src/%.c include/polyc.h $(wildcard src/*.h)
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -c $< -o $@

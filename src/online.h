@@ -1,7 +1,6 @@
 /* online.h - the state of an online context and the online layer's
- * routines (src/online*.c, a layer above the batch stages: no batch file
- * includes this header, but for opt_setup.c and optimize.c, whose online
- * entries are declared at the end). Each part of the state has one file
+ * routines (src/online/, a layer above the batch stages: no batch file
+ * includes this header, make test-batch-alone). Each part of the state has one file
  * that owns it: the cell table (online_cells.c), the poses and the backlog
  * (online_scan.c; the rounds take tiles out: online_round.c), the kept
  * scans and their corrections (online_correct.c), the grid's records

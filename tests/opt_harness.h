@@ -20,6 +20,7 @@
 #include <string.h>
 
 #include "cost.h"
+#include "optimize.h"
 
 #define PI_D 3.14159265358979323846
 #define BEAMS 360
