@@ -127,8 +127,12 @@ def nth(rx, n):
 HEADS = {}  # each bench table's column names, as its header line has them
 
 
+ROW_LINES = {}  # the last text bench_tables read: {table: {row key: its line, 0-based}}
+
+
 def bench_tables(out):
     """{table: {row key: [tokens]}}: each table from its header line; '|' dropped"""
+    ROW_LINES.clear()
     heads = {
         'main': r'^scene\s+scans\s+beams\s+\|\s+parse',
         'topo': r'^scene\s+len\s+dcov',
@@ -145,6 +149,7 @@ def bench_tables(out):
     tables = {}
     for name, rx in heads.items():
         rows = {}
+        ROW_LINES[name] = {}
         rx, nth_head = rx if isinstance(rx, tuple) else (rx, 0)
         starts = [i for i, ln in enumerate(lines) if re.match(rx, ln)]
         for i in starts[nth_head:nth_head + 1]:
@@ -152,7 +157,7 @@ def bench_tables(out):
             if name == 'occ':
                 head = head[:5] + head[6:]
             HEADS[name] = head
-            for row in lines[i + 1:]:
+            for j, row in enumerate(lines[i + 1:], i + 1):
                 if not row.strip() or re.match(r'^(scene|log|peak RSS)\s', row):
                     break
                 t = [x for x in row.split() if x != '|']
@@ -165,6 +170,7 @@ def bench_tables(out):
                 if name in ('final', 'memmap', 'corrmap'):
                     key += ' ' + t[1]
                 rows[key] = t
+                ROW_LINES[name][key] = j
         tables[name] = rows
     return tables
 
@@ -570,10 +576,20 @@ class Runner:
         return out
 
 
-def check_table(t, text, runner):
-    """(cells compared, failures) of a Table"""
+def table_cell_span(line, col, occ=False):
+    """where the col-th cell of a table row (its tokens but '|') stands in line"""
+    toks = [m for m in re.finditer(r'\S+', line) if m.group(0) != '|']
+    if occ and col >= 5:
+        col += 1  # (the occupancy table's method column is part of its key)
+    return toks[col].span() if col < len(toks) else None
+
+
+def check_table(t, text, runner, fixes=None):
+    """(cells compared, failures) of a Table; with a list `fixes`, each
+    differing cell also as (document, start, end, measured) in the text"""
     cmd = runner.command(t.src)
     quoted = t.rows(text)
+    own_line = dict(ROW_LINES.get(t.name, {})) if t.name != 'sweep' else {}
     if not quoted:
         return 0, ['%s: no %s in the document (tools/docs_figures.py, its Table entry)' % (t.doc, t.text)]
     try:
@@ -582,8 +598,9 @@ def check_table(t, text, runner):
         return 0, ['%s: %s: cannot measure: %s (`%s`)' % (t.doc, t.text, e, cmd)]
     n, bad = 0, []
     for key, row in quoted.items():
-        line = next((i + 1 for i, ln in enumerate(text.splitlines())
-                     if ln.split()[:1] == key.split()[:1] and set(key.split()) <= set(ln.split())), 0)
+        line = own_line[key] + 1 if key in own_line else next(
+            (i + 1 for i, ln in enumerate(text.splitlines())
+             if ln.split()[:1] == key.split()[:1] and set(key.split()) <= set(ln.split())), 0)
         where = '%s:%d: %s, row %s' % (t.doc, line, t.text, key)
         got = measured.get(key)
         if got is None:
@@ -595,6 +612,11 @@ def check_table(t, text, runner):
             n += 1
             m = got[c] if c < len(got) else '(none)'
             if q != m:
+                if fixes is not None and line:
+                    at = sum(len(ln) + 1 for ln in text.splitlines()[:line - 1])
+                    span = table_cell_span(text.splitlines()[line - 1], c, t.name == 'occ')
+                    if span:
+                        fixes.append((t.doc, at + span[0], at + span[1], m))
                 head = HEADS.get(t.name, [])
                 col = '%d (%s)' % (c, head[c]) if c < len(head) else '%d' % c
                 bad.append('%s, column %s: %s quoted, %s measured by `%s`' % (where, col, q, m, cmd))
@@ -622,7 +644,7 @@ def check(figs, runner, band, compare_times, fixes=None):
                 docs[fig.doc] = f.read()
         text = docs[fig.doc]
         if isinstance(fig, Table):
-            n, bad = check_table(fig, text, runner)
+            n, bad = check_table(fig, text, runner, fixes)
             checked += n
             fails.extend(bad)
             continue
@@ -704,7 +726,10 @@ def main():
         with open(path, encoding='utf-8') as f:
             text = f.read()
         for _, a, b, new in sorted((x for x in fixes if x[0] == doc), key=lambda x: -x[1]):
-            text = text[:a] + new + text[b:]
+            pad = (b - a) - len(new)
+            while pad < 0 and a > 0 and text[a - 1] == ' ' and a - 2 >= 0 and text[a - 2] == ' ':
+                a, pad = a - 1, pad + 1  # (eat a blank of the column before, keep one)
+            text = text[:a] + ' ' * max(pad, 0) + new + text[b:]
         with open(path, 'w', encoding='utf-8') as f:
             f.write(text)
         print('docs-figures: wrote %d figures into %s' % (sum(1 for x in fixes if x[0] == doc), doc))
