@@ -8,6 +8,7 @@
  * crosses (Amanatides-Woo) and stop at the first cell that settles it.
  */
 #include "gtscore.h"
+#include "grow.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -33,17 +34,9 @@ void gtscore_index_free(gtscore_index *index)
 static int add_segment(gtscore_index *index, double x0, double y0, double x1, double y1)
 {
     double *s;
-    if (index->seg_count == index->seg_cap) {
-        uint32_t cap = index->seg_cap ? 2u * index->seg_cap : 64u;
-        double *p;
-        if (index->seg_cap > UINT32_MAX / 2u)
-            return -1;
-        p = realloc(index->seg_m, (size_t)cap * 4u * sizeof(double));
-        if (!p)
-            return -1;
-        index->seg_m = p;
-        index->seg_cap = cap;
-    }
+    if (grow_array((void **)&index->seg_m, &index->seg_cap, index->seg_count + 1u,
+                   4u * sizeof(double)) != 0)
+        return -1;
     s = &index->seg_m[4u * index->seg_count++];
     s[0] = x0;
     s[1] = y0;
