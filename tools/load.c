@@ -124,15 +124,7 @@ int load_map(const options *o, map_input *m)
         return complain(m->image.no_memory ? EXIT_MEMORY : EXIT_INPUT, "%s", m->image.error);
     m->cells = m->image.cells;
     size_t cells = (size_t)m->image.width * m->image.height;
-    polyc_occupancy_grid *g = &m->grid;
-    g->width = m->image.width;
-    g->height = m->image.height;
-    g->resolution_m = (float)m->yaml.resolution_m;
-    g->reserved = 0;
-    g->origin_x_m = m->yaml.origin_x_m;
-    g->origin_y_m = m->yaml.origin_y_m;
-    g->origin_yaw_rad = m->yaml.origin_yaw_rad;
-    g->cells = m->cells;
+    mapfile_grid(&m->yaml, m->image.width, m->image.height, m->cells, &m->grid);
     double occ = 100.0 * (double)o->config.occupied_thresh;
     double fre = 100.0 * (double)o->config.free_thresh;
     for (size_t i = 0; i < cells; i++) {

@@ -664,3 +664,16 @@ char *mapfile_image_path(const char *yaml_path, const char *image)
     }
     return out;
 }
+
+void mapfile_grid(const mapfile_yaml *y, uint32_t width, uint32_t height, const int8_t *cells,
+                  polyc_occupancy_grid *g)
+{
+    memset(g, 0, sizeof *g);
+    g->width = width;
+    g->height = height;
+    g->resolution_m = (float)y->resolution_m;
+    g->origin_x_m = y->origin_x_m;
+    g->origin_y_m = y->origin_y_m;
+    g->origin_yaw_rad = y->origin_yaw_rad;
+    g->cells = cells;
+}

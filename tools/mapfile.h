@@ -10,6 +10,8 @@
 #include <stdint.h>
 #include <stdio.h>
 
+#include "polyc.h"
+
 /* Limits on untrusted input (docs/security.md). */
 #define MAPFILE_MAX_YAML_BYTES  (1u << 20)    /* the map YAML */
 #define MAPFILE_MAX_PGM_BYTES   (1u << 30)    /* the image file */
@@ -144,6 +146,12 @@ int mapfile_image_read(mapfile_image *m, const uint8_t *data, size_t len, const 
  * with need_bytes set (the bytes it would take) and nothing allocated. */
 int mapfile_image_read_capped(mapfile_image *m, const uint8_t *data, size_t len,
                               const char *name, const mapfile_yaml *y, size_t max_bytes);
+
+/* The library's grid of a map as `polyc map.yaml` reads it: the image's
+ * size, the YAML's resolution and origin pose, and cells (OccupancyGrid
+ * order, as mapfile_to_cells gives them; only pointed to). */
+void mapfile_grid(const mapfile_yaml *y, uint32_t width, uint32_t height, const int8_t *cells,
+                  polyc_occupancy_grid *g);
 
 /* Every pixel converted: cells[(height - 1 - row) * width + column], i.e.
  * OccupancyGrid order with row 0 at the bottom. cells: width * height. */

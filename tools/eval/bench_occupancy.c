@@ -201,21 +201,6 @@ static int occupancy_sim(const options *o, const scene *s)
     return rc;
 }
 
-/* The occupancy grid of a map read as `polyc map.yaml` reads it: the
- * image's size, the YAML's resolution and origin, the converted cells. */
-static void grid_of_map(const mapfile_pgm *pgm, const mapfile_yaml *y, const int8_t *cells,
-                        polyc_occupancy_grid *g)
-{
-    memset(g, 0, sizeof *g);
-    g->width = pgm->width;
-    g->height = pgm->height;
-    g->resolution_m = (float)y->resolution_m;
-    g->origin_x_m = y->origin_x_m;
-    g->origin_y_m = y->origin_y_m;
-    g->origin_yaw_rad = y->origin_yaw_rad;
-    g->cells = cells;
-}
-
 /* A real log: the library's hit/miss grid at 5 cm as `polyc grid --cell
  * 0.05` writes it (tools/gridimage.h, map_saver's PGM and YAML), read back
  * as `polyc map.yaml` reads it (tools/mapfile.h). */
@@ -279,7 +264,7 @@ static int occupancy_log(const options *o, const scene *s)
     mapfile_to_cells(&pgm, &y, cells);
     ms = pipeline_now_ms() - t0;
     polyc_occupancy_grid g;
-    grid_of_map(&pgm, &y, cells, &g);
+    mapfile_grid(&y, pgm.width, pgm.height, cells, &g);
     pipeline_close(&p);
     rc = map_grid(o, label, "hit/miss", &g, ms, NULL);
 done:
@@ -419,7 +404,7 @@ static int occupancy_speed(const options *o)
         goto failed;
     mapfile_to_cells(&pgm, &y, cells);
     polyc_occupancy_grid g;
-    grid_of_map(&pgm, &y, cells, &g);
+    mapfile_grid(&y, pgm.width, pgm.height, cells, &g);
     t[2] = pipeline_now_ms();
     bench_config(o, &config);
     if (pipeline_run_grid(&p, &config, &g, &lib_ms) != 0 || !(lines = pipeline_lines(&p, &count))) {

@@ -19,16 +19,31 @@ typedef struct buf {
     size_t count, cap;
 } buf;
 
+/* p, an array with room for *cap items of `size` bytes, with room for
+ * `need`: as it is, or reallocated to the first of `first`, 2 `first`,
+ * 4 `first`, ... that holds them (*cap updated); NULL when out of memory
+ * (p still valid, *cap unchanged). */
+static void *reserve(void *p, size_t *cap, size_t need, size_t first, size_t size)
+{
+    size_t c = *cap;
+    if (p && need <= c)
+        return p;
+    if (c == 0)
+        c = first;
+    while (c < need)
+        c *= 2u;
+    p = realloc(p, c * size);
+    if (p)
+        *cap = c;
+    return p;
+}
+
 static int push(buf *b, double x, double y)
 {
-    if (b->count == b->cap) {
-        size_t cap = b->cap ? 2u * b->cap : 256u;
-        double *p = realloc(b->xy, 2u * cap * sizeof *p);
-        if (!p)
-            return -1;
-        b->xy = p;
-        b->cap = cap;
-    }
+    double *p = reserve(b->xy, &b->cap, b->count + 1u, 256u, 2u * sizeof *p);
+    if (!p)
+        return -1;
+    b->xy = p;
     b->xy[2u * b->count] = x;
     b->xy[2u * b->count + 1u] = y;
     b->count++;
@@ -140,10 +155,12 @@ static void douglas_peucker(const double *xy, size_t n, size_t a, size_t b, doub
 
 typedef struct out_buf {
     float *xy;
-    uint64_t count, cap;
+    uint64_t count;
+    size_t cap;
     polyc_polyline *lines;
     uint64_t *first;           /* each line's first point in xy */
-    uint32_t line_count, line_cap;
+    uint32_t line_count;
+    size_t line_cap, first_cap;
 } out_buf;
 
 static int add_line(out_buf *o, const double *xy, size_t n, const unsigned char *keep,
@@ -153,27 +170,19 @@ static int add_line(out_buf *o, const double *xy, size_t n, const unsigned char 
     size_t k, kept = 0;
     for (k = 0; k < n; k++)
         kept += keep[k];
-    if (o->line_count == o->line_cap) {
-        uint32_t cap = o->line_cap ? 2u * o->line_cap : 64u;
-        polyc_polyline *l = realloc(o->lines, cap * sizeof *l);
-        if (!l)
-            return -1;
-        o->lines = l;
-        uint64_t *fp = realloc(o->first, cap * sizeof *fp);
-        if (!fp)
-            return -1;
-        o->first = fp;
-        o->line_cap = cap;
-    }
-    while (o->count + kept > o->cap) {
-        uint64_t cap = o->cap ? 2u * o->cap : 1024u;
-        float *p = realloc(o->xy, 2u * cap * sizeof *p);
-        if (!p)
-            return -1;
-        o->xy = p;
-        o->cap = cap;
-    }
-    polyc_polyline *l = &o->lines[o->line_count];
+    polyc_polyline *l = reserve(o->lines, &o->line_cap, o->line_count + 1u, 64u, sizeof *l);
+    if (!l)
+        return -1;
+    o->lines = l;
+    uint64_t *fp = reserve(o->first, &o->first_cap, o->line_count + 1u, 64u, sizeof *fp);
+    if (!fp)
+        return -1;
+    o->first = fp;
+    float *p = reserve(o->xy, &o->cap, (size_t)o->count + kept, 1024u, 2u * sizeof *p);
+    if (!p)
+        return -1;
+    o->xy = p;
+    l = &o->lines[o->line_count];
     o->first[o->line_count++] = o->count;
     l->point_count = (uint32_t)kept;
     l->closed = kept >= 3u;

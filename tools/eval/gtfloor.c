@@ -101,6 +101,17 @@ static uint32_t face_of(const gtscore_truth *truth, const wall_seg *segs, uint32
     return best_s;
 }
 
+/* face_of for the endpoint of scan sc's beam i at FLOOR_NEAR_M; UINT32_MAX
+ * for a beam without return too. */
+static uint32_t beam_face(const gtscore_truth *truth, const wall_seg *segs, uint32_t ns,
+                          const polyc_scan *sc, uint32_t i, double *t_out, double *off_out)
+{
+    double x, y;
+    if (!endpoint_xy(sc, i, &x, &y))
+        return UINT32_MAX;
+    return face_of(truth, segs, ns, x, y, FLOOR_NEAR_M, t_out, off_out);
+}
+
 static void fit_add(side_fit *f, double t, double off)
 {
     f->n += 1.0;
@@ -118,6 +129,24 @@ static double fitted_offset(const side_fit *f, double t)
     double var = f->stt / f->n - mt * mt;
     double slope = var > 1e-12 ? (f->sts / f->n - mt * ms) / var : 0.0;
     return ms + slope * (t - mt);
+}
+
+/* The RMS of fitted lines' offsets from the true wall (0 at the wall) at
+ * the positions added; -1 when none was. */
+typedef struct rms_sum {
+    double sum, count;
+} rms_sum;
+
+static void rms_add(rms_sum *r, const side_fit *f, double t)
+{
+    double e = fitted_offset(f, t);
+    r->sum += e * e;
+    r->count += 1.0;
+}
+
+static double rms_of(const rms_sum *r)
+{
+    return r->count > 0.0 ? sqrt(r->sum / r->count) : -1.0;
 }
 
 int gtscore_line_floor(const gtscore_truth *truth, const polyc_scan *scans, uint32_t scan_count,
@@ -150,10 +179,8 @@ int gtscore_line_floor(const gtscore_truth *truth, const polyc_scan *scans, uint
     for (uint32_t k = 0; k < scan_count; k++) {
         const polyc_scan *sc = &scans[k];
         for (uint32_t i = 0; i < sc->beam_count; i++) {
-            double x, y, best_t = 0.0, best_off = 0.0;
-            if (!endpoint_xy(sc, i, &x, &y))
-                continue;
-            uint32_t best_s = face_of(truth, segs, ns, x, y, FLOOR_NEAR_M, &best_t, &best_off);
+            double best_t = 0.0, best_off = 0.0;
+            uint32_t best_s = beam_face(truth, segs, ns, sc, i, &best_t, &best_off);
             if (best_s == UINT32_MAX)
                 continue;
             const wall_seg *g = &segs[best_s];
@@ -164,22 +191,18 @@ int gtscore_line_floor(const gtscore_truth *truth, const polyc_scan *scans, uint
             seen[f->first_bin + (uint32_t)(best_t / FLOOR_BIN_M)] = 1;
         }
     }
-    double sum = 0.0, count = 0.0;
+    rms_sum rms = {0.0, 0.0};
     for (uint32_t s = 0; s < ns; s++)
         for (int side = 0; side < 2; side++) {
             const side_fit *f = &fits[2 * s + (uint32_t)side];
             if (f->n < FLOOR_MIN_POINTS)
                 continue;
             uint32_t nb = (uint32_t)(segs[s].len / FLOOR_BIN_M) + 1;
-            for (uint32_t b = 0; b < nb; b++) {
-                if (!seen[f->first_bin + b])
-                    continue;
-                double e = fitted_offset(f, ((double)b + 0.5) * FLOOR_BIN_M);
-                sum += e * e;
-                count += 1.0;
-            }
+            for (uint32_t b = 0; b < nb; b++)
+                if (seen[f->first_bin + b])
+                    rms_add(&rms, f, ((double)b + 0.5) * FLOOR_BIN_M);
         }
-    *floor_m = count > 0.0 ? sqrt(sum / count) : -1.0;
+    *floor_m = rms_of(&rms);
     free(seen);
     free(fits);
     free(segs);
@@ -271,26 +294,21 @@ int gtscore_ideal_fit(const gtscore_truth *truth, const polyc_scan *scans, uint3
     for (uint32_t k = 0; k < scan_count; k++) {
         const polyc_scan *sc = &scans[k];
         for (uint32_t i = 0; i < sc->beam_count; i++) {
-            double x, y, t = 0.0, off = 0.0;
-            if (!endpoint_xy(sc, i, &x, &y))
-                continue;
-            uint32_t s = face_of(truth, segs, ns, x, y, FLOOR_NEAR_M, &t, &off);
+            double t = 0.0, off = 0.0;
+            uint32_t s = beam_face(truth, segs, ns, sc, i, &t, &off);
             seen_run *r = s == UINT32_MAX ? NULL : run_at(runs, nr, s, t);
             if (r)
                 fit_add(&r->fit, t, off);
         }
     }
-    double sum = 0.0, count = 0.0;
+    rms_sum rms = {0.0, 0.0};
     for (uint32_t r = 0; r < nr; r++) {
         if (runs[r].t1 - runs[r].t0 < IDEAL_RUN_M || runs[r].fit.n < 1.0)
             continue;
-        for (uint32_t i = runs[r].first; i < runs[r].first + runs[r].count; i++) {
-            double e = fitted_offset(&runs[r].fit, on[i].t);
-            sum += e * e;
-            count += 1.0;
-        }
+        for (uint32_t i = runs[r].first; i < runs[r].first + runs[r].count; i++)
+            rms_add(&rms, &runs[r].fit, on[i].t);
     }
-    *fit_m = count > 0.0 ? sqrt(sum / count) : -1.0;
+    *fit_m = rms_of(&rms);
     free(segs);
     free(on);
     free(runs);

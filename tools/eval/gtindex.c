@@ -8,6 +8,7 @@
  * crosses (Amanatides-Woo) and stop at the first cell that settles it.
  */
 #include "gtscore.h"
+#include "grow.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -33,17 +34,9 @@ void gtscore_index_free(gtscore_index *index)
 static int add_segment(gtscore_index *index, double x0, double y0, double x1, double y1)
 {
     double *s;
-    if (index->seg_count == index->seg_cap) {
-        uint32_t cap = index->seg_cap ? 2u * index->seg_cap : 64u;
-        double *p;
-        if (index->seg_cap > UINT32_MAX / 2u)
-            return -1;
-        p = realloc(index->seg_m, (size_t)cap * 4u * sizeof(double));
-        if (!p)
-            return -1;
-        index->seg_m = p;
-        index->seg_cap = cap;
-    }
+    if (grow_array((void **)&index->seg_m, &index->seg_cap, index->seg_count + 1u,
+                   4u * sizeof(double)) != 0)
+        return -1;
     s = &index->seg_m[4u * index->seg_count++];
     s[0] = x0;
     s[1] = y0;
@@ -52,41 +45,43 @@ static int add_segment(gtscore_index *index, double x0, double y0, double x1, do
     return 0;
 }
 
-int gtscore_index_add_d(gtscore_index *index, const double *xy_m, uint32_t point_count,
-                        int closed)
+/* Coordinate k of a polyline's points, given as doubles (xy_d) or as
+ * floats (xy_f, when xy_d is NULL). */
+static double coord(const double *xy_d, const float *xy_f, uint32_t k)
+{
+    return xy_d ? xy_d[k] : (double)xy_f[k];
+}
+
+/* gtscore_index_add_d and _f: the points as doubles or as floats. */
+static int add_points(gtscore_index *index, const double *xy_d, const float *xy_f,
+                      uint32_t point_count, int closed)
 {
     uint32_t i, n;
-    if (!index || (!xy_m && point_count))
+    if (!index || (!xy_d && !xy_f && point_count))
         return -1;
     if (point_count == 1u)
-        return add_segment(index, xy_m[0], xy_m[1], xy_m[0], xy_m[1]);
+        return add_segment(index, coord(xy_d, xy_f, 0), coord(xy_d, xy_f, 1u),
+                           coord(xy_d, xy_f, 0), coord(xy_d, xy_f, 1u));
     n = closed && point_count > 2u ? point_count : point_count - 1u;
     for (i = 0; point_count > 1u && i < n; i++) {
         uint32_t j = (i + 1u) % point_count;
-        if (add_segment(index, xy_m[2u * i], xy_m[2u * i + 1u], xy_m[2u * j],
-                        xy_m[2u * j + 1u]) != 0)
+        if (add_segment(index, coord(xy_d, xy_f, 2u * i), coord(xy_d, xy_f, 2u * i + 1u),
+                        coord(xy_d, xy_f, 2u * j), coord(xy_d, xy_f, 2u * j + 1u)) != 0)
             return -1;
     }
     return 0;
 }
 
+int gtscore_index_add_d(gtscore_index *index, const double *xy_m, uint32_t point_count,
+                        int closed)
+{
+    return add_points(index, xy_m, NULL, point_count, closed);
+}
+
 int gtscore_index_add_f(gtscore_index *index, const float *xy_m, uint32_t point_count,
                         int closed)
 {
-    uint32_t i, n;
-    if (!index || (!xy_m && point_count))
-        return -1;
-    if (point_count == 1u)
-        return add_segment(index, (double)xy_m[0], (double)xy_m[1], (double)xy_m[0],
-                           (double)xy_m[1]);
-    n = closed && point_count > 2u ? point_count : point_count - 1u;
-    for (i = 0; point_count > 1u && i < n; i++) {
-        uint32_t j = (i + 1u) % point_count;
-        if (add_segment(index, (double)xy_m[2u * i], (double)xy_m[2u * i + 1u],
-                        (double)xy_m[2u * j], (double)xy_m[2u * j + 1u]) != 0)
-            return -1;
-    }
-    return 0;
+    return add_points(index, NULL, xy_m, point_count, closed);
 }
 
 int gtscore_index_add_polylines(gtscore_index *index, const polyc_polyline *lines,
@@ -354,6 +349,20 @@ static double ray_segment(const double *s, double ox, double oy, double dx, doub
     return t;
 }
 
+/* One slab of the ray p + t d (one axis) against [lo, hi): narrows
+ * [*t_in, *t_out] to the t inside it; 0 when the ray runs parallel to the
+ * slab outside it. */
+static int clip_slab(double p, double d, double lo, double hi, double *t_in, double *t_out)
+{
+    if (d != 0.0) {
+        double t0 = (lo - p) / d, t1 = (hi - p) / d;
+        *t_in = fmax(*t_in, fmin(t0, t1));
+        *t_out = fmin(*t_out, fmax(t0, t1));
+        return 1;
+    }
+    return !(p < lo || p >= hi);
+}
+
 double gtscore_index_ray(const gtscore_index *index, double x_m, double y_m, double angle_rad,
                          double max_range_m)
 {
@@ -368,20 +377,9 @@ double gtscore_index_ray(const gtscore_index *index, double x_m, double y_m, dou
     if (!index->cell_start || !isfinite(x_m) || !isfinite(y_m) || !(max_range_m > 0.0))
         return HUGE_VAL;
     /* clip the ray to the grid box (slabs) */
-    if (dx != 0.0) {
-        double t0 = (x_lo - x_m) / dx, t1 = (x_hi - x_m) / dx;
-        t_in = fmax(t_in, fmin(t0, t1));
-        t_out = fmin(t_out, fmax(t0, t1));
-    } else if (x_m < x_lo || x_m >= x_hi) {
+    if (!clip_slab(x_m, dx, x_lo, x_hi, &t_in, &t_out) ||
+        !clip_slab(y_m, dy, y_lo, y_hi, &t_in, &t_out))
         return HUGE_VAL;
-    }
-    if (dy != 0.0) {
-        double t0 = (y_lo - y_m) / dy, t1 = (y_hi - y_m) / dy;
-        t_in = fmax(t_in, fmin(t0, t1));
-        t_out = fmin(t_out, fmax(t0, t1));
-    } else if (y_m < y_lo || y_m >= y_hi) {
-        return HUGE_VAL;
-    }
     if (t_in > t_out)
         return HUGE_VAL;
 

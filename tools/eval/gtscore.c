@@ -5,6 +5,7 @@
  * ray RMSE and f.
  */
 #include "gtscore.h"
+#include "grow.h"
 
 #include <ctype.h>
 #include <errno.h>
@@ -17,26 +18,6 @@
 #define MAP_CELL_M 0.10    /* grid of a learned map for 5 cm queries */
 
 /* ---- reader --------------------------------------------------------------- */
-
-static int grow(void **items, uint32_t *cap, uint32_t need, size_t elem_size)
-{
-    uint32_t new_cap;
-    void *p;
-    if (need <= *cap)
-        return 0;
-    new_cap = *cap ? *cap : 64u;
-    while (new_cap < need) {
-        if (new_cap > UINT32_MAX / 2u)
-            return -1;
-        new_cap *= 2u;
-    }
-    p = realloc(*items, (size_t)new_cap * elem_size);
-    if (!p)
-        return -1;
-    *items = p;
-    *cap = new_cap;
-    return 0;
-}
 
 static int fail(char *err, size_t err_size, const char *name, uint64_t line, const char *fmt,
                 ...)
@@ -107,8 +88,8 @@ static int read_wall(gtscore_truth *truth, char *rest, const char *name, uint64_
         if (!parse_number(token, &v))
             return fail(err, err_size, name, line, "wall: bad number '%.40s'", token);
         if (numbers % 2u == 0 &&
-            grow((void **)&truth->wall_xy_m, &truth->wall_point_cap,
-                 truth->wall_point_count + 1u, 2u * sizeof(double)) != 0)
+            grow_array((void **)&truth->wall_xy_m, &truth->wall_point_cap,
+                       truth->wall_point_count + 1u, 2u * sizeof(double)) != 0)
             return fail(err, err_size, name, line, "out of memory");
         truth->wall_xy_m[2u * first + numbers] = v;
         numbers++;
@@ -120,8 +101,8 @@ static int read_wall(gtscore_truth *truth, char *rest, const char *name, uint64_
     if (numbers / 2u < (closed ? 3u : 2u))
         return fail(err, err_size, name, line, "wall: %s wall needs at least %u points",
                     closed ? "a closed" : "an open", closed ? 3u : 2u);
-    if (grow((void **)&truth->walls, &truth->wall_cap, truth->wall_count + 1u,
-             sizeof(gtscore_wall)) != 0)
+    if (grow_array((void **)&truth->walls, &truth->wall_cap, truth->wall_count + 1u,
+                   sizeof(gtscore_wall)) != 0)
         return fail(err, err_size, name, line, "out of memory");
     wall = &truth->walls[truth->wall_count++];
     wall->first_point = first;
@@ -143,8 +124,8 @@ static int read_line(gtscore_truth *truth, char *text, const char *name, uint64_
         char *a = next_token(&rest), *b = next_token(&rest);
         if (!a || !b || next_token(&rest) || !parse_number(a, &v[0]) || !parse_number(b, &v[1]))
             return fail(err, err_size, name, line, "seen: expected two numbers x y");
-        if (grow((void **)&truth->seen_xy_m, &truth->seen_cap, truth->seen_count + 1u,
-                 2u * sizeof(double)) != 0)
+        if (grow_array((void **)&truth->seen_xy_m, &truth->seen_cap, truth->seen_count + 1u,
+                       2u * sizeof(double)) != 0)
             return fail(err, err_size, name, line, "out of memory");
         truth->seen_xy_m[2u * truth->seen_count] = v[0];
         truth->seen_xy_m[2u * truth->seen_count + 1u] = v[1];

@@ -7,6 +7,7 @@
  * segments, a few hundred scans).
  */
 #include "scansim.h"
+#include "grow.h"
 
 #include <errno.h>
 #include <math.h>
@@ -57,31 +58,6 @@ double scansim_rng_gauss(scansim_rng *rng)
     rng->spare = r * sin(2.0 * SCANSIM_PI * u2);
     rng->has_spare = 1;
     return r * cos(2.0 * SCANSIM_PI * u2);
-}
-
-/* ---- growable arrays ---------------------------------------------------- */
-
-/* Makes room for `need` elements; 0 or -1 (overflow, out of memory). */
-static int grow(void **items, uint32_t *cap, uint32_t need, size_t elem_size)
-{
-    uint32_t new_cap;
-    void *p;
-    if (need <= *cap)
-        return 0;
-    new_cap = *cap ? *cap : 16u;
-    while (new_cap < need) {
-        if (new_cap > UINT32_MAX / 2u)
-            return -1;
-        new_cap *= 2u;
-    }
-    if ((size_t)new_cap > SIZE_MAX / elem_size)
-        return -1;
-    p = realloc(*items, (size_t)new_cap * elem_size);
-    if (!p)
-        return -1;
-    *items = p;
-    *cap = new_cap;
-    return 0;
 }
 
 /* ---- scene building ----------------------------------------------------- */
@@ -147,11 +123,11 @@ int scansim_add_wall(scansim_scene *scene, const double *xy_m, uint32_t point_co
         return -1;
     if (point_count > UINT32_MAX - scene->wall_point_count)
         return -1;
-    if (grow((void **)&scene->wall_xy_m, &scene->wall_point_cap,
-             scene->wall_point_count + point_count, 2u * sizeof(double)) != 0)
+    if (grow_array((void **)&scene->wall_xy_m, &scene->wall_point_cap,
+                   scene->wall_point_count + point_count, 2u * sizeof(double)) != 0)
         return -1;
-    if (grow((void **)&scene->walls, &scene->wall_cap, scene->wall_count + 1u,
-             sizeof(scansim_wall)) != 0)
+    if (grow_array((void **)&scene->walls, &scene->wall_cap, scene->wall_count + 1u,
+                   sizeof(scansim_wall)) != 0)
         return -1;
     for (i = 0; i < 2u * point_count; i++)
         scene->wall_xy_m[2u * scene->wall_point_count + i] = xy_m[i];
@@ -200,8 +176,8 @@ int scansim_add_pose(scansim_scene *scene, double x_m, double y_m, double theta_
     scansim_pose *p;
     if (!scene || scene->pose_count == UINT32_MAX)
         return -1;
-    if (grow((void **)&scene->poses, &scene->pose_cap, scene->pose_count + 1u,
-             sizeof(scansim_pose)) != 0)
+    if (grow_array((void **)&scene->poses, &scene->pose_cap, scene->pose_count + 1u,
+                   sizeof(scansim_pose)) != 0)
         return -1;
     p = &scene->poses[scene->pose_count++];
     p->x_m = x_m;
@@ -239,8 +215,8 @@ int scansim_add_person(scansim_scene *scene, const scansim_person *person)
     if (!scene || !person || !(person->radius_m > 0.0) ||
         person->last_scan < person->first_scan)
         return -1;
-    if (grow((void **)&scene->people, &scene->person_cap, scene->person_count + 1u,
-             sizeof(scansim_person)) != 0)
+    if (grow_array((void **)&scene->people, &scene->person_cap, scene->person_count + 1u,
+                   sizeof(scansim_person)) != 0)
         return -1;
     scene->people[scene->person_count++] = *person;
     return 0;
