@@ -288,19 +288,27 @@ static void test_remove_collinear_vertex(void **state)
     fx_close(&f);
 }
 
+/* The corner's points (corner_points) mapped by the exact L through them:
+ * (-1, 0), (0, 0), (0, 1); returns its line. */
+static const float L_CORNER[6] = {-1.0f, 0.0f, 0.0f, 0.0f, 0.0f, 1.0f};
+static int32_t open_exact_corner(fixture *f)
+{
+    fx_open_hand(f, 0.0f);
+    corner_points(f, 1);
+    clear_lines(&f->o);
+    int32_t l = add_line(&f->o, L_CORNER, 3, 0);
+    rebuild(&f->o);
+    return l;
+}
+
 static void test_remove_keeps_true_corner(void **state)
 {
     (void)state;
     static fixture f;
-    fx_open_hand(&f, 0.0f);
-    corner_points(&f, 1);
-    clear_lines(&f.o);
-    const float xy[6] = {-1.0f, 0.0f, 0.0f, 0.0f, 0.0f, 1.0f};
-    int32_t l = add_line(&f.o, xy, 3, 0);
-    rebuild(&f.o);
+    int32_t l = open_exact_corner(&f);
     assert_true(polyc__removal_delta_below(&f.o, 1, INFINITY) > 0.0f);
     assert_int_equal(polyc__op_remove_vertices(&f.o, 0), 0);
-    assert_line_is(&f.o, l, xy, 3);
+    assert_line_is(&f.o, l, L_CORNER, 3);
     fx_close(&f);
 }
 
@@ -340,14 +348,9 @@ static void test_failed_addition_not_tried_again(void **state)
 {
     (void)state;
     static fixture f;
-    fx_open_hand(&f, 0.0f);
-    corner_points(&f, 1);
-    clear_lines(&f.o);
-    const float xy[6] = {-1.0f, 0.0f, 0.0f, 0.0f, 0.0f, 1.0f};
-    int32_t l = add_line(&f.o, xy, 3, 0);
-    rebuild(&f.o);
+    int32_t l = open_exact_corner(&f);
     assert_int_equal(polyc__op_add_vertices(&f.o, 1), 0);
-    assert_line_is(&f.o, l, xy, 3);
+    assert_line_is(&f.o, l, L_CORNER, 3);
     uint32_t touch[3];
     for (int32_t v = 0; v < 3; v++)
         touch[v] = f.o.v_touch[v];
