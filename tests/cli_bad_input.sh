@@ -19,19 +19,12 @@ case $1 in /*) POLYC=$1 ;; *) POLYC=$(pwd)/$1 ;; esac
 [ -x "$POLYC" ] || { echo "$0: $POLYC is not executable" >&2; exit 2; }
 ROOT=$(cd "$(dirname "$0")/.." && pwd)   # for examples/office.log
 
-T=$(mktemp -d "${TMPDIR:-/tmp}/polyc_cli.XXXXXX") || exit 2
+. "$ROOT/tests/cli_lib.sh"
+CLI_ERR_LINES=5
+cli_scratch cli
 trap 'rm -rf "$T"' EXIT INT TERM
-cd "$T" || exit 2
-failed=0
-count=0
 LIMIT_S=120               # seconds per run: a hang fails
 LIMIT_KB=3000000          # address space per run (plain builds): 3 GB
-
-bad() {
-    echo "FAIL $name: $*"
-    sed 's/^/    stderr: /' err.txt | head -5
-    failed=$((failed + 1))
-}
 
 # run ARGS...: polyc with a time limit (and a memory limit unless --quick);
 # sets rc, leaves stdout in out.txt and stderr in err.txt.

@@ -15,16 +15,8 @@ LOG=${2:-$ROOT/examples/office.log}
 case $LOG in /*) ;; *) LOG=$(pwd)/$LOG ;; esac
 [ -x "$POLYC" ] && [ -r "$LOG" ] || { echo "$0: cannot run $POLYC on $LOG" >&2; exit 2; }
 
-T=$(mktemp -d "${TMPDIR:-/tmp}/polyc_online.XXXXXX") || exit 2
-trap 'rm -rf "$T"' EXIT
-cd "$T" || exit 2
-failed=0
-count=0
-bad() {
-    echo "FAIL $name: $*"
-    sed 's/^/    stderr: /' err.txt 2> /dev/null | head -3
-    failed=$((failed + 1))
-}
+. "$ROOT/tests/cli_lib.sh"
+cli_scratch online
 # run ARGS...: polyc with a time limit; rc, stdout in out.txt, stderr in err.txt
 run() {
     count=$((count + 1))

@@ -21,16 +21,8 @@ case $LOG in /*) ;; *) LOG=$(pwd)/$LOG ;; esac
 uid=$(id -u)
 who=$([ "$uid" = 0 ] && echo root || echo "user $uid")
 
-T=$(mktemp -d "${TMPDIR:-/tmp}/polyc_out.XXXXXX") || exit 2
-trap 'rm -rf "$T"' EXIT
-cd "$T" || exit 2
-failed=0
-count=0
-bad() {
-    echo "FAIL $name ($who): $*"
-    sed 's/^/    stderr: /' err.txt 2> /dev/null | head -3
-    failed=$((failed + 1))
-}
+. "$(dirname "$SELF")/cli_lib.sh"
+cli_scratch out
 # no temporary file (.polyc-XXXXXX) in the folder after a run
 no_temps() {
     left=$(ls -A | grep '^\.polyc-')
@@ -451,8 +443,9 @@ echo "cli_output ($who): $count runs, $failed failures"
 # ---- as root: again as an ordinary user ----
 if [ "$uid" = 0 ]; then
     U=$(mktemp -d "${TMPDIR:-/tmp}/polyc_user.XXXXXX") || exit 1
-    cp "$POLYC" "$U/polyc" && cp "$LOG" "$U/in.log" && cp "$SELF" "$U/cli_output.sh" && chmod 755 "$U" \
-        && chmod 644 "$U/in.log" || exit 1
+    cp "$POLYC" "$U/polyc" && cp "$LOG" "$U/in.log" && cp "$SELF" "$U/cli_output.sh" \
+        && cp "$(dirname "$SELF")/cli_lib.sh" "$U/cli_lib.sh" && chmod 755 "$U" \
+        && chmod 644 "$U/in.log" "$U/cli_lib.sh" || exit 1
     if command -v setpriv > /dev/null 2>&1; then
         setpriv --reuid=65534 --regid=65534 --clear-groups sh "$U/cli_output.sh" "$U/polyc" "$U/in.log"
         rc=$?

@@ -15,16 +15,8 @@ ROOT=$(cd "$(dirname "$0")/.." && pwd)
 LIB=$(dirname "$POLYC")/libpolyc.a
 [ -x "$POLYC" ] && [ -r "$LIB" ] || { echo "$0: no $POLYC or $LIB" >&2; exit 2; }
 
-T=$(mktemp -d "${TMPDIR:-/tmp}/polyc_readme.XXXXXX") || exit 2
-trap 'rm -rf "$T"' EXIT
-cd "$T" || exit 2
-failed=0
-count=0
-bad() {
-    echo "FAIL $name: $*"
-    sed 's/^/    stderr: /' err.txt 2> /dev/null | head -3
-    failed=$((failed + 1))
-}
+. "$ROOT/tests/cli_lib.sh"
+cli_scratch readme
 
 # the first C block of the section "As a library", unchanged
 awk '/^## As a library/ { in_section = 1; next }

@@ -60,14 +60,20 @@ def hammer_online():
             except Exception as e:            # none expected
                 errors.append(repr(e))
 
+    run_threads(run)
+    m.finish()
+    return {"ids": sorted(i for mine in ids for i in mine), "scans": m.stats["scans"],
+            "polylines": len(m.polylines), "errors": errors}
+
+
+def run_threads(run):
+    """run(k) on THREADS threads at once, k = 0 .. THREADS - 1; returns
+    when all have ended"""
     workers = [threading.Thread(target=run, args=(k,)) for k in range(THREADS)]
     for w in workers:
         w.start()
     for w in workers:
         w.join()
-    m.finish()
-    return {"ids": sorted(i for mine in ids for i in mine), "scans": m.stats["scans"],
-            "polylines": len(m.polylines), "errors": errors}
 
 
 def hammer_context():
@@ -108,11 +114,7 @@ def hammer_context():
             except Exception as e:
                 errors.append(repr(e))
 
-    workers = [threading.Thread(target=run, args=(k,)) for k in range(THREADS)]
-    for w in workers:
-        w.start()
-    for w in workers:
-        w.join()
+    run_threads(run)
     ctx.build()
     return {"scans": ctx.stats()["scans"], "polylines": len(ctx.polylines()),
             "errors": errors, "statuses": statuses}
