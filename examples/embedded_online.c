@@ -15,7 +15,7 @@
  *                            eight scans hit 380: the walls lie on cell
  *                            boundaries, and the noise spreads their
  *                            endpoints over two rows of cells)
- * polyc_online_memory_size() is then 128,640 bytes <= sizeof block; the
+ * polyc_online_memory_size() is then 128,240 bytes <= sizeof block; the
  * whole map is updated in it, from the first scan to the finish.
  *
  * Host:   prints the map in polyc's TXT format (tests/embedded_test.sh).

@@ -24,6 +24,12 @@ typedef uint16_t polyc__count;
 #endif
 
 #define POLYC__NONE (-1)
+/* a function the compiler must not inline (where inlining copies code) */
+#if defined(__GNUC__)
+#define POLYC__NOINLINE __attribute__((noinline))
+#else
+#define POLYC__NOINLINE
+#endif
 
 /* ---- arena.c: bump allocation inside the caller's block ---- */
 typedef struct polyc__arena {

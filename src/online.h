@@ -151,6 +151,12 @@ typedef struct polyc__online {
 } polyc__online;
 
 /* ---- online.c: sizes, the block's layout, the layer table ---- */
+/* The head of an online context's block: the context, then its online
+ * state (one struct, so that they pad as one). */
+typedef struct polyc__online_head {
+    polyc_ctx ctx;
+    polyc__online on;
+} polyc__online_head;
 /* the contour cells a round may list (limits.max_points + 1) */
 static inline uint32_t polyc__online_cells_cap(const polyc__online *on)
 {
@@ -191,8 +197,12 @@ enum {
 polyc_status polyc__online_accumulate(polyc_ctx *ctx, const polyc__scan *s, uint32_t number, int how);
 /* the first occupied cell along each of the scan's beams labelled contour */
 void polyc__online_label_contour(polyc_ctx *ctx, const polyc__scan *s);
-/* whether the scan at its pose lies inside the area (frame metres) */
-int polyc__online_inside_area(const polyc_ctx *ctx, const polyc_scan *s);
+/* POLYC_OK if the scan at its pose lies inside the area (frame metres),
+ * else POLYC_ERR_EXTENT, reported */
+polyc_status polyc__online_inside_area(polyc_ctx *ctx, const polyc_scan *s);
+/* polyc__enter, and POLYC_ERR_STATE (reported) unless ctx is an online
+ * context: the online entry points' preamble */
+polyc_status polyc__online_enter(polyc_ctx *ctx, int args_ok);
 /* the layer's spacing table (polyc__layer): made again from the tiles
  * that held a pose when stale */
 polyc_status polyc__online_spacing(polyc_ctx *ctx, polyc__spacing *sp, size_t n);

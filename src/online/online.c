@@ -184,7 +184,7 @@ static const polyc__layer online_layer = {
 
 static size_t header_bytes(void)
 {
-    return polyc__add(polyc__bytes(1, sizeof(polyc_ctx)), polyc__bytes(1, sizeof(polyc__online)));
+    return polyc__bytes(1, sizeof(polyc__online_head));
 }
 
 size_t polyc_online_memory_size(const polyc_config *config, const polyc_online_limits *limits)
@@ -221,7 +221,7 @@ polyc_status polyc_online_init(void *block, size_t size, const polyc_config *con
                               config, &ctx);
     if (st != POLYC_OK)
         return st;
-    polyc__online *on = (polyc__online *)((unsigned char *)ctx + polyc__bytes(1, sizeof(polyc_ctx)));
+    polyc__online *on = &((polyc__online_head *)(void *)ctx)->on;
     ctx->online = on;
     ctx->layer = &online_layer;
     on->lim = *limits;

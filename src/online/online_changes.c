@@ -79,8 +79,7 @@ polyc_status polyc__online_publish(polyc_ctx *ctx, uint32_t *changed)
     polyc__online *on = ctx->online;
     polyc__export_result(ctx);
     ctx->opt_result_valid = 1;
-    ctx->stats.memory_used_bytes = (uint64_t)(polyc__bytes(1, sizeof(polyc_ctx)) +
-                                              polyc__bytes(1, sizeof(polyc__online)) + ctx->arena.peak);
+    ctx->stats.memory_used_bytes = (uint64_t)(polyc__bytes(1, sizeof(polyc__online_head)) + ctx->arena.peak);
     ctx->stage = POLYC__STAGE_OPTIMIZED; /* the results are readable */
     const polyc__flat *f = &ctx->flat;
     uint64_t v = on->pubs.version + 1;

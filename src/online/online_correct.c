@@ -57,12 +57,10 @@ static void moved_scan(const polyc_ctx *ctx, uint32_t k, double x, double y, dou
 polyc_status polyc_online_correct(polyc_ctx *ctx, uint32_t scan_id, double pose_x_m,
                                   double pose_y_m, double pose_theta_rad)
 {
-    polyc_status cst = polyc__enter(ctx, 1);
+    polyc_status cst = polyc__online_enter(ctx, 1);
     if (cst != POLYC_OK)
         return cst;
     polyc__online *on = ctx->online;
-    if (!on)
-        return polyc__fail(ctx, POLYC_ERR_STATE, "not an online context (polyc_online_init)");
     uint32_t lo = 0, hi = on->kept.n;
     while (lo < hi) { /* kept_id ascends */
         uint32_t mid = lo + (hi - lo) / 2;
@@ -77,8 +75,8 @@ polyc_status polyc_online_correct(polyc_ctx *ctx, uint32_t scan_id, double pose_
         return polyc__fail(ctx, POLYC_ERR_SCAN, "scan pose is not finite or beyond 1e7 m");
     polyc_scan moved;
     moved_scan(ctx, lo, pose_x_m, pose_y_m, pose_theta_rad, &moved);
-    if (!polyc__online_inside_area(ctx, &moved))
-        return polyc__fail(ctx, POLYC_ERR_EXTENT, "the scan reaches outside limits.area_m around the first pose");
+    if ((cst = polyc__online_inside_area(ctx, &moved)) != POLYC_OK)
+        return cst;
     on->kept.new_pose[3 * (size_t)lo] = pose_x_m;
     on->kept.new_pose[3 * (size_t)lo + 1] = pose_y_m;
     on->kept.new_pose[3 * (size_t)lo + 2] = pose_theta_rad;

@@ -272,20 +272,27 @@ polyc_status polyc__online_accumulate(polyc_ctx *ctx, const polyc__scan *s, uint
     return st;
 }
 
-/* Whether the scan at its pose lies inside the area (frame metres). */
-int polyc__online_inside_area(const polyc_ctx *ctx, const polyc_scan *s)
+polyc_status polyc__online_inside_area(polyc_ctx *ctx, const polyc_scan *s)
 {
-    return polyc__frame_inside(ctx, s, 0.5f * polyc__narrow(ctx->online->lim.area_m) - AREA_MARGIN_M);
+    if (polyc__frame_inside(ctx, s, 0.5f * polyc__narrow(ctx->online->lim.area_m) - AREA_MARGIN_M))
+        return POLYC_OK;
+    return polyc__fail(ctx, POLYC_ERR_EXTENT, "the scan reaches outside limits.area_m around the first pose");
+}
+
+polyc_status polyc__online_enter(polyc_ctx *ctx, int args_ok)
+{
+    polyc_status st = polyc__enter(ctx, args_ok);
+    if (st == POLYC_OK && !ctx->online)
+        st = polyc__fail(ctx, POLYC_ERR_STATE, "not an online context (polyc_online_init)");
+    return st;
 }
 
 polyc_status polyc_online_add_scan(polyc_ctx *ctx, const polyc_scan *s, int keep, uint32_t *scan_id)
 {
-    polyc_status cst = polyc__enter(ctx, s != NULL);
+    polyc_status cst = polyc__online_enter(ctx, s != NULL);
     if (cst != POLYC_OK)
         return cst;
     polyc__online *on = ctx->online;
-    if (!on)
-        return polyc__fail(ctx, POLYC_ERR_STATE, "not an online context (polyc_online_init)");
     if ((cst = polyc__scan_check(ctx, s, on->scans)) != POLYC_OK)
         return cst;
     if (s->beam_count > on->lim.max_scan_beams)
@@ -302,8 +309,8 @@ polyc_status polyc_online_add_scan(polyc_ctx *ctx, const polyc_scan *s, int keep
         polyc__frame_set(ctx, s->pose_x_m, s->pose_y_m);
         polyc__frame_grid_origin(ctx, &ctx->grid, ctx->grid.frame_ox, ctx->grid.frame_oy);
     }
-    if (!polyc__online_inside_area(ctx, s))
-        return polyc__fail(ctx, POLYC_ERR_EXTENT, "the scan reaches outside limits.area_m around the first pose");
+    if ((cst = polyc__online_inside_area(ctx, s)) != POLYC_OK)
+        return cst;
     /* the current scan is slot 0; a kept one has its own slot and ranges */
     polyc__scan *d = &ctx->scans[0];
     uint32_t first = 0;

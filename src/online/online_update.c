@@ -32,11 +32,9 @@
 
 static polyc_status online_ctx(polyc_ctx *ctx)
 {
-    polyc_status cst = polyc__enter(ctx, 1);
+    polyc_status cst = polyc__online_enter(ctx, 1);
     if (cst != POLYC_OK)
         return cst;
-    if (!ctx->online)
-        return polyc__fail(ctx, POLYC_ERR_STATE, "not an online context (polyc_online_init)");
     if (ctx->online->scans == 0)
         return polyc__fail(ctx, POLYC_ERR_STATE, "no scan added yet");
     return POLYC_OK;

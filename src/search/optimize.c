@@ -165,8 +165,10 @@ enum { POLYC__OP_TABLE(OP_ID) OP_COUNT };
 #define OP_ROW(id, name, call, seq, flags) {seq, flags},
 static const polyc__op OPS[OP_COUNT] = {POLYC__OP_TABLE(OP_ROW)};
 
-/* The step of row i, with the run's arguments a. */
-static int run_step(polyc__opt *o, polyc__op_args *a, int i)
+/* The step of row i, with the run's arguments a (not inlined into the
+ * loop: each case is then one tail call, where -Os otherwise copies the
+ * loop's tail into all of them). */
+POLYC__NOINLINE static int run_step(polyc__opt *o, polyc__op_args *a, int i)
 {
 #define OP_CASE(id, name, call, seq, flags) \
     case OP_##id:                           \
