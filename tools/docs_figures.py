@@ -394,10 +394,10 @@ FIGURES = [
     Fig(P, '| one scan | {} | {} % | `polyc__walk_step` {} %, `count_beam` {} %, `list_near_points` {} %, '
         '`beam_fill` {} % |',
         'profile', prof('embedded_scan', 'polyc__walk_step', 'count_beam', 'list_near_points', 'beam_fill')),
-    Fig(P, '| online | {} | {} % | `list_near_points` {} %, `polyc__buckets_around` {} %, '
-        '`polyc__segment_region` {} %, `smoothed` {} % |',
-        'profile', prof('embedded_online', 'list_near_points', 'polyc__buckets_around',
-                        'polyc__segment_region', 'smoothed')),
+    Fig(P, '| online | {} | {} % | `list_near_points` {} %, `polyc__segment_region` {} %, '
+        '`polyc__seg_pre_cost` {} %, `polyc__local_eval` {} % |',
+        'profile', prof('embedded_online', 'list_near_points', 'polyc__segment_region',
+                        'polyc__seg_pre_cost', 'polyc__local_eval')),
     # docs/performance.md: the sweep's summary, every column but ms
     Table(P, 'sweep', 'sweep', skip_cols=(4,)),
 

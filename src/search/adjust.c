@@ -15,15 +15,27 @@ typedef struct angle_places {
     polyc__prior_place prev, at, next;
 } angle_places;
 
+/* The prior at vertex u into *out: a copy of *same when u lies in its
+ * cell (a prior cell is a grid tile: neighbours often share one). */
+static void place_of(const polyc__opt *o, int32_t u, const polyc__prior_place *same,
+                     polyc__prior_place *out)
+{
+    const polyc__vertex *V = o->s->v;
+    if (polyc__prior_same_place(&o->prior, same, V[u].x, V[u].y))
+        *out = *same;
+    else
+        polyc__prior_at(&o->prior, V[u].x, V[u].y, out);
+}
+
 static void places_init(const polyc__opt *o, int32_t v, angle_places *pl)
 {
     const polyc__vertex *V = o->s->v;
     pl->prev.valid = pl->next.valid = 0;
-    if (V[v].prev != POLYC__NONE)
-        polyc__prior_at(&o->prior, V[V[v].prev].x, V[V[v].prev].y, &pl->prev);
-    if (V[v].next != POLYC__NONE)
-        polyc__prior_at(&o->prior, V[V[v].next].x, V[V[v].next].y, &pl->next);
     polyc__prior_at(&o->prior, V[v].x, V[v].y, &pl->at);
+    if (V[v].prev != POLYC__NONE)
+        place_of(o, V[v].prev, &pl->at, &pl->prev);
+    if (V[v].next != POLYC__NONE)
+        place_of(o, V[v].next, &pl->at, &pl->next);
 }
 
 /* Angle terms of v's neighbourhood with v at (x, y). */

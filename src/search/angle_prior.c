@@ -356,19 +356,26 @@ static void smoothed(const polyc__prior *p, int32_t cx, int32_t cy, const int *b
     for (int k = 0; k < nb; k++)
         cnt[bins[k]] = 0;
     *n = 0;
-    for (int k = 0; k < 9; k++) {
-        size_t cell;
-        uint32_t w;
-        if (!neighbour(p, cx, cy, k, &cell, &w) || p->row_of[cell] == 0)
+    /* the 3 x 3 cells as neighbour() gives them, row by row */
+    for (int32_t j = -1; j <= 1; j++) {
+        int32_t iy = cy + j;
+        if (iy < 0 || iy >= p->h)
             continue;
-        const uint16_t *h = p->hist + (size_t)(p->row_of[cell] - 1) * BINS;
-        if (nb == BINS) /* all bins, in order: a loop the compiler vectorises */
-            for (int b = 0; b < BINS; b++)
-                cnt[b] += w * h[b];
-        else
-            for (int q = 0; q < nb; q++)
-                cnt[bins[q]] += w * h[bins[q]];
-        *n += w * p->total[p->row_of[cell] - 1];
+        const uint32_t *row = p->row_of + (size_t)iy * (size_t)p->w;
+        for (int32_t i = -1; i <= 1; i++) {
+            int32_t ix = cx + i;
+            if (ix < 0 || ix >= p->w || row[ix] == 0)
+                continue;
+            uint32_t w = (uint32_t)(4 >> ((i != 0) + (j != 0))), r = row[ix] - 1;
+            const uint16_t *h = p->hist + (size_t)r * BINS;
+            if (nb == BINS) /* all bins, in order: a loop the compiler vectorises */
+                for (int b = 0; b < BINS; b++)
+                    cnt[b] += w * h[b];
+            else
+                for (int q = 0; q < nb; q++)
+                    cnt[bins[q]] += w * h[bins[q]];
+            *n += w * p->total[r];
+        }
     }
 }
 

@@ -212,18 +212,21 @@ void polyc__segment_region(polyc__opt *o, float ax, float ay, float bx, float by
     const polyc__hash *h = &o->h;
     const uint32_t epoch = o->chg.epoch;
     path_walk p;
-    int32_t ix, iy, around[9];
+    int32_t ix, iy;
     if (!path_begin(h, ax, ay, bx, by, &p))
         return;
     while (path_next(&p, &ix, &iy)) {
-        int n = polyc__buckets_around(h, ix, iy, around);
-        for (int i = 0; i < n; i++) {
-            int32_t k = around[i];
-            if (o->chg.bucket_mark[k] == epoch)
-                continue;
-            o->chg.bucket_mark[k] = epoch;
-            o->chg.bucket_list[o->chg.bucket_n++] = k;
-        }
+        /* the 3 x 3 around it in polyc__buckets_around's order, written
+         * out (this is the hottest bucket walk) */
+        int32_t x0 = ix > 0 ? ix - 1 : 0, x1 = ix + 1 < h->bx ? ix + 1 : h->bx - 1;
+        int32_t y0 = iy > 0 ? iy - 1 : 0, y1 = iy + 1 < h->by ? iy + 1 : h->by - 1;
+        for (int32_t y = y0; y <= y1; y++)
+            for (int32_t k = y * h->bx + x0; k <= y * h->bx + x1; k++) {
+                if (o->chg.bucket_mark[k] == epoch)
+                    continue;
+                o->chg.bucket_mark[k] = epoch;
+                o->chg.bucket_list[o->chg.bucket_n++] = k;
+            }
     }
 }
 
