@@ -295,6 +295,12 @@ void polyc__segment_buckets(polyc__opt *o, float ax, float ay, float bx, float b
 /* lists in o->bucket_list, once per epoch (o->bucket_mark), every bucket
  * within one bucket of the segment a-b: those whose points it can reach */
 void polyc__segment_region(polyc__opt *o, float ax, float ay, float bx, float by);
+/* whether a segment that touches neither end of segment v comes within
+ * `reach` of it or crosses it, among the segments in the 3 x 3 buckets
+ * around each bucket v crosses: those a query near a point of v walks
+ * (polyc__near_segs); 0: no point of v is within reach of another piece
+ * of map there */
+int polyc__segment_near_other(const polyc__opt *o, int32_t v, float reach);
 
 /* A segment prepared for many cost evaluations (trial.h). */
 typedef struct polyc__seg_pre {

@@ -230,6 +230,58 @@ void polyc__segment_region(polyc__opt *o, float ax, float ay, float bx, float by
     }
 }
 
+/* the side of p that line q-r leaves it on (twice the signed area) */
+static float orient(const polyc__vertex *q, const polyc__vertex *r, const polyc__vertex *p)
+{
+    return (r->x - q->x) * (p->y - q->y) - (r->y - q->y) * (p->x - q->x);
+}
+
+/* Whether the segments of vertices p and q come within sqrt(lim2) of each
+ * other, or cross (or lie on one line). */
+POLYC__NOINLINE static int segments_near(const polyc__store *s, int32_t p, int32_t q, float lim2)
+{
+    const polyc__vertex *e[4] = {&s->v[p], &s->v[s->v[p].next], &s->v[q], &s->v[s->v[q].next]};
+    for (int k = 0; k < 4; k++) { /* each end against the other segment */
+        const polyc__vertex *c = e[k], *a = e[k < 2 ? 2 : 0], *b = e[k < 2 ? 3 : 1];
+        if (polyc__seg_dist2(c->x, c->y, a->x, a->y, b->x, b->y) <= lim2)
+            return 1;
+    }
+    return orient(e[0], e[1], e[2]) * orient(e[0], e[1], e[3]) <= 0.0f &&
+           orient(e[2], e[3], e[0]) * orient(e[2], e[3], e[1]) <= 0.0f;
+}
+
+int polyc__segment_near_other(const polyc__opt *o, int32_t v, float reach)
+{
+    const polyc__hash *h = &o->h;
+    const polyc__vertex *a = &o->s->v[v], *b = &o->s->v[a->next];
+    path_walk p;
+    int32_t ix, iy, around[9];
+    if (!path_begin(h, a->x, a->y, b->x, b->y, &p))
+        return 0;
+    while (path_next(&p, &ix, &iy)) {
+        int n = polyc__buckets_around(h, ix, iy, around);
+        for (int i = 0; i < n; i++)
+            for (int32_t e = h->seg_head[around[i]]; e != POLYC__NONE; e = h->entries[e].next) {
+                int32_t sg = h->entries[e].seg;
+                if (!polyc__touches(o->s, sg, v, a->next) && segments_near(o->s, v, sg, reach * reach))
+                    return 1;
+            }
+    }
+    return 0;
+    while (path_next(&p, &ix, &iy)) {
+        int32_t x0 = ix > 0 ? ix - 1 : 0, x1 = ix + 1 < h->bx ? ix + 1 : h->bx - 1;
+        int32_t y0 = iy > 0 ? iy - 1 : 0, y1 = iy + 1 < h->by ? iy + 1 : h->by - 1;
+        for (int32_t y = y0; y <= y1; y++)
+            for (int32_t k = y * h->bx + x0; k <= y * h->bx + x1; k++)
+                for (int32_t e = h->seg_head[k]; e != POLYC__NONE; e = h->entries[e].next) {
+                    int32_t sg = h->entries[e].seg;
+                    if (!polyc__touches(o->s, sg, v, a->next) && segments_near(o->s, v, sg, reach * reach))
+                        return 1;
+                }
+    }
+    return 0;
+}
+
 /* The bucket callbacks get the segment id as their user pointer. */
 static void insert_in_bucket(polyc__opt *o, void *user, int32_t bucket)
 {

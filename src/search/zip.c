@@ -183,58 +183,10 @@ static int sample_in_run(const polyc__opt *o, const run_test *rt, float x, float
     return covered(o, x, y, a, b, rt->lim2);
 }
 
-/* Whether some segment that touches neither a nor b comes within sqrt
- * lim2 of segment a-b (or crosses it), among the segments in the 3 x 3
- * buckets around each bucket a-b crosses: those its samples' covered()
- * looks at. No: none of its samples is covered (a clean map's usual case,
- * found without sampling). */
-typedef struct near_test {
-    int32_t a, b;
-    float lim2;
-    int found;
-} near_test;
-
-/* the side of p that line q-r leaves it on (twice the signed area) */
-static float orient(const polyc__vertex *q, const polyc__vertex *r, const polyc__vertex *p)
-{
-    return (r->x - q->x) * (p->y - q->y) - (r->y - q->y) * (p->x - q->x);
-}
-
-POLYC__NOINLINE static int segments_near(const polyc__store *s, int32_t p, int32_t q, float lim2)
-{
-    const polyc__vertex *e[4] = {&s->v[p], &s->v[s->v[p].next], &s->v[q], &s->v[s->v[q].next]};
-    for (int k = 0; k < 4; k++) { /* each end against the other segment */
-        const polyc__vertex *c = e[k], *a = e[k < 2 ? 2 : 0], *b = e[k < 2 ? 3 : 1];
-        if (polyc__seg_dist2(c->x, c->y, a->x, a->y, b->x, b->y) <= lim2)
-            return 1;
-    }
-    /* they cross (or lie on one line) */
-    return orient(e[0], e[1], e[2]) * orient(e[0], e[1], e[3]) <= 0.0f &&
-           orient(e[2], e[3], e[0]) * orient(e[2], e[3], e[1]) <= 0.0f;
-}
-
-static void near_in_bucket(polyc__opt *o, void *user, int32_t bucket)
-{
-    near_test *t = user;
-    const polyc__hash *h = &o->h;
-    int32_t around[9];
-    if (t->found)
-        return;
-    int n = polyc__buckets_around(h, bucket % h->bx, bucket / h->bx, around);
-    for (int i = 0; i < n; i++)
-        for (int32_t e = h->seg_head[around[i]]; e != POLYC__NONE; e = h->entries[e].next) {
-            int32_t sg = h->entries[e].seg;
-            if (!polyc__touches(o->s, sg, t->a, t->b) && segments_near(o->s, t->a, sg, t->lim2)) {
-                t->found = 1;
-                return;
-            }
-        }
-}
-
 /* The longest stretch of segment v whose samples pass the test (band 0:
  * double cover; 1: a band with another piece of map seen from v's side),
  * as fractions [*t0, *t1] along it; 0 if none is longer than ZIP_RUN_M. */
-static int longest_run(polyc__opt *o, int32_t v, int band, float *t0, float *t1)
+static int longest_run(const polyc__opt *o, int32_t v, int band, float *t0, float *t1)
 {
     const polyc__vertex *V = o->s->v;
     int32_t w = V[v].next;
@@ -246,19 +198,14 @@ static int longest_run(polyc__opt *o, int32_t v, int band, float *t0, float *t1)
     rt.band = band;
     rt.lim2 = o->cfg->overlap_m * o->cfg->overlap_m;
     rt.n_cand = 0;
-    /* (the samples lie on the segment within rounding, and a covering
-     * segment's bucket is within one of the sample's when buckets are
-     * wider than twice the reach: else no shortcut) */
-    if (!band && o->h.bucket_m > 2.0f * o->cfg->overlap_m + 0.01f) {
-        near_test nt;
-        nt.a = v;
-        nt.b = w;
-        nt.lim2 = (o->cfg->overlap_m + 1e-3f) * (o->cfg->overlap_m + 1e-3f);
-        nt.found = 0;
-        polyc__segment_buckets(o, ax, ay, V[w].x, V[w].y, near_in_bucket, &nt);
-        if (!nt.found)
-            return 0;
-    }
+    /* none of its samples is covered when no other segment comes within
+     * reach of the segment (a clean map's usual case, found without
+     * sampling; a millimetre more: the samples lie on it within rounding,
+     * and a covering segment's bucket is one a sample's query walks when
+     * buckets are wider than twice the reach: else no shortcut) */
+    if (!band && o->h.bucket_m > 2.0f * o->cfg->overlap_m + 0.01f &&
+        !polyc__segment_near_other(o, v, o->cfg->overlap_m + 1e-3f))
+        return 0;
     if (band) {
         float nx = 0.0f, ny = 0.0f;
         int two = two_sided_now(o, v);
