@@ -254,8 +254,9 @@ inline void polyc__bucket_xy(const polyc__hash *h, float x, float y, int32_t *ix
     *iy = fy < 0.0f ? 0 : (fy >= (float)h->by ? h->by - 1 : (int32_t)fy);
 }
 /* The 3 x 3 buckets around bucket (bx, by) that lie in the hash, row by
- * row, into out; returns their count (the one bucket walk of the library:
- * polyc__near_segs below walks their segments). */
+ * row, into out; returns their count (the library's bucket walk:
+ * polyc__near_segs below walks their segments; only polyc__segment_region,
+ * the hottest, writes the same rows out). */
 inline int polyc__buckets_around(const polyc__hash *h, int32_t bx, int32_t by, int32_t out[9])
 {
     int32_t x0 = bx > 0 ? bx - 1 : 0, x1 = bx + 1 < h->bx ? bx + 1 : h->bx - 1;

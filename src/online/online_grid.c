@@ -89,11 +89,67 @@ void polyc__records_take(polyc__records *rec, polyc__tile *t, size_t d)
     rec->pre_free[rec->pre_nfree++] = (uint32_t)r;
 }
 
+/* The walk's cells from where it is to its tile's edge or the end cell
+ * into a record (nib, sum), as count_beam's loop counts a stored tile: a
+ * cell counts when the walk enters it before miss_key. The steps are
+ * polyc__walk_step's, on the walk's fields held in locals: the byte stores
+ * may alias anything, and through the walk's pointer each step would load
+ * them again (half of an online add's time on a long-range log is this
+ * loop). take_back: out again, where the count is exact (a constant in
+ * each call below, which the compiler folds). Returns the last step's
+ * result (1: the walk left the tile). */
+static inline int record_cells(polyc__walk *w, uint8_t *nib, uint16_t *sum, int64_t miss_key,
+                               int take_back)
+{
+    int64_t kx = w->kx, ky = w->ky, t = w->t_key;
+    const int64_t inc_x = w->inc_x, inc_y = w->inc_y;
+    int32_t idx = w->idx, n = w->n, lx = w->left_x, ly = w->left_y;
+    const int32_t sx = w->stx, sy = w->sty, lx0 = lx, ly0 = ly;
+    int left;
+    do {
+        if (t < miss_key) {
+            uint16_t *s = &sum[pre_block(idx)];
+            uint8_t *p = &nib[idx >> 1];
+            unsigned shift = (unsigned)(idx & 1) * 4, c = (unsigned)(*p >> shift) & 15u;
+            if (take_back) {
+                *s = (uint16_t)(*s > 0 ? *s - 1 : 0);
+                if (c > 0 && c < POLYC__PRE_FULL)
+                    *p = (uint8_t)(*p - (1u << shift));
+            } else {
+                *s = (uint16_t)(*s < 65535u ? *s + 1 : *s);
+                if (c < POLYC__PRE_FULL)
+                    *p = (uint8_t)(*p + (1u << shift));
+            }
+        }
+        n--;
+        if (kx < ky) {
+            t = kx;
+            kx += inc_x;
+            idx += sx;
+            left = --lx < 0;
+        } else {
+            t = ky;
+            ky += inc_y;
+            idx += sy * POLYC__TILE_SIDE;
+            left = --ly < 0;
+        }
+    } while (!left && n > 0);
+    w->kx = kx;
+    w->ky = ky;
+    w->t_key = t;
+    w->idx = idx;
+    w->n = n;
+    w->ix += sx * (lx0 - lx); /* a step each time left_x went down */
+    w->iy += sy * (ly0 - ly);
+    w->left_x = lx;
+    w->left_y = ly;
+    return left;
+}
+
 /* The beam's cells in the tile not stored of entry d, from the walk's
  * cell to the tile's edge or the end cell, into its record (take_back: out
- * again, where the count is exact). As count_beam's loop: a cell counts
- * when the walk enters it before miss_end. Returns polyc__walk_step's
- * last result (1: the walk left the tile). */
+ * again). Returns polyc__walk_step's last result (1: the walk left the
+ * tile). */
 int polyc__records_walk(polyc__records *rec, size_t d, polyc__walk *w, int64_t miss_key, int take_back)
 {
     int64_t r = pre_record(rec, d, !take_back);
@@ -106,23 +162,7 @@ int polyc__records_walk(polyc__records *rec, size_t d, polyc__walk *w, int64_t m
     }
     uint8_t *nib = rec->pre_cells + (size_t)r * (POLYC__TILE_CELLS / 2);
     uint16_t *sum = rec->pre_miss + (size_t)r * POLYC__PRE_BLOCKS;
-    do {
-        if (w->t_key < miss_key) {
-            uint16_t *s = &sum[pre_block(w->idx)];
-            unsigned c = pre_cell(nib, w->idx), shift = (unsigned)(w->idx & 1) * 4;
-            if (take_back) {
-                *s = (uint16_t)(*s > 0 ? *s - 1 : 0);
-                if (c > 0 && c < POLYC__PRE_FULL)
-                    nib[w->idx >> 1] = (uint8_t)(nib[w->idx >> 1] - (1u << shift));
-            } else {
-                *s = (uint16_t)(*s < 65535u ? *s + 1 : *s);
-                if (c < POLYC__PRE_FULL)
-                    nib[w->idx >> 1] = (uint8_t)(nib[w->idx >> 1] + (1u << shift));
-            }
-        }
-        left = polyc__walk_step(w);
-    } while (!left && w->n > 0);
-    return left;
+    return take_back ? record_cells(w, nib, sum, miss_key, 1) : record_cells(w, nib, sum, miss_key, 0);
 }
 
 
