@@ -328,11 +328,11 @@ X_STDIO = $(subst $(sp),|,.*printf.* .*scanf.* f?open fdopen freopen fclose frea
 # newlib's float libm that computes in double (sinf, cosf, atan2f, logf,
 # expf, powf: src/fmath.c has the library's own), or libgcc's 64-bit float
 # conversions, which go through double; except the cold files of X_COLD:
-#   boundary  the API's double poses, origins and figures in and out (a few
-#             operations per scan, grid or result)
-#   config    configuration checks and sizing (polyc_limits_for_scans and
-#             its extent: a few per scan, before the library runs)
-X_COLD   = boundary config
+#   boundary  the API's double poses, origins and figures in and out: the
+#             subtractions and additions of the frame's origin and the
+#             narrowing to float (a few per scan, grid or result; its
+#             checks and comparisons are done on the bits)
+X_COLD   = boundary
 X_DOUBLE = __aeabi_d[a-z0-9]+|__aeabi_[fiul]+2d|__aeabi_d2[a-z]+|__[a-z]+df[23]|__extendsfdf2|\
            __truncdfsf2|__fix(uns)?sfdi|__fix(uns)?dfsi|__float(un)?sidf|__float(un)?didf|__ieee754_[a-z0-9]+|\
            sin|cos|tan|asin|acos|atan|atan2|sinh|cosh|tanh|exp|exp2|log|log2|log10|pow|sqrt|cbrt|\

@@ -1,17 +1,151 @@
 /* boundary.c - where the API's doubles meet the library's floats.
  * Takes: poses and origins in the caller's frame (double, polyc.h).
- * Gives: float coordinates relative to the frame (the first pose, or an
- * occupancy grid's origin), the map back in the caller's frame, and the
- * BIC and error figures as the API's doubles.
+ * Gives: the checks of poses and grid origins, the extent of scans (the
+ * sizing of polyc_limits_for_scans and the frame's box), float
+ * coordinates relative to the frame (the first pose, or an occupancy
+ * grid's origin), the map back in the caller's frame, and the BIC and
+ * error figures as the API's doubles.
  * Everything else computes in float: on a Cortex-M4F (a single-precision
  * FPU) each double operation is a software call. The calls here run a few
- * times per scan, per grid or per result (the Makefile's cold list). */
+ * times per scan, per grid or per result (the Makefile's cold list); what
+ * needs no double arithmetic (the checks, the comparisons) is done on the
+ * doubles' bits, exactly as the FPU would decide it. */
 #include "context.h"
 
 #include <math.h>
+#include <string.h>
 
 #define TWO_PI 6.283185307179586
 #define PI 3.141592653589793
+
+/* ---- comparisons on the bits (IEEE 754 binary64) ---- */
+
+#define SIGN_BIT (UINT64_C(1) << 63)
+
+static uint64_t bits_of(double v)
+{
+    uint64_t u;
+    memcpy(&u, &v, sizeof u);
+    return u;
+}
+
+static int is_nan(double v)
+{
+    return (bits_of(v) << 1) > (UINT64_C(0x7ff) << 53); /* exponent all ones, a fraction */
+}
+
+/* |v| as an integer that orders as |v| does (infinity and NaN above every
+ * finite number): `fabs(v) < lim` is magnitude(v) < magnitude(lim) */
+static uint64_t magnitude(double v)
+{
+    return bits_of(v) & ~SIGN_BIT;
+}
+
+/* v (not NaN) as an integer that orders as v does, -0 and +0 as 0 */
+static int64_t order(double v)
+{
+    uint64_t u = bits_of(v);
+    return (u & SIGN_BIT) ? -(int64_t)(u & ~SIGN_BIT) : (int64_t)u;
+}
+
+/* a < b and a <= b, false when either is NaN (as the FPU's) */
+static int less(double a, double b)
+{
+    return !is_nan(a) && !is_nan(b) && order(a) < order(b);
+}
+static int less_eq(double a, double b)
+{
+    return !is_nan(a) && !is_nan(b) && order(a) <= order(b);
+}
+
+/* fmin and fmax: the other when one is NaN */
+static double min_of(double a, double b)
+{
+    return is_nan(a) || less(b, a) ? b : a;
+}
+static double max_of(double a, double b)
+{
+    return is_nan(a) || less(a, b) ? b : a;
+}
+
+/* ---- the checks and the extent ---- */
+
+int polyc__pose_ok(double x, double y, double th)
+{
+    /* finite, within 1e7 m, turned at most 1e4 rad */
+    return magnitude(x) < magnitude(1e7) && magnitude(y) < magnitude(1e7) &&
+           magnitude(th) <= magnitude(1e4);
+}
+
+int polyc__grid_origin_ok(const polyc_occupancy_grid *grid)
+{
+    return magnitude(grid->origin_x_m) < magnitude(1e7) && magnitude(grid->origin_y_m) < magnitude(1e7) &&
+           magnitude(grid->origin_yaw_rad) <= magnitude(100.0);
+}
+
+/* Extent rule: the poses and every reflected endpoint. Free-space beams do
+ * not widen it (they are clipped to it). ox, oy shift the frame.
+ * The endpoints' offsets from the pose are found in float (ranges are
+ * small numbers; a double per beam is a software call on the target), the
+ * box in double once per scan (poses may be far from the origin). */
+void polyc__extent_add(const polyc_scan *s, double ox, double oy, double *box, int *have)
+{
+    double px = s->pose_x_m - ox, py = s->pose_y_m - oy;
+    float off[4] = {0.0f, 0.0f, 0.0f, 0.0f}; /* min x, min y, max x, max y */
+    float theta = polyc__heading(s->pose_theta_rad);
+    for (uint32_t i = 0; s->range_m && i < s->beam_count; i++) {
+        float r = s->range_m[i];
+        if (!(r >= s->min_range_m && r < s->max_range_m))
+            continue;
+        float a = theta + s->start_angle_rad + (float)i * s->angle_step_rad;
+        float sn, cs;
+        polyc__sincosf(a, &sn, &cs);
+        float x = r * cs, y = r * sn;
+        off[0] = x < off[0] ? x : off[0];
+        off[1] = y < off[1] ? y : off[1];
+        off[2] = x > off[2] ? x : off[2];
+        off[3] = y > off[3] ? y : off[3];
+    }
+    double lo_x = px + (double)off[0], lo_y = py + (double)off[1];
+    double hi_x = px + (double)off[2], hi_y = py + (double)off[3];
+    if (!*have) {
+        box[0] = lo_x;
+        box[1] = lo_y;
+        box[2] = hi_x;
+        box[3] = hi_y;
+        *have = 1;
+        return;
+    }
+    box[0] = min_of(box[0], lo_x);
+    box[1] = min_of(box[1], lo_y);
+    box[2] = max_of(box[2], hi_x);
+    box[3] = max_of(box[3], hi_y);
+}
+
+void polyc_scan_extent(const polyc_config *config, const polyc_scan *scan, polyc_box *box)
+{
+    (void)config;
+    if (!scan || !box || !polyc__pose_ok(scan->pose_x_m, scan->pose_y_m, scan->pose_theta_rad))
+        return;
+    double b[4] = {box->min_x_m, box->min_y_m, box->max_x_m, box->max_y_m};
+    int have = less_eq(b[0], b[2]) && less_eq(b[1], b[3]);
+    polyc__extent_add(scan, 0.0, 0.0, b, &have);
+    box->min_x_m = b[0];
+    box->min_y_m = b[1];
+    box->max_x_m = b[2];
+    box->max_y_m = b[3];
+}
+
+int polyc__box_spans(const polyc_box *box, float *w, float *h)
+{
+    if (!less_eq(box->min_x_m, box->max_x_m))
+        return 0;
+    *w = (float)(box->max_x_m - box->min_x_m);
+    *h = (float)(box->max_y_m - box->min_y_m);
+    return 1;
+}
+
+/* ---- the frame ---- */
 
 float polyc__narrow(double v)
 {
@@ -30,9 +164,9 @@ float polyc__heading(double theta_rad)
     /* whole turns off, by additions (|theta| <= 1e4 rad, polyc__pose_ok:
      * at most 1,592 of them): libm's remainder() and a multiply would
      * bring a kilobyte and more of software double into every firmware */
-    while (theta_rad > PI)
+    while (less(PI, theta_rad))
         theta_rad -= TWO_PI;
-    while (theta_rad < -PI)
+    while (less(theta_rad, -PI))
         theta_rad += TWO_PI;
     return (float)theta_rad;
 }
@@ -58,7 +192,7 @@ int polyc__frame_inside(const polyc_ctx *ctx, const polyc_scan *s, float half_m)
     int have = 0;
     polyc__extent_add(s, ctx->frame_x, ctx->frame_y, box, &have);
     double h = (double)half_m;
-    return !have || (box[0] > -h && box[1] > -h && box[2] < h && box[3] < h);
+    return !have || (less(-h, box[0]) && less(-h, box[1]) && less(box[2], h) && less(box[3], h));
 }
 
 void polyc__frame_box(const polyc_ctx *ctx, float box[4])
@@ -94,12 +228,6 @@ void polyc__frame_of_grid(polyc_ctx *ctx, const polyc_occupancy_grid *grid)
     ctx->grid.frame_ox = ctx->grid.frame_oy = 0.0f;
 }
 
-int polyc__grid_origin_ok(const polyc_occupancy_grid *grid)
-{
-    return isfinite(grid->origin_x_m) && isfinite(grid->origin_y_m) &&
-           isfinite(grid->origin_yaw_rad) && fabs(grid->origin_x_m) < 1e7 &&
-           fabs(grid->origin_y_m) < 1e7 && fabs(grid->origin_yaw_rad) <= 100.0;
-}
 
 void polyc__figures_iteration(polyc_iteration *rep, float bic, float best_bic, float noise_m)
 {

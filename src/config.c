@@ -1,7 +1,8 @@
 /* config.c - the entry points that need no context: version, status
- * strings, struct sizes, the default configuration and its check, a scan's
- * extent and the limits for a set of scans. Takes: the caller's config and
- * scans. Gives: what polyc_memory_size and polyc_init are then called with. */
+ * strings, struct sizes, the default configuration and its check, and the
+ * limits for a set of scans (their extent: boundary.c). Takes: the
+ * caller's config and scans. Gives: what polyc_memory_size and polyc_init
+ * are then called with. */
 #include "context.h"
 
 #include <math.h>
@@ -118,66 +119,7 @@ polyc_status polyc_config_check(const polyc_config *c, const char **why)
     return w ? POLYC_ERR_CONFIG : POLYC_OK;
 }
 
-/* ---- extent ---- */
-
-int polyc__pose_ok(double x, double y, double th)
-{
-    return isfinite(x) && isfinite(y) && isfinite(th) && fabs(x) < 1e7 && fabs(y) < 1e7 &&
-           fabs(th) <= 1e4;
-}
-
-/* Extent rule: the poses and every reflected endpoint. Free-space beams do
- * not widen it (they are clipped to it). ox, oy shift the frame.
- * The endpoints' offsets from the pose are found in float (ranges are
- * small numbers; a double per beam is a software call on the target), the
- * box in double once per scan (poses may be far from the origin). */
-void polyc__extent_add(const polyc_scan *s, double ox, double oy, double *box, int *have)
-{
-    double px = s->pose_x_m - ox, py = s->pose_y_m - oy;
-    float off[4] = {0.0f, 0.0f, 0.0f, 0.0f}; /* min x, min y, max x, max y */
-    float theta = polyc__heading(s->pose_theta_rad);
-    for (uint32_t i = 0; s->range_m && i < s->beam_count; i++) {
-        float r = s->range_m[i];
-        if (!(r >= s->min_range_m && r < s->max_range_m))
-            continue;
-        float a = theta + s->start_angle_rad + (float)i * s->angle_step_rad;
-        float sn, cs;
-        polyc__sincosf(a, &sn, &cs);
-        float x = r * cs, y = r * sn;
-        off[0] = x < off[0] ? x : off[0];
-        off[1] = y < off[1] ? y : off[1];
-        off[2] = x > off[2] ? x : off[2];
-        off[3] = y > off[3] ? y : off[3];
-    }
-    double lo_x = px + (double)off[0], lo_y = py + (double)off[1];
-    double hi_x = px + (double)off[2], hi_y = py + (double)off[3];
-    if (!*have) {
-        box[0] = lo_x;
-        box[1] = lo_y;
-        box[2] = hi_x;
-        box[3] = hi_y;
-        *have = 1;
-        return;
-    }
-    box[0] = fmin(box[0], lo_x);
-    box[1] = fmin(box[1], lo_y);
-    box[2] = fmax(box[2], hi_x);
-    box[3] = fmax(box[3], hi_y);
-}
-
-void polyc_scan_extent(const polyc_config *config, const polyc_scan *scan, polyc_box *box)
-{
-    (void)config;
-    if (!scan || !box || !polyc__pose_ok(scan->pose_x_m, scan->pose_y_m, scan->pose_theta_rad))
-        return;
-    double b[4] = {box->min_x_m, box->min_y_m, box->max_x_m, box->max_y_m};
-    int have = b[0] <= b[2] && b[1] <= b[3];
-    polyc__extent_add(scan, 0.0, 0.0, b, &have);
-    box->min_x_m = b[0];
-    box->min_y_m = b[1];
-    box->max_x_m = b[2];
-    box->max_y_m = b[3];
-}
+/* ---- limits ---- */
 
 polyc_status polyc_limits_for_scans(const polyc_config *config, const polyc_scan *scans,
                                     uint32_t scan_count, polyc_limits *out)
@@ -197,12 +139,13 @@ polyc_status polyc_limits_for_scans(const polyc_config *config, const polyc_scan
         return POLYC_ERR_LIMIT;
     out->max_scans = scan_count;
     out->max_beams = (uint32_t)beams;
-    if (box.min_x_m <= box.max_x_m) {
+    float span_x, span_y;
+    if (polyc__box_spans(&box, &span_x, &span_y)) {
         /* in float once the spans are known (the grid lays itself out in
          * float too, with 4 cells less of padding than allowed here) */
         float cell = config->cell_m, ext = config->max_extent_m;
         float pad = 4.0f * cell;
-        float w = (float)(box.max_x_m - box.min_x_m) + pad, h = (float)(box.max_y_m - box.min_y_m) + pad;
+        float w = span_x + pad, h = span_y + pad;
         if (w > ext || h > ext)
             return POLYC_ERR_EXTENT;
         float tx = ceilf(ceilf(w / cell + 1.0f) / POLYC__TILE_SIDE);

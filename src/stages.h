@@ -7,15 +7,17 @@
 
 #include "internal.h"
 
-/* config.c: a pose is usable (finite, within 10,000 km); the extent rule
- * (the pose and every reflected endpoint, frame shifted by ox, oy) grows
- * box[4] = min x, min y, max x, max y (have: it holds something) */
-int polyc__pose_ok(double x, double y, double th);
 /* context.c: what is wrong with a scan's geometry (a static message), or NULL */
 const char *polyc__scan_problem(const polyc_scan *s);
-void polyc__extent_add(const polyc_scan *s, double ox, double oy, double *box, int *have);
 
-/* boundary.c: the API's doubles in and out (the library computes in float) */
+/* boundary.c: the API's doubles in and out (the library computes in float).
+ * A pose is usable (finite, within 10,000 km); the extent rule (the pose
+ * and every reflected endpoint, frame shifted by ox, oy) grows box[4] = min
+ * x, min y, max x, max y (have: it holds something); a box's spans in x
+ * and y (0: empty) */
+int polyc__pose_ok(double x, double y, double th);
+void polyc__extent_add(const polyc_scan *s, double ox, double oy, double *box, int *have);
+int polyc__box_spans(const polyc_box *box, float *w, float *h);
 float polyc__narrow(double v); /* a double of the API (an area, a limit) as a float */
 void polyc__frame_set(polyc_ctx *ctx, double x_m, double y_m);
 float polyc__heading(double theta_rad); /* a pose's heading in [-pi, pi] */
