@@ -90,7 +90,7 @@ int polyc__grid_origin_ok(const polyc_occupancy_grid *grid)
  * box in double once per scan (poses may be far from the origin). */
 void polyc__extent_add(const polyc_scan *s, double ox, double oy, double *box, int *have)
 {
-    double px = s->pose_x_m - ox, py = s->pose_y_m - oy;
+    double px = polyc__d_sub(s->pose_x_m, ox), py = polyc__d_sub(s->pose_y_m, oy);
     float off[4] = {0.0f, 0.0f, 0.0f, 0.0f}; /* min x, min y, max x, max y */
     float theta = polyc__heading(s->pose_theta_rad);
     for (uint32_t i = 0; s->range_m && i < s->beam_count; i++) {
@@ -106,8 +106,8 @@ void polyc__extent_add(const polyc_scan *s, double ox, double oy, double *box, i
         off[2] = x > off[2] ? x : off[2];
         off[3] = y > off[3] ? y : off[3];
     }
-    double lo_x = px + (double)off[0], lo_y = py + (double)off[1];
-    double hi_x = px + (double)off[2], hi_y = py + (double)off[3];
+    double lo_x = polyc__d_add(px, polyc__f_to_d(off[0])), lo_y = polyc__d_add(py, polyc__f_to_d(off[1]));
+    double hi_x = polyc__d_add(px, polyc__f_to_d(off[2])), hi_y = polyc__d_add(py, polyc__f_to_d(off[3]));
     if (!*have) {
         box[0] = lo_x;
         box[1] = lo_y;
@@ -140,8 +140,8 @@ int polyc__box_spans(const polyc_box *box, float *w, float *h)
 {
     if (!less_eq(box->min_x_m, box->max_x_m))
         return 0;
-    *w = (float)(box->max_x_m - box->min_x_m);
-    *h = (float)(box->max_y_m - box->min_y_m);
+    *w = polyc__d_to_f(polyc__d_sub(box->max_x_m, box->min_x_m));
+    *h = polyc__d_to_f(polyc__d_sub(box->max_y_m, box->min_y_m));
     return 1;
 }
 
@@ -149,7 +149,7 @@ int polyc__box_spans(const polyc_box *box, float *w, float *h)
 
 float polyc__narrow(double v)
 {
-    return (float)v;
+    return polyc__d_to_f(v);
 }
 
 void polyc__frame_set(polyc_ctx *ctx, double x_m, double y_m)
@@ -165,16 +165,16 @@ float polyc__heading(double theta_rad)
      * at most 1,592 of them): libm's remainder() and a multiply would
      * bring a kilobyte and more of software double into every firmware */
     while (less(PI, theta_rad))
-        theta_rad -= TWO_PI;
+        theta_rad = polyc__d_sub(theta_rad, TWO_PI);
     while (less(theta_rad, -PI))
-        theta_rad += TWO_PI;
-    return (float)theta_rad;
+        theta_rad = polyc__d_add(theta_rad, TWO_PI);
+    return polyc__d_to_f(theta_rad);
 }
 
 void polyc__frame_scan(const polyc_ctx *ctx, const polyc_scan *s, polyc__scan *d)
 {
-    d->x_m = (float)(s->pose_x_m - ctx->frame_x);
-    d->y_m = (float)(s->pose_y_m - ctx->frame_y);
+    d->x_m = polyc__d_to_f(polyc__d_sub(s->pose_x_m, ctx->frame_x));
+    d->y_m = polyc__d_to_f(polyc__d_sub(s->pose_y_m, ctx->frame_y));
     d->theta_rad = polyc__heading(s->pose_theta_rad);
 }
 
@@ -182,8 +182,8 @@ void polyc__frame_grid_origin(const polyc_ctx *ctx, polyc__grid *g, float x0_m, 
 {
     g->frame_ox = x0_m;
     g->frame_oy = y0_m;
-    g->origin_x_m = ctx->frame_x + (double)x0_m;
-    g->origin_y_m = ctx->frame_y + (double)y0_m;
+    g->origin_x_m = polyc__d_add(ctx->frame_x, polyc__f_to_d(x0_m));
+    g->origin_y_m = polyc__d_add(ctx->frame_y, polyc__f_to_d(y0_m));
 }
 
 int polyc__frame_inside(const polyc_ctx *ctx, const polyc_scan *s, float half_m)
@@ -191,16 +191,16 @@ int polyc__frame_inside(const polyc_ctx *ctx, const polyc_scan *s, float half_m)
     double box[4] = {0.0, 0.0, 0.0, 0.0};
     int have = 0;
     polyc__extent_add(s, ctx->frame_x, ctx->frame_y, box, &have);
-    double h = (double)half_m;
-    return !have || (less(-h, box[0]) && less(-h, box[1]) && less(box[2], h) && less(box[3], h));
+    double h = polyc__f_to_d(half_m), minus_h = polyc__f_to_d(-half_m);
+    return !have || (less(minus_h, box[0]) && less(minus_h, box[1]) && less(box[2], h) && less(box[3], h));
 }
 
 void polyc__frame_box(const polyc_ctx *ctx, float box[4])
 {
-    box[0] = (float)ctx->ext.min_x;
-    box[1] = (float)ctx->ext.min_y;
-    box[2] = (float)ctx->ext.max_x;
-    box[3] = (float)ctx->ext.max_y;
+    box[0] = polyc__d_to_f(ctx->ext.min_x);
+    box[1] = polyc__d_to_f(ctx->ext.min_y);
+    box[2] = polyc__d_to_f(ctx->ext.max_x);
+    box[3] = polyc__d_to_f(ctx->ext.max_y);
 }
 
 void polyc__frame_export(polyc_ctx *ctx)
@@ -209,20 +209,19 @@ void polyc__frame_export(polyc_ctx *ctx)
         /* turned in float (offsets from the grid's corner), placed in double */
         float x = ctx->flat.xy[2 * i], y = ctx->flat.xy[2 * i + 1];
         float c = ctx->frame_dir.cos, s = ctx->frame_dir.sin;
-        ctx->flat.xy[2 * i] = (float)(ctx->frame_x + (double)(c * x - s * y));
-        ctx->flat.xy[2 * i + 1] = (float)(ctx->frame_y + (double)(s * x + c * y));
+        ctx->flat.xy[2 * i] = polyc__d_to_f(polyc__d_add(ctx->frame_x, polyc__f_to_d(c * x - s * y)));
+        ctx->flat.xy[2 * i + 1] = polyc__d_to_f(polyc__d_add(ctx->frame_y, polyc__f_to_d(s * x + c * y)));
     }
     for (uint32_t i = 0; !ctx->from_grid && i < ctx->flat.points; i++) {
-        ctx->flat.xy[2 * i] = (float)((double)ctx->flat.xy[2 * i] + ctx->frame_x);
-        ctx->flat.xy[2 * i + 1] = (float)((double)ctx->flat.xy[2 * i + 1] + ctx->frame_y);
+        ctx->flat.xy[2 * i] = polyc__d_to_f(polyc__d_add(polyc__f_to_d(ctx->flat.xy[2 * i]), ctx->frame_x));
+        ctx->flat.xy[2 * i + 1] = polyc__d_to_f(polyc__d_add(polyc__f_to_d(ctx->flat.xy[2 * i + 1]), ctx->frame_y));
     }
 }
 
 void polyc__frame_of_grid(polyc_ctx *ctx, const polyc_occupancy_grid *grid)
 {
     polyc__frame_set(ctx, grid->origin_x_m, grid->origin_y_m);
-    ctx->frame_dir.cos = (float)cos(grid->origin_yaw_rad);
-    ctx->frame_dir.sin = (float)sin(grid->origin_yaw_rad);
+    polyc__sincosf(polyc__heading(grid->origin_yaw_rad), &ctx->frame_dir.sin, &ctx->frame_dir.cos);
     ctx->grid.origin_x_m = grid->origin_x_m; /* the grid's corner is the frame */
     ctx->grid.origin_y_m = grid->origin_y_m;
     ctx->grid.frame_ox = ctx->grid.frame_oy = 0.0f;
@@ -231,15 +230,15 @@ void polyc__frame_of_grid(polyc_ctx *ctx, const polyc_occupancy_grid *grid)
 
 void polyc__figures_iteration(polyc_iteration *rep, float bic, float best_bic, float noise_m)
 {
-    rep->bic = (double)bic;
-    rep->best_bic = (double)best_bic;
-    rep->noise_m = (double)noise_m;
+    rep->bic = polyc__f_to_d(bic);
+    rep->best_bic = polyc__f_to_d(best_bic);
+    rep->noise_m = polyc__f_to_d(noise_m);
 }
 
 void polyc__figures_out(float bic, float err, double *bic_out, double *err_out)
 {
     if (bic_out)
-        *bic_out = (double)bic;
+        *bic_out = polyc__f_to_d(bic);
     if (err_out)
-        *err_out = (double)err;
+        *err_out = polyc__f_to_d(err);
 }

@@ -56,6 +56,14 @@ uint64_t polyc__rng_next(polyc__rng *r);
 float polyc__rng_uniform(polyc__rng *r);   /* [0, 1) */
 float polyc__rng_normal(polyc__rng *r);    /* N(0, 1) */
 
+/* binary64.c: a + b, a - b, a double to float and a float to double,
+ * rounded as IEEE 754 rounds them, with integers (no software double on
+ * a single-precision FPU) */
+double polyc__d_add(double a, double b);
+double polyc__d_sub(double a, double b);
+float polyc__d_to_f(double v);
+double polyc__f_to_d(float v);
+
 /* fmath.c: float sine, cosine, arc tangent, logarithm (libm's compute in
  * double on the target); angles within a few thousand turns, log of a
  * finite normal x > 0 */
