@@ -66,7 +66,9 @@ const char *polyc__check_arena(const polyc__arena *a);
 const char *polyc__check_store(const polyc__store *s, int32_t *at);
 const char *polyc__check_hash(polyc__opt *o, int32_t *at);
 const char *polyc__check_books(const polyc__opt *o, int32_t *at);
-/* the cheap ones (arena, store, hash), asserted after each iteration */
+const char *polyc__check_point_order(const polyc__opt *o, int32_t *at);
+/* the cheap ones (arena, store, hash, the points' order), asserted after
+ * each iteration */
 void polyc__checks_iteration(polyc__opt *o);
 #define POLYC__CHECKS_ITERATION(o) polyc__checks_iteration(o)
 #else

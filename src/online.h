@@ -254,6 +254,9 @@ float polyc__online_sum_tile(const polyc_ctx *ctx, int32_t d, polyc__point *tmp,
 uint32_t polyc__online_drop_empty(polyc__point *pts, float *view, uint32_t *tile, uint32_t n);
 
 /* ---- online_data.c: the optimiser's data and books ---- */
+/* the buckets within a bucket of the first `taken` tiles of the backlog,
+ * in o->chg.bucket_list (a new epoch) */
+void polyc__online_list_taken_buckets(polyc_ctx *ctx, uint32_t taken);
 /* the points of the n taken tiles (the first n of the backlog, marked)
  * made again from the sums */
 polyc_status polyc__online_refresh_tiles(polyc_ctx *ctx, uint32_t n);

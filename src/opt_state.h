@@ -235,11 +235,14 @@ void polyc__points_reserve(polyc__arena *a, const polyc_config *cfg, const polyc
 
 /* spatial_hash.c */
 int32_t polyc__hash_bucket_cap(const polyc_limits *lim);
+/* the bucket cap of a grid of this many tiles (its area, stored or not) */
+int32_t polyc__hash_bucket_cap_tiles(size_t tiles);
 /* the entries for a hash of nb buckets (the reserve: the bucket cap) */
 int32_t polyc__hash_entry_cap(const polyc_limits *lim, size_t nb);
 polyc_status polyc__hash_init(polyc__opt *o);
-/* the buckets over the grid, carved from a (no clearing); 0: no room */
-int polyc__hash_lay_out(polyc__opt *o, polyc__arena *a);
+/* the buckets over the grid, at most cap of them, carved from a (no
+ * clearing); 0: no room */
+int polyc__hash_lay_out(polyc__opt *o, polyc__arena *a, int32_t cap);
 /* the hash's allocations under the limits, on a counting arena */
 void polyc__hash_reserve(polyc__arena *a, polyc__opt *o, const polyc_limits *lim);
 int polyc__hash_insert(polyc__opt *o, int32_t seg);

@@ -52,8 +52,9 @@ uint32_t polyc__operators(polyc__opt *o, uint32_t since, uint32_t climb);
 polyc_status polyc__opt_setup(polyc_ctx *ctx, polyc__opt *o);
 /* opt_setup.c: an optimiser that lasts across calls (an online context's),
  * carved once for the limits; and its data made again (the points through
- * ctx->layer's collect, with the prior given) before a search */
-int polyc__opt_carve_lasting(polyc_ctx *ctx, polyc__arena *a, polyc__opt *o);
+ * ctx->layer's collect, with the prior given) before a search; at most
+ * bucket_cap buckets */
+int polyc__opt_carve_lasting(polyc_ctx *ctx, polyc__arena *a, polyc__opt *o, int32_t bucket_cap);
 polyc_status polyc__opt_refresh(polyc__opt *o, const polyc__prior *prior);
 
 /* optimize.c: the search on a set-up optimiser (the batch loop) */

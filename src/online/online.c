@@ -125,7 +125,12 @@ static int lay_out(polyc_ctx *ctx, polyc__online *on, polyc__arena *a)
     POLYC__CARVE(ok, a, on->poses.spacing_dist, dir_n);
     POLYC__CARVE_ZERO(ok, a, on->backlog.dirty_since, dir_n);
     POLYC__CARVE(ok, a, on->backlog.dirty, dir_n);
-    ok = ok && polyc__opt_carve_lasting(ctx, a, &on->opt);
+    /* buckets as narrow as a batch's over the same area (the search walks
+     * 3 x 3 of them around every point it scores): an update moves the
+     * other buckets' points and starts as whole blocks (online_data.c), so
+     * their number costs memory more than time */
+    int32_t bucket_cap = polyc__hash_bucket_cap(&ctx->lim), by_area = polyc__hash_bucket_cap_tiles(dir_n);
+    ok = ok && polyc__opt_carve_lasting(ctx, a, &on->opt, bucket_cap > by_area ? bucket_cap : by_area);
     if (!ok)
         return 0;
     size_t P = (size_t)polyc__points_bound(&ctx->cfg, &ctx->lim), nb = (size_t)on->opt.h.bx * (size_t)on->opt.h.by;

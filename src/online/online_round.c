@@ -133,34 +133,8 @@ static int explained(const polyc__opt *o, float x, float y, float near, float fa
  * proportion to the whole map, not to its region.) */
 static int32_t taken_points(polyc_ctx *ctx, uint32_t taken)
 {
-    polyc__online *on = ctx->online;
-    polyc__opt *o = &on->opt;
-    const polyc__grid *g = &ctx->grid;
-    const polyc__hash *h = &o->h;
-    float tile_m = g->cell_m * (float)POLYC__TILE_SIDE;
-    float ox = g->frame_ox, oy = g->frame_oy;
-    polyc__chg_begin(o); /* a new epoch for the bucket marks */
-    for (uint32_t k = 0; k < taken; k++) {
-        uint32_t d = on->backlog.dirty[k];
-        float x0 = ox + (float)(d % (uint32_t)g->tiles_x) * tile_m;
-        float y0 = oy + (float)(d / (uint32_t)g->tiles_x) * tile_m;
-        int32_t bx0, by0, bx1, by1;
-        polyc__bucket_xy(h, x0, y0, &bx0, &by0);
-        polyc__bucket_xy(h, x0 + tile_m, y0 + tile_m, &bx1, &by1);
-        bx0 = bx0 > 0 ? bx0 - 1 : 0;
-        by0 = by0 > 0 ? by0 - 1 : 0;
-        bx1 = bx1 + 1 < h->bx ? bx1 + 1 : h->bx - 1;
-        by1 = by1 + 1 < h->by ? by1 + 1 : h->by - 1;
-        for (int32_t by = by0; by <= by1; by++)
-            for (int32_t bx = bx0; bx <= bx1; bx++) {
-                int32_t b = by * h->bx + bx;
-                if (o->chg.bucket_mark[b] == o->chg.epoch)
-                    continue;
-                o->chg.bucket_mark[b] = o->chg.epoch;
-                o->chg.bucket_list[o->chg.bucket_n++] = b;
-            }
-    }
-    return polyc__listed_points(o);
+    polyc__online_list_taken_buckets(ctx, taken);
+    return polyc__listed_points(&ctx->online->opt);
 }
 
 /* The taken tiles' contour cells that are occupied now (or data alone now:

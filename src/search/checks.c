@@ -182,12 +182,34 @@ const char *polyc__check_books(const polyc__opt *o, int32_t *at)
     return NULL;
 }
 
+/* the points sorted by bucket: each bucket's starts in order, each point
+ * in the bucket its position gives, the last end the points' count (an
+ * online update moves them in runs, online_data.c) */
+const char *polyc__check_point_order(const polyc__opt *o, int32_t *at)
+{
+    const polyc__hash *h = &o->h;
+    int32_t nb = h->bx * h->by;
+    if (h->pt_start[0] != 0 || h->pt_start[nb] != (uint32_t)o->d.np)
+        return "points: the buckets' starts do not span the points";
+    for (int32_t b = 0; b < nb; b++) {
+        *at = b;
+        if (h->pt_start[b] > h->pt_start[b + 1])
+            return "points: a bucket starts after the next one";
+        for (uint32_t i = h->pt_start[b]; i < h->pt_start[b + 1]; i++)
+            if (polyc__bucket_of(h, o->d.pts[i].x, o->d.pts[i].y) != b)
+                return "points: a point lies outside its bucket";
+    }
+    *at = -1;
+    return NULL;
+}
+
 void polyc__checks_iteration(polyc__opt *o)
 {
     int32_t at;
     POLYC_ASSERT(polyc__check_arena(&o->ctx->arena) == NULL);
     POLYC_ASSERT(polyc__check_store(o->s, &at) == NULL);
     POLYC_ASSERT(polyc__check_hash(o, &at) == NULL);
+    POLYC_ASSERT(polyc__check_point_order(o, &at) == NULL);
 }
 
 #else

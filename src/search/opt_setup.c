@@ -125,12 +125,12 @@ static void opt_begin(polyc_ctx *ctx, polyc__opt *o)
  * carved once for the limits (on the block, or on the size query's
  * counting arena): the spatial hash over the whole grid, the points, its
  * own arrays, the best map. The prior and the spacing are the caller's. */
-int polyc__opt_carve_lasting(polyc_ctx *ctx, polyc__arena *a, polyc__opt *o)
+int polyc__opt_carve_lasting(polyc_ctx *ctx, polyc__arena *a, polyc__opt *o, int32_t bucket_cap)
 {
     opt_begin(ctx, o);
     int32_t V = polyc__max_vertices(&ctx->lim), P = polyc__points_bound(o->cfg, &ctx->lim);
     polyc__rays_init(&o->rays, ctx);
-    int ok = polyc__hash_lay_out(o, a) && polyc__points_carve_online(a, o) &&
+    int ok = polyc__hash_lay_out(o, a, bucket_cap) && polyc__points_carve_online(a, o) &&
              opt_carve(a, o, P > 0 ? P : 1, V, 1, loc_soa_cap(o->cfg, &ctx->lim), 1);
     if (!a->base) { /* a counting arena: nothing is written */
         polyc__flat_reserve(a, V);

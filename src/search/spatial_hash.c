@@ -19,10 +19,16 @@ extern inline float polyc__seg_dist2(float px, float py, float ax, float ay, flo
 #define HASH_MARGIN_M 2.0f /* vertices may wander a little outside the grid */
 #define HASH_BUCKETS_PER_BEAM 16
 
+int32_t polyc__hash_bucket_cap_tiles(size_t tiles)
+{
+    size_t cap = 4 * (tiles * 4 + 64) + 1024; /* wider buckets when the map is larger */
+    return tiles > 0x1000000 || cap > 0x3fffffff ? 0x3fffffff : (int32_t)cap;
+}
+
 int32_t polyc__hash_bucket_cap(const polyc_limits *lim)
 {
     size_t tiles = ((size_t)lim->max_grid_cells + POLYC__TILE_CELLS - 1) / POLYC__TILE_CELLS;
-    size_t cap = 4 * (tiles * 4 + 64) + 1024; /* wider buckets when the map is larger */
+    size_t cap = (size_t)polyc__hash_bucket_cap_tiles(tiles);
     /* and wider when the data are few for the area (one scan's 361 returns
      * over 80 m x 80 m): clearing and counting 160,000 buckets took more
      * than the queries saved (at 16 buckets a beam single scans take fewer
@@ -68,19 +74,18 @@ void polyc__hash_reserve(polyc__arena *a, polyc__opt *o, const polyc_limits *lim
 
 polyc_status polyc__hash_init(polyc__opt *o)
 {
-    if (!polyc__hash_lay_out(o, &o->ctx->arena))
+    if (!polyc__hash_lay_out(o, &o->ctx->arena, polyc__hash_bucket_cap(&o->ctx->lim)))
         return polyc__fail(o->ctx, POLYC_ERR_NOMEM, "no room for the spatial hash");
     polyc__hash_clear(o);
     return POLYC_OK;
 }
 
-int polyc__hash_lay_out(polyc__opt *o, polyc__arena *a)
+int polyc__hash_lay_out(polyc__opt *o, polyc__arena *a, int32_t cap)
 {
     polyc_ctx *ctx = o->ctx;
     polyc__hash *h = &o->h;
     const polyc__grid *g = &ctx->grid;
     memset(h, 0, sizeof *h);
-    int32_t cap = polyc__hash_bucket_cap(&ctx->lim);
     float w_m = (float)g->width * g->cell_m + 2.0f * HASH_MARGIN_M;
     float h_m = (float)g->height * g->cell_m + 2.0f * HASH_MARGIN_M;
     /* at least the search radius plus the reach of one hill-climbing round */
