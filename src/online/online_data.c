@@ -1,10 +1,11 @@
 /* online_data.c - an online update's data: the weighted points of the
  * tiles it takes are made again from their cells' sums and take the place
- * of their old ones in the same arrays (the other tiles' points, and their
- * segments, stay); the polylines the update traced join the spatial hash,
- * the points near them re-assigned as after any edit. Takes: the optimiser of an online
- * context, the taken tiles. Gives: the optimiser's data and books, exact
- * for what it holds. */
+ * of their old ones in the same arrays, in the buckets over those tiles
+ * (the other tiles' points, and their segments, stay; they and the bucket
+ * starts move as whole runs); the polylines the update traced join the
+ * spatial hash, the points near them re-assigned as after any edit.
+ * Takes: the optimiser of an online context, the taken tiles. Gives: the
+ * optimiser's data and books, exact for what it holds. */
 #include "../online.h"
 
 #include <math.h>

@@ -273,18 +273,6 @@ int polyc__segment_near_other(const polyc__opt *o, int32_t v, float reach)
             }
     }
     return 0;
-    while (path_next(&p, &ix, &iy)) {
-        int32_t x0 = ix > 0 ? ix - 1 : 0, x1 = ix + 1 < h->bx ? ix + 1 : h->bx - 1;
-        int32_t y0 = iy > 0 ? iy - 1 : 0, y1 = iy + 1 < h->by ? iy + 1 : h->by - 1;
-        for (int32_t y = y0; y <= y1; y++)
-            for (int32_t k = y * h->bx + x0; k <= y * h->bx + x1; k++)
-                for (int32_t e = h->seg_head[k]; e != POLYC__NONE; e = h->entries[e].next) {
-                    int32_t sg = h->entries[e].seg;
-                    if (!polyc__touches(o->s, sg, v, a->next) && segments_near(o->s, v, sg, reach * reach))
-                        return 1;
-                }
-    }
-    return 0;
 }
 
 /* The bucket callbacks get the segment id as their user pointer. */
