@@ -74,8 +74,46 @@ static void test_truth_as_map(void **state)
     assert_near(sc.completeness, 1.0, 0.0);
     assert_int_equal(sc.vertices, 4);
     assert_near(sc.vertex_ratio, 1.0, 0.0);
+    assert_int_equal(sc.params, 8); /* 2 a vertex, no arc, no circle */
+    assert_int_equal(sc.arcs + sc.circles, 0);
+    assert_int_equal(sc.ideal_params, 0); /* no ideal_params line: ratio 0 */
+    assert_near(sc.param_ratio, 0.0, 0.0);
     gtscore_truth_free(&t);
     free(text);
+}
+
+/* ideal_params P A C: read, and refused when malformed or given twice. */
+static void test_ideal_params_line(void **state)
+{
+    static const float room[] = {0, 0, 4, 0, 4, 3, 0, 3};
+    polyc_polyline line = {room, 4, 1};
+    static const char *const bad[] = {"ideal_params 7 1\nwall open 0 0 1 0\n",
+                                      "ideal_params 7 1 0 2\nwall open 0 0 1 0\n",
+                                      "ideal_params 7 1.5 0\nwall open 0 0 1 0\n",
+                                      "ideal_params 7 1 0\nideal_params 7 1 0\nwall open 0 0 1 0\n"};
+    gtscore_truth t;
+    gtscore_map_score sc;
+    char err[256];
+    size_t k;
+    (void)state;
+    truth_from_text(&t, "ideal 4\nideal_params 10 2 0\nwall closed 0 0 4 0 4 3 0 3\n");
+    assert_true(t.has_ideal_params);
+    assert_int_equal(t.ideal_params, 10);
+    assert_int_equal(t.ideal_arcs, 2);
+    assert_int_equal(t.ideal_circles, 0);
+    assert_int_equal(gtscore_score_map(&t, &line, 1, &sc), 0);
+    assert_int_equal(sc.params, 8);
+    assert_int_equal(sc.ideal_params, 10);
+    assert_near(sc.param_ratio, 0.8, 1e-12);
+    gtscore_truth_free(&t);
+    for (k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+        FILE *f = fmemopen((void *)bad[k], strlen(bad[k]), "r");
+        assert_non_null(f);
+        assert_int_equal(gtscore_truth_read(&t, f, "bad.gt.txt", err, sizeof err), -1);
+        assert_non_null(strstr(err, "ideal_params"));
+        fclose(f);
+        gtscore_truth_free(&t);
+    }
 }
 
 /* A map 1 cm beside a straight wall: every sample is 1 cm off. */
@@ -415,6 +453,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_truth_as_map),
+        cmocka_unit_test(test_ideal_params_line),
         cmocka_unit_test(test_shifted_map),
         cmocka_unit_test(test_missing_wall),
         cmocka_unit_test(test_percentile_and_far),

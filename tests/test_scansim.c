@@ -18,6 +18,8 @@
 #include "scanlog.h"
 #include "scansim.h"
 
+#define TEST_PI 3.14159265358979323846
+
 /* splitmix64 from seed 0: the published first outputs. Pins the integer
  * stream on every platform. */
 static void test_rng_reference(void **state)
@@ -202,6 +204,65 @@ static void test_builtins_sane(void **state)
     assert_int_equal(scansim_scene_builtin(&s, "nowhere", 1), -1);
 }
 
+/* A stadium (two straight sides, two half circles of 2 m radius) seen all
+ * round from its centre by a full-circle scanner: four vertices where the
+ * straights meet the arcs, two arcs: 10 parameters; a circle seen all
+ * round: 3; straight rooms: 2 a corner. */
+static void test_ideal_params(void **state)
+{
+    scansim_scene s;
+    double xy[2u * 2048u];
+    uint8_t smooth[2048u];
+    uint32_t n = 0, m, k, arcs, circles;
+    (void)state;
+    scansim_scene_init(&s, "stadium", 1);
+    s.laser.beam_count = 2880u;
+    s.laser.start_angle_rad = (float)(-TEST_PI);
+    s.laser.angle_step_rad = (float)(TEST_PI / 1440.0);
+    s.laser.dropout = 0.0f;
+    /* east half circle from (2, -2) up to (2, 2), then west from (-2, 2) down */
+    m = scansim_arc_points(&xy[2u * n], 1024u, 2.0, 0.0, 2.0, -TEST_PI / 2.0, TEST_PI / 2.0);
+    for (k = 0; k < m; k++)
+        smooth[n + k] = k > 0 && k + 1u < m;
+    n += m;
+    m = scansim_arc_points(&xy[2u * n], 1024u, -2.0, 0.0, 2.0, TEST_PI / 2.0, 1.5 * TEST_PI);
+    for (k = 0; k < m; k++)
+        smooth[n + k] = k > 0 && k + 1u < m;
+    n += m;
+    assert_true(n > 100u); /* sides of at most 0.1 mm sagitta: about 1.8 cm */
+    assert_int_equal(scansim_add_wall_smooth(&s, xy, n, 1, smooth), 0);
+    assert_int_equal(scansim_add_pose(&s, 0.0, 0.0, 0.0), 0);
+    assert_int_equal(scansim_run(&s), 0);
+    assert_int_equal(scansim_seen_count(&s), s.sample_count);
+    assert_int_equal(scansim_ideal_params(&s, &arcs, &circles), 10);
+    assert_int_equal(arcs, 2);
+    assert_int_equal(circles, 0);
+    scansim_scene_free(&s);
+
+    run_builtin(&s, "circle", 1); /* the paper's three circles, seen all round */
+    assert_int_equal(scansim_ideal_params(&s, &arcs, &circles), 9);
+    assert_int_equal(circles, 3);
+    assert_int_equal(arcs, 0);
+    assert_int_equal(scansim_ideal_vertices(&s), 2160); /* the line-only count keeps its sides */
+    scansim_scene_free(&s);
+
+    run_builtin(&s, "square", 1);
+    assert_int_equal(scansim_ideal_params(&s, &arcs, &circles), 2u * scansim_ideal_vertices(&s));
+    assert_int_equal(arcs + circles, 0);
+    scansim_scene_free(&s);
+
+    /* a pillar hall: pillars seen all round are circles, those seen in
+     * part arcs; without the smooth flags every point is a corner again,
+     * and the parameters are twice the line-only vertices */
+    run_builtin(&s, "pillars", 3);
+    assert_true(scansim_ideal_params(&s, &arcs, &circles) < scansim_ideal_vertices(&s));
+    assert_true(circles >= 1u);
+    memset(s.sample_smooth, 0, s.sample_count);
+    assert_int_equal(scansim_ideal_params(&s, &arcs, &circles), 2u * scansim_ideal_vertices(&s));
+    assert_int_equal(arcs + circles, 0);
+    scansim_scene_free(&s);
+}
+
 /* The ground truth written, read back by gtscore: same walls, seen
  * samples and ideal count. */
 static void test_gt_round_trip(void **state)
@@ -222,6 +283,8 @@ static void test_gt_round_trip(void **state)
     assert_int_equal(t.seen_count, scansim_seen_count(&s));
     assert_true(t.has_ideal);
     assert_int_equal(t.ideal, scansim_ideal_vertices(&s));
+    assert_true(t.has_ideal_params);
+    assert_int_equal(t.ideal_params, scansim_ideal_params(&s, NULL, NULL));
     for (w = 0; w < s.wall_count; w++) {
         assert_int_equal(t.walls[w].point_count, s.walls[w].point_count);
         assert_int_equal(t.walls[w].closed, s.walls[w].closed);
@@ -290,8 +353,8 @@ static void test_path_spacing(void **state)
 }
 
 
-static const char *const kinds[] = {"hall",      "shelves", "flat",   "curved",
-                                    "thinwalls", "drift",   "farhall"};
+static const char *const kinds[] = {"hall",      "shelves", "flat",    "curved",  "thinwalls",
+                                    "drift",     "farhall", "pillars", "arcwalls", "roundmix"};
 #define KIND_COUNT (sizeof kinds / sizeof kinds[0])
 
 /* Is (x, y) inside the closed wall w? (even-odd rule) */
@@ -715,6 +778,7 @@ int main(void)
         cmocka_unit_test(test_person_in_one_scan),
         cmocka_unit_test(test_dropout_and_max_range),
         cmocka_unit_test(test_builtins_sane),
+        cmocka_unit_test(test_ideal_params),
         cmocka_unit_test(test_gt_round_trip),
         cmocka_unit_test(test_log_round_trip),
         cmocka_unit_test(test_path_spacing),

@@ -290,15 +290,15 @@ FIGURES = [
     # README: the simulator's scenes (`make sweep`)
     Fig(R, 'Over {} simulated\nscenes', 'sweep', lambda o: [len(sweep_rows(o))]),
     Fig(R, '{} crossings, {} m of double cover and {} stretches over 20 cm without data',
-        'sweep', lambda o: [max(float(r[c]) for r in sweep_rows(o)) for c in (15, 14, 16)]),
-    Fig(R, '(`band15`) at most {} % of a map', 'sweep', lambda o: [max(float(r[17]) for r in sweep_rows(o))]),
+        'sweep', lambda o: [max(float(r[c]) for r in sweep_rows(o)) for c in (20, 19, 21)]),
+    Fig(R, '(`band15`) at most {} % of a map', 'sweep', lambda o: [max(float(r[22]) for r in sweep_rows(o))]),
     Fig(R, 'vertices are at most {} times the ideal', 'sweep',
         lambda o: [max(float(r[7]) for r in sweep_rows(o))]),
     Fig(R, 'completeness is {} or more on the {} scenes without drift', 'sweep',
-        lambda o: (lambda rs: [min(float(r[12]) for r in rs), len(rs)])(
+        lambda o: (lambda rs: [min(float(r[17]) for r in rs), len(rs)])(
             [r for r in sweep_rows(o) if r[0] not in ('drift', 'farhall')])),
     Fig(R, '{} of the {} meet every target', 'sweep',
-        lambda o: [sum(r[20] == 'ok' for r in sweep_rows(o)), len(sweep_rows(o))]),
+        lambda o: [sum(r[25] == 'ok' for r in sweep_rows(o)), len(sweep_rows(o))]),
     # docs/formats.md: the --online --stats sample (office.log)
     Fig(FMT, 'online         {} scans, --work {}, a square of {} m, block {} bytes', 'office-online',
         g(r'^online\s+(\d+) scans, --work (\d+), a square of ([0-9.]+) m, block (\d+) bytes')),

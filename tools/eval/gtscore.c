@@ -143,6 +143,26 @@ static int read_line(gtscore_truth *truth, char *text, const char *name, uint64_
         truth->has_ideal = 1;
         return 0;
     }
+    if (strcmp(key, "ideal_params") == 0) {
+        uint32_t n[3], k;
+        for (k = 0; k < 3u; k++) {
+            token = next_token(&rest);
+            if (!token || !parse_number(token, &v[0]) || v[0] < 0.0 ||
+                v[0] > (double)UINT32_MAX || v[0] != floor(v[0]))
+                return fail(err, err_size, name, line,
+                            "ideal_params: expected three whole numbers P A C");
+            n[k] = (uint32_t)v[0];
+        }
+        if (next_token(&rest))
+            return fail(err, err_size, name, line, "ideal_params: expected three whole numbers P A C");
+        if (truth->has_ideal_params)
+            return fail(err, err_size, name, line, "ideal_params: given twice");
+        truth->ideal_params = n[0];
+        truth->ideal_arcs = n[1];
+        truth->ideal_circles = n[2];
+        truth->has_ideal_params = 1;
+        return 0;
+    }
     return fail(err, err_size, name, line, "unknown line type '%.40s'", key);
 }
 
@@ -336,6 +356,10 @@ int gtscore_score_map(const gtscore_truth *truth, const polyc_polyline *lines,
     out->polylines = count;
     out->ideal = truth->has_ideal ? truth->ideal : 0u;
     out->vertex_ratio = out->ideal ? (double)out->vertices / (double)out->ideal : 0.0;
+    out->params = 2u * out->vertices;
+    out->arcs = out->circles = 0;
+    out->ideal_params = truth->has_ideal_params ? truth->ideal_params : 0u;
+    out->param_ratio = out->ideal_params ? (double)out->params / (double)out->ideal_params : 0.0;
     if (precision(truth, lines, count, out) != 0)
         return -1;
 

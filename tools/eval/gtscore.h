@@ -10,7 +10,9 @@
  *                 RMS, 95th percentile (nearest rank) and max of the
  *                 distance of those samples to the nearest true wall.
  *   completeness  share of `seen` samples within 5 cm (<=) of the map.
- *   compactness   vertices of the map (sum of point counts) against `ideal`.
+ *   compactness   vertices of the map (sum of point counts) against `ideal`;
+ *                 parameters (2 a vertex, 1 an arc, 3 a circle) against
+ *                 `ideal_params`.
  *   single scan   for one scan and a map: a reflected beam is one whose
  *                 range lies in [min_range_m, max_range_m) and is finite. It
  *                 HITS THE MAP if its ray, cast from the scan pose along the
@@ -112,6 +114,11 @@ typedef struct gtscore_truth {
     uint32_t seen_count, seen_cap;
     uint32_t ideal;
     int has_ideal;
+    /* ideal_params P A C: the perfect map's parameters with arcs and circles
+     * (2 a vertex, 1 an arc, 3 a circle), its arcs and circles; absent in
+     * older files (has_ideal_params 0) */
+    uint32_t ideal_params, ideal_arcs, ideal_circles;
+    int has_ideal_params;
     gtscore_index index;       /* the true walls, built by the reader */
 } gtscore_truth;
 
@@ -137,6 +144,12 @@ typedef struct gtscore_map_score {
     uint32_t polylines;
     uint32_t ideal;            /* from the truth, 0 if absent */
     double vertex_ratio;       /* vertices / ideal (0 if no ideal) */
+    /* the map's parameters: 2 a vertex, 1 an arc, 3 a circle (the
+     * polylines the library gives today are straight segments only: 2 a
+     * vertex, no arc, no circle) */
+    uint32_t params, arcs, circles;
+    uint32_t ideal_params;     /* from the truth, 0 if absent */
+    double param_ratio;        /* params / ideal_params (0 if absent) */
 } gtscore_map_score;
 
 int gtscore_score_map(const gtscore_truth *truth, const polyc_polyline *lines,

@@ -28,7 +28,8 @@ static const char usage_text[] =
     "usage: mapscore [--runs] LOG [MAP.txt]\n"
     "Scores MAP (as `polyc --format txt` writes it; without MAP: the log mapped\n"
     "with the library's defaults) against LOG's scan endpoints, one row:\n"
-    "lines, verts; len = map length (m); dcov (m, and % of len), cross, uns20,\n"
+    "lines, verts, params (2 a vertex, 1 an arc, 3 a circle), arcs, circ(les);\n"
+    "len = map length (m); dcov (m, and % of len), cross, uns20,\n"
     "uns10, loose (tools/eval/gttopo.h); band15 = map length drawn as a band of\n"
     "parallel lines seen from the same side (m, and % of len); end20, end10,\n"
     "end5 = share of endpoints within 20 / 10 / 5 cm of the map\n"
@@ -194,12 +195,15 @@ int main(int argc, char **argv)
         fprintf(stderr, "mapscore: the scorers ran out of memory\n");
         goto done;
     }
-    printf("%-28s %6s %7s %9s %8s %6s %5s %5s %5s %5s %8s %6s %6s %6s %6s %8s %7s\n", "map",
-           "lines", "verts", "len", "dcov", "dcov%", "cross", "uns20", "uns10", "loose",
+    printf("%-28s %6s %7s %7s %5s %5s %9s %8s %6s %5s %5s %5s %5s %8s %6s %6s %6s %6s %8s %7s\n",
+           "map", "lines", "verts", "params", "arcs", "circ", "len", "dcov", "dcov%", "cross", "uns20", "uns10", "loose",
            "band15", "band%", "end20", "end10", "end5", "libms", "scorems");
-    printf("%-28s %6u %7u %9.1f %8.2f %6.2f %5u %5u %5u %5u %8.2f %6.2f %6.4f %6.4f %6.4f %8.1f "
-           "%7.1f\n",
-           from_file ? argv[2] : "(library defaults)", count, verts, topo.map_length_m,
+    /* parameters: 2 a vertex, 1 an arc, 3 a circle; the maps are of straight
+     * segments only */
+    printf("%-28s %6u %7u %7u %5u %5u %9.1f %8.2f %6.2f %5u %5u %5u %5u %8.2f %6.2f %6.4f %6.4f "
+           "%6.4f %8.1f %7.1f\n",
+           from_file ? argv[2] : "(library defaults)", count, verts, 2u * verts, 0u, 0u,
+           topo.map_length_m,
            topo.double_cover_m,
            topo.map_length_m > 0.0 ? 100.0 * topo.double_cover_m / topo.map_length_m : 0.0,
            topo.crossings, topo.unsupported_20, topo.unsupported_10, topo.loose_ends,

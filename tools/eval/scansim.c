@@ -88,6 +88,8 @@ static void free_results(scansim_scene *scene)
     free(scene->sample_xy_m);
     free(scene->sample_seen);
     free(scene->sample_corner);
+    free(scene->sample_smooth);
+    free(scene->wall_box);
     free(scene->wall_first_sample);
     free(scene->wall_sample_count);
     scene->scans = NULL;
@@ -95,6 +97,8 @@ static void free_results(scansim_scene *scene)
     scene->sample_xy_m = NULL;
     scene->sample_seen = NULL;
     scene->sample_corner = NULL;
+    scene->sample_smooth = NULL;
+    scene->wall_box = NULL;
     scene->wall_first_sample = NULL;
     scene->wall_sample_count = NULL;
     scene->scan_count = 0;
@@ -108,35 +112,79 @@ void scansim_scene_free(scansim_scene *scene)
         return;
     free_results(scene);
     free(scene->wall_xy_m);
+    free(scene->wall_smooth);
     free(scene->walls);
     free(scene->poses);
     free(scene->people);
     memset(scene, 0, sizeof *scene);
 }
 
-int scansim_add_wall(scansim_scene *scene, const double *xy_m, uint32_t point_count,
-                     int closed)
+int scansim_add_wall_smooth(scansim_scene *scene, const double *xy_m, uint32_t point_count,
+                            int closed, const uint8_t *smooth)
 {
-    uint32_t i;
+    uint32_t i, cap;
     scansim_wall *w;
     if (!scene || !xy_m || point_count < 2u || (closed && point_count < 3u))
         return -1;
     if (point_count > UINT32_MAX - scene->wall_point_count)
         return -1;
-    if (grow_array((void **)&scene->wall_xy_m, &scene->wall_point_cap,
-                   scene->wall_point_count + point_count, 2u * sizeof(double)) != 0)
+    cap = scene->wall_point_cap;
+    if (grow_array((void **)&scene->wall_xy_m, &cap, scene->wall_point_count + point_count,
+                   2u * sizeof(double)) != 0)
         return -1;
+    /* (the flags grow with the points, to the same capacity) */
+    cap = scene->wall_point_cap;
+    if (grow_array((void **)&scene->wall_smooth, &cap, scene->wall_point_count + point_count,
+                   1u) != 0)
+        return -1;
+    scene->wall_point_cap = cap;
     if (grow_array((void **)&scene->walls, &scene->wall_cap, scene->wall_count + 1u,
                    sizeof(scansim_wall)) != 0)
         return -1;
     for (i = 0; i < 2u * point_count; i++)
         scene->wall_xy_m[2u * scene->wall_point_count + i] = xy_m[i];
+    for (i = 0; i < point_count; i++)
+        scene->wall_smooth[scene->wall_point_count + i] = smooth && smooth[i] ? 1u : 0u;
+    free(scene->wall_box); /* (made again by the next run) */
+    scene->wall_box = NULL;
     w = &scene->walls[scene->wall_count++];
     w->first_point = scene->wall_point_count;
     w->point_count = point_count;
     w->closed = closed ? 1u : 0u;
     scene->wall_point_count += point_count;
     return 0;
+}
+
+int scansim_add_wall(scansim_scene *scene, const double *xy_m, uint32_t point_count,
+                     int closed)
+{
+    return scansim_add_wall_smooth(scene, xy_m, point_count, closed, NULL);
+}
+
+uint32_t scansim_arc_points(double *xy, uint32_t max, double cx, double cy, double r, double a0,
+                            double a1)
+{
+    /* a side of angle d strays r (1 - cos(d / 2)) from the arc */
+    double d = 2.0 * acos(fmax(-1.0, 1.0 - SCANSIM_ARC_SAGITTA_M / r));
+    double n = ceil(fabs(a1 - a0) / d);
+    uint32_t count = (uint32_t)(n < 1.0 ? 1.0 : n) + 1u;
+    if (max < 2u)
+        return 0;
+    if (count > max)
+        count = max;
+    scansim_arc_fill(xy, count, cx, cy, r, a0, a1);
+    return count;
+}
+
+void scansim_arc_fill(double *xy, uint32_t count, double cx, double cy, double r, double a0,
+                      double a1)
+{
+    uint32_t k;
+    for (k = 0; k < count; k++) {
+        double a = a0 + (a1 - a0) * (double)k / (double)(count - 1u);
+        xy[2u * k] = cx + r * cos(a);
+        xy[2u * k + 1u] = cy + r * sin(a);
+    }
 }
 
 int scansim_add_circle(scansim_scene *scene, double cx_m, double cy_m, double radius_m,
@@ -155,7 +203,16 @@ int scansim_add_circle(scansim_scene *scene, double cx_m, double cy_m, double ra
         xy[2u * i] = cx_m + radius_m * cos(a);
         xy[2u * i + 1u] = cy_m + radius_m * sin(a);
     }
-    rc = scansim_add_wall(scene, xy, sides, 1);
+    {
+        uint8_t *smooth = malloc(sides);
+        if (!smooth) {
+            free(xy);
+            return -1;
+        }
+        memset(smooth, 1, sides);
+        rc = scansim_add_wall_smooth(scene, xy, sides, 1, smooth);
+        free(smooth);
+    }
     free(xy);
     return rc;
 }
@@ -234,6 +291,8 @@ void scansim_transform(scansim_scene *scene, double angle_rad, double dx_m, doub
 {
     double c = cos(angle_rad), s = sin(angle_rad);
     uint32_t i;
+    free(scene->wall_box);
+    scene->wall_box = NULL;
     for (i = 0; i < scene->wall_point_count; i++)
         rotate_shift(&scene->wall_xy_m[2u * i], &scene->wall_xy_m[2u * i + 1u], c, s, dx_m,
                      dy_m);
@@ -321,6 +380,58 @@ static int person_at(const scansim_person *p, uint32_t scan, double *x, double *
 
 /* The nearest hit along the ray; *segment gets the segment index (-2 person,
  * -1 nothing) and *along the hit's parameter in [0, 1] on that segment. */
+/* The boxes round the walls (wall_box); 0, or -1 out of memory. */
+static int make_boxes(scansim_scene *scene)
+{
+    uint32_t w, j;
+    free(scene->wall_box);
+    scene->wall_box = malloc(4u * (size_t)(scene->wall_count ? scene->wall_count : 1u) * sizeof(double));
+    if (!scene->wall_box)
+        return -1;
+    for (w = 0; w < scene->wall_count; w++) {
+        const scansim_wall *wall = &scene->walls[w];
+        double *b = &scene->wall_box[4u * w];
+        b[0] = b[1] = HUGE_VAL;
+        b[2] = b[3] = -HUGE_VAL;
+        for (j = 0; j < wall->point_count; j++) {
+            const double *p = &scene->wall_xy_m[2u * (wall->first_point + j)];
+            b[0] = fmin(b[0], p[0]);
+            b[1] = fmin(b[1], p[1]);
+            b[2] = fmax(b[2], p[0]);
+            b[3] = fmax(b[3], p[1]);
+        }
+    }
+    return 0;
+}
+
+/* Can the ray from (ox, oy) along (dx, dy) meet the box b (with a margin
+ * far above rounding)? */
+static int ray_meets_box(const double *b, double ox, double oy, double dx, double dy)
+{
+    const double m = 1e-6;
+    double lo = 0.0, hi = HUGE_VAL, o[2] = {ox, oy}, d[2] = {dx, dy};
+    int k;
+    for (k = 0; k < 2; k++) {
+        double a0 = b[k] - m, a1 = b[k + 2] + m;
+        if (fabs(d[k]) < 1e-15) {
+            if (o[k] < a0 || o[k] > a1)
+                return 0;
+            continue;
+        }
+        double t0 = (a0 - o[k]) / d[k], t1 = (a1 - o[k]) / d[k];
+        if (t0 > t1) {
+            double t = t0;
+            t0 = t1;
+            t1 = t;
+        }
+        lo = fmax(lo, t0);
+        hi = fmin(hi, t1);
+        if (lo > hi)
+            return 0;
+    }
+    return 1;
+}
+
 static double cast_ray(const scansim_scene *scene, double ox, double oy, double angle,
                        uint32_t scan, int32_t *segment, double *along)
 {
@@ -332,6 +443,10 @@ static double cast_ray(const scansim_scene *scene, double ox, double oy, double 
     for (w = 0; w < scene->wall_count; w++) {
         const scansim_wall *wall = &scene->walls[w];
         uint32_t nseg = wall->closed ? wall->point_count : wall->point_count - 1u;
+        if (scene->wall_box && !ray_meets_box(&scene->wall_box[4u * w], ox, oy, dx, dy)) {
+            seg += nseg;
+            continue;
+        }
         for (j = 0; j < nseg; j++, seg++) {
             const double *a = &scene->wall_xy_m[2u * (wall->first_point + j)];
             const double *b =
@@ -430,7 +545,9 @@ static int make_samples(scansim_scene *scene, seg_info *seg)
     scene->sample_xy_m = malloc(2u * (size_t)total * sizeof(double));
     scene->sample_seen = calloc(total ? total : 1u, 1u);
     scene->sample_corner = calloc(total ? total : 1u, 1u);
-    if (!scene->sample_xy_m || !scene->sample_seen || !scene->sample_corner)
+    scene->sample_smooth = calloc(total ? total : 1u, 1u);
+    if (!scene->sample_xy_m || !scene->sample_seen || !scene->sample_corner ||
+        !scene->sample_smooth)
         return -1;
     for (s = 0, w = 0; w < scene->wall_count; w++) {
         const scansim_wall *wall = &scene->walls[w];
@@ -442,6 +559,8 @@ static int make_samples(scansim_scene *scene, seg_info *seg)
                 &scene->wall_xy_m[2u * (wall->first_point + (j + 1u) % wall->point_count)];
             scene->sample_corner[scene->wall_first_sample[w] + seg[s].base] =
                 seg[s].corner ? 1u : 0u;
+            scene->sample_smooth[scene->wall_first_sample[w] + seg[s].base] =
+                scene->wall_smooth[wall->first_point + j];
             for (k = 0; k < seg[s].intervals; k++) {
                 double t = (double)k / (double)seg[s].intervals;
                 *out++ = a[0] + (b[0] - a[0]) * t;
@@ -585,7 +704,7 @@ int scansim_run(scansim_scene *scene)
     scene->scans = calloc(scene->pose_count ? scene->pose_count : 1u, sizeof(polyc_scan));
     scene->range_m = malloc(((size_t)scene->pose_count * n + 1u) * sizeof(float));
     if (!seg || !scene->wall_first_sample || !scene->wall_sample_count || !scene->scans ||
-        !scene->range_m || make_samples(scene, seg) != 0)
+        !scene->range_m || make_samples(scene, seg) != 0 || make_boxes(scene) != 0)
         goto done;
     if (scene->drift_m_per_m > 0.0 || scene->drift_rad_per_m > 0.0) {
         drift = malloc(((size_t)scene->pose_count * 3u + 1u) * sizeof *drift);

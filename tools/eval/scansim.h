@@ -101,6 +101,9 @@ typedef struct scansim_scene {
     double drift_keep;
 
     double *wall_xy_m;         /* interleaved x, y */
+    uint8_t *wall_smooth;      /* per wall point: 1 where the wall runs through it
+                                  on a curve (an arc's or a circle's sample, not
+                                  a corner), as scansim_add_wall_smooth gives */
     uint32_t wall_point_count, wall_point_cap;
     scansim_wall *walls;
     uint32_t wall_count, wall_cap;
@@ -118,7 +121,10 @@ typedef struct scansim_scene {
     double *sample_xy_m;       /* wall samples every <= 2 cm, along each wall */
     uint8_t *sample_seen;      /* 1: some beam observed this sample */
     uint8_t *sample_corner;    /* 1: this sample is a corner of its wall */
+    uint8_t *sample_smooth;    /* 1: this sample is a smooth point of its wall */
     uint32_t *wall_first_sample; /* per wall, index of its first sample */
+    double *wall_box;          /* per wall: x0 y0 x1 y1 round its points (a ray
+                                  that misses it skips the wall's segments) */
     uint32_t *wall_sample_count;
     uint32_t sample_count;
 } scansim_scene;
@@ -130,7 +136,25 @@ void scansim_scene_free(scansim_scene *scene);
 
 int scansim_add_wall(scansim_scene *scene, const double *xy_m, uint32_t point_count,
                      int closed);
-/* A closed regular polygon of `sides` points approximating a circle. */
+/* A wall whose points flagged in smooth[] (point_count of them; NULL: none)
+ * lie on a curve that runs through them: samples of an arc or a circle,
+ * not corners. The truth's parameters count the curve between two corners
+ * as one arc (scansim_ideal_params); the scans see the polygon, so its
+ * sides must be short enough to stand for the curve (scansim_arc_points). */
+int scansim_add_wall_smooth(scansim_scene *scene, const double *xy_m, uint32_t point_count,
+                            int closed, const uint8_t *smooth);
+/* Points on the arc of radius r about (cx, cy) from angle a0 to a1 (either
+ * way round), both ends included, spaced so that a side strays at most
+ * SCANSIM_ARC_SAGITTA_M from the arc; returns the count written to xy (at
+ * most max; fewer points when max is too small). */
+#define SCANSIM_ARC_SAGITTA_M 0.0001
+uint32_t scansim_arc_points(double *xy, uint32_t max, double cx, double cy, double r, double a0,
+                            double a1);
+/* count >= 2 points evenly spaced on that arc, both ends included */
+void scansim_arc_fill(double *xy, uint32_t count, double cx, double cy, double r, double a0,
+                      double a1);
+/* A closed regular polygon of `sides` points approximating a circle (its
+ * points smooth: the truth holds a circle). */
 int scansim_add_circle(scansim_scene *scene, double cx_m, double cy_m, double radius_m,
                        uint32_t sides);
 /* A closed rectangle, axis-aligned in the scene's frame (for thick walls). */
@@ -148,9 +172,10 @@ void scansim_transform(scansim_scene *scene, double angle_rad, double dx_m, doub
 
 /* Built-in scenes: "square", "office", "angled", "circle" (fixed layouts;
  * the seed drives the noise only) and the randomised kinds "hall",
- * "shelves", "flat", "curved", "thinwalls", and with drifting poses
- * "drift", "farhall" (the seed also draws the layout, furniture, people,
- * rotation and shift). -1 if unknown. */
+ * "shelves", "flat", "curved", "thinwalls", with drifting poses "drift",
+ * "farhall", and with round things "pillars", "arcwalls", "roundmix" (the
+ * seed also draws the layout, furniture, people, rotation and shift). -1
+ * if unknown. */
 int scansim_scene_builtin(scansim_scene *scene, const char *name, uint64_t seed);
 /* NULL-terminated list of the built-in names. */
 const char *const *scansim_builtin_names(void);
@@ -165,6 +190,10 @@ int scansim_kind_curved(scansim_scene *scene);
 int scansim_kind_thinwalls(scansim_scene *scene);
 int scansim_kind_drift(scansim_scene *scene);
 int scansim_kind_farhall(scansim_scene *scene);
+/* with round things (tools/eval/scansim_round.c): true arcs and circles */
+int scansim_kind_pillars(scansim_scene *scene);
+int scansim_kind_arcwalls(scansim_scene *scene);
+int scansim_kind_roundmix(scansim_scene *scene);
 
 /* Keeps every step-th pose (0, step, 2 step, ...) and moves the people's
  * scan intervals with them: a smaller scene of the same layout, for tests.
@@ -196,6 +225,16 @@ int scansim_run(scansim_scene *scene);
  * stretch seen over >= 20 cm counts its two ends and its corners; a closed
  * wall seen all round counts its corners. */
 uint32_t scansim_ideal_vertices(const scansim_scene *scene);
+/* Parameters of a perfect map of the seen walls with arcs and circles
+ * (after scansim_run): 2 per vertex (the ends of every stretch seen over
+ * >= 20 cm and the corners inside it), 1 per arc (a piece between two of
+ * those vertices that runs through a smooth point and strays over
+ * SCANSIM_ARC_MIN_SAGITTA_M from its chord: less, and a line fits it as
+ * well as the scores can tell), 3 per circle (a closed wall of smooth
+ * points seen all round). *arcs and *circles (may be NULL) get their
+ * counts. */
+#define SCANSIM_ARC_MIN_SAGITTA_M 0.001
+uint32_t scansim_ideal_params(const scansim_scene *scene, uint32_t *arcs, uint32_t *circles);
 /* Number of seen samples (after scansim_run). */
 uint32_t scansim_seen_count(const scansim_scene *scene);
 

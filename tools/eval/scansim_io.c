@@ -67,6 +67,101 @@ uint32_t scansim_ideal_vertices(const scansim_scene *scene)
     return ideal;
 }
 
+/* ---- parameters with arcs and circles ------------------------------------- */
+
+/* The samples a..b (mod count) of wall w stray over SCANSIM_ARC_MIN_SAGITTA_M
+ * from the chord a-b, and one inside runs through a smooth point. */
+static int piece_is_arc(const scansim_scene *scene, uint32_t w, uint32_t a, uint32_t b)
+{
+    uint32_t count = scene->wall_sample_count[w], k;
+    const double *xy = &scene->sample_xy_m[2u * scene->wall_first_sample[w]];
+    const uint8_t *smooth = &scene->sample_smooth[scene->wall_first_sample[w]];
+    int through = 0;
+    double far = 0.0;
+    for (k = (a + 1u) % count; k != b; k = (k + 1u) % count) {
+        through |= smooth[k];
+        far = fmax(far, scansim_point_segment_m(xy[2u * k], xy[2u * k + 1u], &xy[2u * a],
+                                                &xy[2u * b]));
+    }
+    return through && far > SCANSIM_ARC_MIN_SAGITTA_M;
+}
+
+/* The vertices and arcs of the run of samples first..first+len-1 (mod
+ * count) of wall w, closed_all: the wall seen all round (no ends). */
+static void run_params(const scansim_scene *scene, uint32_t w, uint32_t first, uint32_t len,
+                       int closed_all, uint32_t *vertices, uint32_t *arcs)
+{
+    uint32_t count = scene->wall_sample_count[w], k, prev = UINT32_MAX, first_v = UINT32_MAX;
+    const double *xy = &scene->sample_xy_m[2u * scene->wall_first_sample[w]];
+    const uint8_t *corner = &scene->sample_corner[scene->wall_first_sample[w]];
+    const uint8_t *smooth = &scene->sample_smooth[scene->wall_first_sample[w]];
+    double length = 0.0;
+    *vertices = *arcs = 0;
+    for (k = 1; k < len; k++) {
+        uint32_t a = (first + k - 1u) % count, b = (first + k) % count;
+        length += hypot(xy[2u * b] - xy[2u * a], xy[2u * b + 1u] - xy[2u * a + 1u]);
+    }
+    if (!closed_all && length < SCANSIM_MIN_STRETCH_M)
+        return;
+    for (k = 0; k < len; k++) {
+        uint32_t i = (first + k) % count;
+        int end = !closed_all && (k == 0 || k + 1u == len);
+        if (!end && !(corner[i] && !smooth[i]))
+            continue;
+        (*vertices)++;
+        if (prev != UINT32_MAX)
+            *arcs += (uint32_t)piece_is_arc(scene, w, prev, i);
+        else
+            first_v = i;
+        prev = i;
+    }
+    if (closed_all && prev != UINT32_MAX)
+        *arcs += (uint32_t)piece_is_arc(scene, w, prev, first_v == prev ? (prev + count - 1u) % count
+                                                                         : first_v);
+}
+
+uint32_t scansim_ideal_params(const scansim_scene *scene, uint32_t *arcs_out, uint32_t *circles_out)
+{
+    uint32_t w, params = 0, arcs = 0, circles = 0, v, a;
+    for (w = 0; w < scene->wall_count; w++) {
+        const scansim_wall *wall = &scene->walls[w];
+        uint32_t count = scene->wall_sample_count[w];
+        const uint8_t *seen = &scene->sample_seen[scene->wall_first_sample[w]];
+        uint32_t j, k, start, run = 0, run_first = 0;
+        for (k = 0; k < count && seen[k]; k++)
+            ;
+        if (k == count && wall->closed) {
+            run_params(scene, w, 0, count, 1, &v, &a);
+            if (v == 0) {      /* no corner: a circle */
+                circles++;
+                params += 3u;
+            } else {
+                params += 2u * v + a;
+                arcs += a;
+            }
+            continue;
+        }
+        start = wall->closed && k < count ? k : 0u;
+        for (j = 0; j <= count; j++) {
+            uint32_t idx = (start + j) % count;
+            if (j < count && seen[idx]) {
+                if (run++ == 0)
+                    run_first = idx;
+            } else if (run) {
+                run_params(scene, w, run_first, run, 0, &v, &a);
+                params += 2u * v + a;
+                arcs += a;
+                run = 0;
+            }
+        }
+    }
+    if (arcs_out)
+        *arcs_out = arcs;
+    if (circles_out)
+        *circles_out = circles;
+    return params;
+}
+
 /* ---- output ------------------------------------------------------------- */
 
 int scansim_write_log(const scansim_scene *scene, FILE *out)
@@ -102,6 +197,12 @@ int scansim_write_gt(const scansim_scene *scene, FILE *out)
     fprintf(out, "# ideal N: vertices of a perfect map of the seen walls (every seen stretch\n"
                  "# of at least 20 cm traced: its two ends plus the true corners inside it)\n");
     fprintf(out, "ideal %u\n", scansim_ideal_vertices(scene));
+    {
+        uint32_t arcs, circles, params = scansim_ideal_params(scene, &arcs, &circles);
+        fprintf(out, "# ideal_params P A C: parameters of a perfect map of the seen walls with\n"
+                     "# arcs and circles (2 a vertex, 1 an arc, 3 a circle), its arcs, its circles\n");
+        fprintf(out, "ideal_params %u %u %u\n", params, arcs, circles);
+    }
     fprintf(out, "# wall closed|open x1 y1 x2 y2 ... (metres)\n");
     for (w = 0; w < scene->wall_count; w++) {
         const scansim_wall *wall = &scene->walls[w];

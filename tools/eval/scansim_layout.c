@@ -98,18 +98,24 @@ static int fits(const layout *L, const double *poly, uint32_t n, double gap_m)
 /* Adds the polygon if `check` (the polygon itself, or a copy of it moved
  * off the wall it stands against) fits; 1 added, 0 not, -1 out of memory. */
 static int try_add_checked(layout *L, const double *poly, const double *check, uint32_t n,
-                           double gap_m)
+                           double gap_m, const uint8_t *smooth)
 {
     if (L->first_object == UINT32_MAX)
         L->first_object = L->s->wall_count;
     if (!fits(L, check, n, gap_m))
         return 0;
-    return scansim_add_wall(L->s, poly, n, 1) == 0 ? 1 : -1;
+    return scansim_add_wall_smooth(L->s, poly, n, 1, smooth) == 0 ? 1 : -1;
 }
 
 int layout_try_add(layout *L, const double *poly, uint32_t n, double gap_m)
 {
-    return try_add_checked(L, poly, poly, n, gap_m);
+    return try_add_checked(L, poly, poly, n, gap_m, NULL);
+}
+
+int layout_try_add_smooth(layout *L, const double *poly, uint32_t n, double gap_m,
+                          const uint8_t *smooth)
+{
+    return try_add_checked(L, poly, poly, n, gap_m, smooth);
 }
 
 /* Up to `count` w x h boxes (sizes drawn per box from the ranges) at random
@@ -163,7 +169,7 @@ int layout_against_wall(layout *L, double x0, double y0, double x1, double y1, d
         rect_xy(xy, cx, along, d, w, 0.0);
         rect_xy(check, side == 3u ? cx + off : cx - off, along, d, w, 0.0);
     }
-    return try_add_checked(L, xy, check, 4u, FLUSH_CHECK_M);
+    return try_add_checked(L, xy, check, 4u, FLUSH_CHECK_M, NULL);
 }
 
 /* The smallest distance from the segment ab to any wall. */

@@ -58,20 +58,19 @@ static inline uint32_t arc_xy(double *xy, uint32_t max, double cx, double cy, do
                               double a0, double a1)
 {
     double n = ceil(fabs(a1 - a0) * r / ARC_STEP_M);
-    uint32_t k, count = (uint32_t)(n < 1.0 ? 1.0 : n) + 1u;
+    uint32_t count = (uint32_t)(n < 1.0 ? 1.0 : n) + 1u;
     if (count > max)
         count = max;
-    for (k = 0; k < count; k++) {
-        double a = a0 + (a1 - a0) * (double)k / (double)(count - 1u);
-        xy[2u * k] = cx + r * cos(a);
-        xy[2u * k + 1u] = cy + r * sin(a);
-    }
+    scansim_arc_fill(xy, count, cx, cy, r, a0, a1);
     return count;
 }
 
 void layout_init(layout *L, scansim_scene *s, uint64_t kind_salt);
 void layout_way(layout *L, double x, double y);
 int layout_try_add(layout *L, const double *poly, uint32_t n, double gap_m);
+/* layout_try_add with the points flagged smooth[] (scansim_add_wall_smooth) */
+int layout_try_add_smooth(layout *L, const double *poly, uint32_t n, double gap_m,
+                          const uint8_t *smooth);
 
 /* Up to `count` w x h boxes (sizes drawn per box from the ranges) at random
  * places in [x0, x1] x [y0, y1]; angle_rad < 0: any angle. -1 out of memory. */

@@ -156,11 +156,15 @@ static const builtin builtins[] = {
     {"thinwalls", scansim_kind_thinwalls},
     {"drift", scansim_kind_drift},
     {"farhall", scansim_kind_farhall},
+    {"pillars", scansim_kind_pillars},
+    {"arcwalls", scansim_kind_arcwalls},
+    {"roundmix", scansim_kind_roundmix},
 };
 
 static const char *const builtin_names[] = {"square", "office",  "angled", "circle",
                                             "hall",   "shelves", "flat",   "curved",
-                                            "thinwalls", "drift", "farhall", NULL};
+                                            "thinwalls", "drift", "farhall", "pillars",
+                                            "arcwalls", "roundmix", NULL};
 
 const char *const *scansim_builtin_names(void)
 {

@@ -42,6 +42,9 @@
 #define TARGET_FIT_MARGIN_M 0.0015
 #define TARGET_COMPLETENESS 0.98
 #define TARGET_RATIO 1.5
+/* and, in a scene with round things (arcs or circles in its truth), at most
+ * 1.25 times the ideal parameters (2 a vertex, 1 an arc, 3 a circle) */
+#define TARGET_PARAM_RATIO 1.25
 /* and the topology's: double cover at most 25 cm, no crossing, no run of
  * map over 20 cm without a scan endpoint within 5 cm */
 #define TARGET_DCOV_M 0.25
@@ -68,7 +71,8 @@ static const char usage_text[] =
     "  --seeds A-B      seeds A to B (or one seed A); default 1-6\n"
     "  --kinds a,b,...  scene kinds; default hall,shelves,flat,curved,thinwalls,\n"
     "                   office,angled,square,drift,farhall (any of scansim's\n"
-    "                   built-in names; drift and farhall: poses that drift)\n"
+    "                   built-in names; drift and farhall: poses that drift;\n"
+    "                   pillars, arcwalls and roundmix: true arcs and circles)\n"
     "  --save DIR       write DIR/KIND-sSEED.log and .gt.txt (for build/polyc)\n"
     "  --svg DIR        write DIR/KIND-sSEED.svg: true walls (grey), the robot's\n"
     "                   path (blue), people (pink), the map (black, dots on vertices;\n"
@@ -114,7 +118,10 @@ static const char usage_text[] =
 /* (in two: a C99 compiler need not take a string over 4095 characters) */
 static const char usage_columns[] =
     "Columns: scans, beams (all scans), ms (the pipeline from polyc_init to the\n"
-    "optimised map), verts (map vertices), ideal, ratio (verts / ideal), rms\n"
+    "optimised map), verts (map vertices), ideal, ratio (verts / ideal), params\n"
+    "(the map's parameters: 2 a vertex, 1 an arc, 3 a circle), iparam (the ideal\n"
+    "map's with arcs and circles, scansim_ideal_params), p/i (params / iparam),\n"
+    "arcs and circ (the map's arcs and circles), rms\n"
     "(precision RMS, mm), core (precision over the map samples within 0.5 m of a\n"
     "true wall, mm), fit (the ideal map's fit to the data, mm), floor (the\n"
     "line-fit floor, mm), compl (completeness), gcompl (--occupancy: the grid's\n"
@@ -125,7 +132,8 @@ static const char usage_columns[] =
     "tools/eval/gtband.h), end20, end10 (share of scan endpoints within 20 / 10 cm\n"
     "of the map; band%, end20 and end10 need the scans: '-' with --occupancy),\n"
     "then the targets missed: P core precision > max(1.25 x\n"
-    "fit, fit + 1.5 mm), C completeness < 0.98, V vertices > 1.5 x ideal, T\n"
+    "fit, fit + 1.5 mm), C completeness < 0.98, V vertices > 1.5 x ideal, A\n"
+    "(scenes with arcs or circles in their truth) params > 1.25 x iparam, T\n"
     "double cover > 0.25 m, a crossing or a run over 20 cm, B band15 > 1 % of\n"
     "the map's length ('ok': none).\n"
     "Summary rows give per kind and over all the median and the worst (highest;\n"
@@ -155,7 +163,8 @@ typedef struct options {
 /* One entry per column: to add a figure, add it here, to `figures` and to
  * score_scene. The figures from FIG_BCORE on are --online's, set by
  * sweep_scene from the batch map's row and printed only with --online. */
-enum figure { FIG_SCANS, FIG_BEAMS, FIG_MS, FIG_VERTS, FIG_IDEAL, FIG_RATIO, FIG_RMS,
+enum figure { FIG_SCANS, FIG_BEAMS, FIG_MS, FIG_VERTS, FIG_IDEAL, FIG_RATIO, FIG_PARAMS,
+              FIG_IPARAMS, FIG_PRATIO, FIG_ARCS, FIG_CIRCLES, FIG_RMS,
               FIG_CORE, FIG_FIT, FIG_FLOOR, FIG_COMPL, FIG_GCOMPL, FIG_DCOV, FIG_CROSS,
               FIG_UNS20, FIG_BAND, FIG_END20, FIG_END10,
               FIG_BCORE, FIG_CORE_RATIO, FIG_BVERTS, FIG_VERTS_RATIO, FIG_BMS, FIG_MS_RATIO,
@@ -171,6 +180,8 @@ typedef struct figure_info {
 static const figure_info figures[FIG_COUNT] = {
     {"scans", 6, 0, 1.0, 0},   {"beams", 8, 0, 1.0, 0},   {"ms", 7, 1, 1.0, 0},
     {"verts", 6, 0, 1.0, 0},   {"ideal", 6, 0, 1.0, 0},   {"ratio", 6, 2, 1.0, 0},
+    {"params", 6, 0, 1.0, 0},  {"iparam", 6, 0, 1.0, 0},  {"p/i", 5, 2, 1.0, 0},
+    {"arcs", 4, 0, 1.0, 0},    {"circ", 4, 0, 1.0, 0},
     {"rms", 6, 1, 1e3, 0},     {"core", 6, 1, 1e3, 0},    {"fit", 6, 1, 1e3, 0},
     {"floor", 6, 1, 1e3, 0},   {"compl", 7, 4, 1.0, 1},   {"gcompl", 7, 4, 1.0, 1},
     {"dcov", 6, 2, 1.0, 0},
@@ -189,7 +200,7 @@ static uint32_t shown_figures(const options *o)
 
 /* Bits of the targets a scene misses. */
 enum { MISS_PRECISION = 1, MISS_COMPLETENESS = 2, MISS_VERTICES = 4, MISS_TOPOLOGY = 8,
-       MISS_BAND = 16 };
+       MISS_BAND = 16, MISS_PARAMS = 32 };
 
 typedef struct row {
     char kind[32];
@@ -301,6 +312,11 @@ static int score_scene(const scansim_scene *sc, const gtscore_truth *truth,
     r->fig[FIG_VERTS] = score.vertices;
     r->fig[FIG_IDEAL] = score.ideal;
     r->fig[FIG_RATIO] = score.ideal ? score.vertex_ratio : (double)NAN;
+    r->fig[FIG_PARAMS] = score.params;
+    r->fig[FIG_IPARAMS] = score.ideal_params ? (double)score.ideal_params : (double)NAN;
+    r->fig[FIG_PRATIO] = score.ideal_params ? score.param_ratio : (double)NAN;
+    r->fig[FIG_ARCS] = score.arcs;
+    r->fig[FIG_CIRCLES] = score.circles;
     r->fig[FIG_RMS] = score.precision_rms_m;
     r->fig[FIG_FIT] = fit_m >= 0.0 ? fit_m : (double)NAN;
     r->fig[FIG_FLOOR] = floor_m >= 0.0 ? floor_m : (double)NAN;
@@ -333,6 +349,9 @@ static int score_scene(const scansim_scene *sc, const gtscore_truth *truth,
         r->missed |= MISS_VERTICES;
     if (r->fig[FIG_BAND] > TARGET_BAND)
         r->missed |= MISS_BAND;
+    if ((truth->ideal_arcs || truth->ideal_circles) && score.ideal_params &&
+        (double)score.params > TARGET_PARAM_RATIO * (double)score.ideal_params)
+        r->missed |= MISS_PARAMS;
     return 0;
 }
 
@@ -442,9 +461,10 @@ static void print_missed(unsigned missed)
         printf("  ok\n");
         return;
     }
-    printf("  %s%s%s%s%s\n", missed & MISS_PRECISION ? "P" : "",
+    printf("  %s%s%s%s%s%s\n", missed & MISS_PRECISION ? "P" : "",
            missed & MISS_COMPLETENESS ? "C" : "", missed & MISS_VERTICES ? "V" : "",
-           missed & MISS_TOPOLOGY ? "T" : "", missed & MISS_BAND ? "B" : "");
+           missed & MISS_PARAMS ? "A" : "", missed & MISS_TOPOLOGY ? "T" : "",
+           missed & MISS_BAND ? "B" : "");
 }
 
 /* a / b; 1 when both are 0, NAN when only b is */
