@@ -62,6 +62,8 @@ typedef enum polyc_status {
 #define POLYC_FLAG_GRID_TRACE    0x4u /* trace the grid's contour even for a
                                          single scan (by default one scan's
                                          initial polylines follow its beam order) */
+#define POLYC_FLAG_NO_ARCS       0x8u /* no circles: every polyline stays
+                                         polylines only (polyc_get_circle) */
 
 typedef struct polyc_config {
     /* Grid (paper section III) */
@@ -158,6 +160,15 @@ typedef struct polyc_polyline {
     uint32_t point_count;
     uint32_t closed;           /* 1: the last point connects to the first */
 } polyc_polyline;
+
+/* A polyline of the result that the BIC prefers as a circle
+ * (polyc_get_circle): its centre and radius, and how far the polyline
+ * itself (what polyc_get_polyline gives) strays from the circle at most. */
+typedef struct polyc_circle {
+    float center_x_m, center_y_m;
+    float radius_m;            /* 0: the polyline is no circle */
+    float polyline_dev_m;
+} polyc_circle;
 
 typedef struct polyc_stats {
     uint64_t beams;            /* beams added */
@@ -300,6 +311,22 @@ POLYC_API polyc_status polyc_get_polyline(const polyc_ctx *ctx, uint32_t index,
 POLYC_API polyc_status polyc_copy_polyline(const polyc_ctx *ctx, uint32_t index, float *xy_m,
                                            uint32_t capacity, uint32_t *count,
                                            uint32_t *closed);
+/* Round things: which polylines of the current map are circles. A
+ * polyline that goes round (closed, or its ends nearer than split_gap_m)
+ * becomes a circle where its own points, held all round with no stretch
+ * over split_gap_m without one, fit a circle at a lower BIC than the
+ * polyline's (3 numbers against 2 a vertex; docs/algorithm.md, "Circles").
+ * Call after polyc_build or polyc_optimize (an online context: after any
+ * update or the finish); a call that changes the map forgets them. None
+ * with POLYC_FLAG_NO_ARCS. POLYC_ERR_STATE before polyc_trace;
+ * POLYC_ERR_NOMEM if the block cannot hold the optimiser again. */
+POLYC_API polyc_status polyc_find_circles(polyc_ctx *ctx);
+/* Whether polyline `index` is a circle (polyc_find_circles): out->radius_m
+ * > 0 and its centre, or radius_m 0. polyc_get_polyline still gives the
+ * polyline, which strays at most out->polyline_dev_m from the circle.
+ * polyc_circle_count: how many of the polylines are circles. */
+POLYC_API polyc_status polyc_get_circle(const polyc_ctx *ctx, uint32_t index, polyc_circle *out);
+POLYC_API uint32_t polyc_circle_count(const polyc_ctx *ctx);
 POLYC_API polyc_status polyc_get_stats(const polyc_ctx *ctx, polyc_stats *out);
 /* Current BIC of the map and its parts, recomputed from scratch. */
 POLYC_API polyc_status polyc_score(polyc_ctx *ctx, double *bic, double *error_sq_m2);

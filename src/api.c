@@ -35,7 +35,7 @@ size_t polyc_memory_size(const polyc_config *config, const polyc_limits *limits)
     a.used = grid_mark;
     polyc__contour_reserve(&a, limits);
     polyc__trace_reserve(&a, limits);
-    polyc__flat_reserve(&a, polyc__max_vertices(limits)); /* the result */
+    polyc__flat_reserve(&a, polyc__max_vertices(limits), 1); /* the result */
     polyc__prior_reserve(&a, limits);
     polyc__optimizer_reserve(&a, config, limits);
     size_t head = polyc__bytes(1, sizeof(polyc_ctx)) + 16; /* + alignment of the block */
@@ -177,7 +177,7 @@ static polyc_status stage_trace(polyc_ctx *ctx)
     if (st != POLYC_OK)
         return st;
     int32_t vcap = ctx->store.v_cap;
-    if (!polyc__flat_init(&ctx->arena, &ctx->flat, (uint32_t)polyc__line_cap(vcap), (uint32_t)vcap))
+    if (!polyc__flat_result(&ctx->arena, &ctx->flat, (uint32_t)polyc__line_cap(vcap), (uint32_t)vcap))
         return polyc__fail(ctx, POLYC_ERR_NOMEM, "no room for the result polylines");
     polyc__export_result(ctx);
     ctx->stats.initial_polylines = ctx->stats.polylines;
@@ -283,6 +283,24 @@ polyc_status polyc_build(polyc_ctx *ctx, polyc_progress_fn progress, void *user)
     if (st != POLYC_OK || ctx->cfg.max_iterations == 0)
         return st;
     return polyc_optimize(ctx, progress, user);
+}
+
+polyc_status polyc_find_circles(polyc_ctx *ctx)
+{
+    polyc_status cst = polyc__enter(ctx, 1);
+    if (cst != POLYC_OK)
+        return cst;
+    if (ctx->stage < POLYC__STAGE_TRACE && !ctx->online)
+        return polyc__fail(ctx, POLYC_ERR_STATE, "no polylines yet: run polyc_trace first");
+    if (ctx->layer && ctx->layer->live_opt) { /* its optimiser holds the map */
+        polyc__circles_select(ctx->layer->live_opt(ctx));
+        return POLYC_OK;
+    }
+    ctx->arena.used = ctx->trace_mark;
+    polyc_status st = polyc__find_circles(ctx);
+    note_memory(ctx);
+    ctx->arena.used = ctx->trace_mark;
+    return st;
 }
 
 polyc_status polyc_score(polyc_ctx *ctx, double *bic, double *err)

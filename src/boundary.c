@@ -203,19 +203,24 @@ void polyc__frame_box(const polyc_ctx *ctx, float box[4])
     box[3] = polyc__d_to_f(ctx->ext.max_y);
 }
 
+void polyc__frame_point_out(const polyc_ctx *ctx, float x, float y, float *out_x, float *out_y)
+{
+    if (ctx->from_grid) {
+        /* turned in float (offsets from the grid's corner), placed in double */
+        float c = ctx->frame_dir.cos, s = ctx->frame_dir.sin;
+        *out_x = polyc__d_to_f(polyc__d_add(ctx->frame_x, polyc__f_to_d(c * x - s * y)));
+        *out_y = polyc__d_to_f(polyc__d_add(ctx->frame_y, polyc__f_to_d(s * x + c * y)));
+    } else {
+        *out_x = polyc__d_to_f(polyc__d_add(polyc__f_to_d(x), ctx->frame_x));
+        *out_y = polyc__d_to_f(polyc__d_add(polyc__f_to_d(y), ctx->frame_y));
+    }
+}
+
 void polyc__frame_export(polyc_ctx *ctx)
 {
-    for (uint32_t i = 0; ctx->from_grid && i < ctx->flat.points; i++) {
-        /* turned in float (offsets from the grid's corner), placed in double */
-        float x = ctx->flat.xy[2 * i], y = ctx->flat.xy[2 * i + 1];
-        float c = ctx->frame_dir.cos, s = ctx->frame_dir.sin;
-        ctx->flat.xy[2 * i] = polyc__d_to_f(polyc__d_add(ctx->frame_x, polyc__f_to_d(c * x - s * y)));
-        ctx->flat.xy[2 * i + 1] = polyc__d_to_f(polyc__d_add(ctx->frame_y, polyc__f_to_d(s * x + c * y)));
-    }
-    for (uint32_t i = 0; !ctx->from_grid && i < ctx->flat.points; i++) {
-        ctx->flat.xy[2 * i] = polyc__d_to_f(polyc__d_add(polyc__f_to_d(ctx->flat.xy[2 * i]), ctx->frame_x));
-        ctx->flat.xy[2 * i + 1] = polyc__d_to_f(polyc__d_add(polyc__f_to_d(ctx->flat.xy[2 * i + 1]), ctx->frame_y));
-    }
+    for (uint32_t i = 0; i < ctx->flat.points; i++)
+        polyc__frame_point_out(ctx, ctx->flat.xy[2 * i], ctx->flat.xy[2 * i + 1], &ctx->flat.xy[2 * i],
+                               &ctx->flat.xy[2 * i + 1]);
 }
 
 void polyc__frame_of_grid(polyc_ctx *ctx, const polyc_occupancy_grid *grid)

@@ -41,7 +41,7 @@ size_t polyc_struct_size(const char *name)
         {"polyc_occupancy_grid", sizeof(polyc_occupancy_grid)},
         {"polyc_online_limits", sizeof(polyc_online_limits)},
         {"polyc_online_report", sizeof(polyc_online_report)},
-        {"polyc_change", sizeof(polyc_change)},
+        {"polyc_change", sizeof(polyc_change)},   {"polyc_circle", sizeof(polyc_circle)},
     };
     if (!name)
         return 0;
@@ -112,7 +112,8 @@ polyc_status polyc_config_check(const polyc_config *c, const char **why)
     else if (!in(c->free_thresh, 0.0f, 1.0f) || !(c->free_thresh < c->occupied_thresh))
         w = "free_thresh must be in [0, occupied_thresh)";
     else if (c->reserved != 0) w = "reserved must be 0";
-    else if (c->flags & ~(POLYC_FLAG_EXACT_POINTS | POLYC_FLAG_NO_GRAZING | POLYC_FLAG_GRID_TRACE))
+    else if (c->flags & ~(POLYC_FLAG_EXACT_POINTS | POLYC_FLAG_NO_GRAZING | POLYC_FLAG_GRID_TRACE |
+                          POLYC_FLAG_NO_ARCS))
         w = "unknown flags";
     if (why)
         *why = w;

@@ -161,6 +161,13 @@ typedef struct polyc__store {
 } polyc__store;
 
 /* ---- flattened map, the form results are read in ---- */
+/* A closed polyline the BIC prefers as a circle (circles.c): its store
+ * id, the circle (frame metres) and how far the polyline strays from it. */
+typedef struct polyc__circle {
+    uint32_t line_id;
+    float cx, cy, r, dev;
+} polyc__circle;
+
 typedef struct polyc__flat {
     float *xy;                     /* 2 floats per point */
     uint32_t *start;               /* point offset of each polyline, count + 1 entries */
@@ -168,6 +175,10 @@ typedef struct polyc__flat {
     uint32_t *id;                  /* per polyline: its store id */
     uint32_t count, points;
     uint32_t cap_lines, cap_points;
+    /* the result's circles (the search's last step; not copied with the
+     * polylines: set on the context's result only) */
+    polyc__circle *circ;
+    uint32_t circ_n, circ_cap;
 } polyc__flat;
 
 /* ---- data points (points.c): one weighted point per cell, or raw points ----
@@ -370,6 +381,9 @@ typedef struct polyc__layer {
     int (*rec_walk)(struct polyc__records *r, size_t d, struct polyc__walk *w, int64_t miss_key,
                     int take_back);
     void (*rec_take)(struct polyc__records *r, struct polyc__tile *t, size_t d);
+    /* api.c: the optimiser that holds the layer's map, its points assigned
+     * (polyc_find_circles) */
+    struct polyc__opt *(*live_opt)(polyc_ctx *ctx);
 } polyc__layer;
 
 /* the stages' calls on these types */

@@ -60,4 +60,5 @@ polyc_status polyc__opt_refresh(polyc__opt *o, const polyc__prior *prior);
 /* optimize.c: the search on a set-up optimiser (the batch loop) */
 polyc_status polyc__search(polyc__opt *o, polyc_progress_fn progress, void *user);
 
+
 #endif

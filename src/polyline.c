@@ -207,30 +207,54 @@ void polyc__line_reverse(polyc__store *s, int32_t l)
 
 /* ---- flattened form ---- */
 
-static int flat_carve(polyc__arena *a, polyc__flat *f, uint32_t cap_lines, uint32_t cap_points)
+/* circles: one for every fourth polyline (a map of pillars alone has a
+ * polyline round each, and more circles than that stay polylines) */
+static uint32_t circle_cap(uint32_t cap_lines)
+{
+    return cap_lines / 4 + 4;
+}
+
+/* (circles: the context's result only, polyc__flat_result) */
+static int flat_carve(polyc__arena *a, polyc__flat *f, uint32_t cap_lines, uint32_t cap_points,
+                      int circles)
 {
     memset(f, 0, sizeof *f);
     f->xy = polyc__alloc(a, (size_t)cap_points * 2, sizeof(float));
     f->start = polyc__alloc(a, (size_t)cap_lines + 1, sizeof(uint32_t));
     f->closed = polyc__alloc(a, cap_lines, 1);
     f->id = polyc__alloc(a, cap_lines, sizeof(uint32_t));
-    return f->xy && f->start && f->closed && f->id;
+    if (circles) {
+        f->circ = polyc__alloc(a, circle_cap(cap_lines), sizeof(polyc__circle));
+        f->circ_cap = circle_cap(cap_lines);
+    }
+    return f->xy && f->start && f->closed && f->id && (!circles || f->circ);
 }
 
-void polyc__flat_reserve(polyc__arena *a, int32_t v_cap)
+void polyc__flat_reserve(polyc__arena *a, int32_t v_cap, int result)
 {
     polyc__flat f;
-    flat_carve(a, &f, (uint32_t)polyc__line_cap(v_cap), (uint32_t)v_cap);
+    flat_carve(a, &f, (uint32_t)polyc__line_cap(v_cap), (uint32_t)v_cap, result);
 }
 
-int polyc__flat_init(polyc__arena *a, polyc__flat *f, uint32_t cap_lines, uint32_t cap_points)
+static int flat_start(polyc__arena *a, polyc__flat *f, uint32_t cap_lines, uint32_t cap_points,
+                      int circles)
 {
-    if (!flat_carve(a, f, cap_lines, cap_points))
+    if (!flat_carve(a, f, cap_lines, cap_points, circles))
         return 0;
     f->cap_lines = cap_lines;
     f->cap_points = cap_points;
     f->start[0] = 0;
     return 1;
+}
+
+int polyc__flat_result(polyc__arena *a, polyc__flat *f, uint32_t cap_lines, uint32_t cap_points)
+{
+    return flat_start(a, f, cap_lines, cap_points, 1);
+}
+
+int polyc__flat_init(polyc__arena *a, polyc__flat *f, uint32_t cap_lines, uint32_t cap_points)
+{
+    return flat_start(a, f, cap_lines, cap_points, 0);
 }
 
 void polyc__flat_from_store(polyc__flat *f, const polyc__store *s)

@@ -48,6 +48,39 @@ polyc_status polyc_copy_polyline(const polyc_ctx *ctx, uint32_t index, float *xy
     return POLYC_OK;
 }
 
+/* The circle that stands for the result's polyline `index`, or NULL. */
+static const polyc__circle *circle_of(const polyc_ctx *ctx, uint32_t index)
+{
+    for (uint32_t k = 0; k < ctx->flat.circ_n; k++)
+        if (ctx->flat.circ[k].line_id == ctx->flat.id[index])
+            return &ctx->flat.circ[k];
+    return NULL;
+}
+
+polyc_status polyc_get_circle(const polyc_ctx *ctx, uint32_t index, polyc_circle *out)
+{
+    polyc_polyline pl;
+    polyc_status st = out ? polyc_get_polyline(ctx, index, &pl) : polyc__check_ctx(ctx);
+    if (st != POLYC_OK || !out)
+        return st != POLYC_OK ? st : POLYC_ERR_NULL;
+    const polyc__circle *c = circle_of(ctx, index);
+    memset(out, 0, sizeof *out);
+    if (c) {
+        polyc__frame_point_out(ctx, c->cx, c->cy, &out->center_x_m, &out->center_y_m);
+        out->radius_m = c->r;
+        out->polyline_dev_m = c->dev;
+    }
+    return POLYC_OK;
+}
+
+uint32_t polyc_circle_count(const polyc_ctx *ctx)
+{
+    uint32_t n = polyc_polyline_count(ctx), k = 0;
+    for (uint32_t i = 0; i < n; i++)
+        k += circle_of(ctx, i) != NULL;
+    return k;
+}
+
 polyc_status polyc_get_stats(const polyc_ctx *ctx, polyc_stats *out)
 {
     polyc_status cst = polyc__check_ctx(ctx);

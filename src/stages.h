@@ -26,6 +26,8 @@ void polyc__frame_grid_origin(const polyc_ctx *ctx, polyc__grid *g, float x0_m, 
 int polyc__frame_inside(const polyc_ctx *ctx, const polyc_scan *s, float half_m);
 void polyc__frame_box(const polyc_ctx *ctx, float box[4]); /* the data's extent, frame metres */
 void polyc__frame_export(polyc_ctx *ctx);
+/* a frame point (x, y) in the caller's frame, as the result's points are */
+void polyc__frame_point_out(const polyc_ctx *ctx, float x, float y, float *out_x, float *out_y);
 void polyc__frame_of_grid(polyc_ctx *ctx, const polyc_occupancy_grid *grid);
 int polyc__grid_origin_ok(const polyc_occupancy_grid *grid);
 void polyc__figures_out(float bic, float err, double *bic_out, double *err_out);
@@ -205,9 +207,11 @@ void polyc__line_reverse(polyc__store *s, int32_t line);
 int32_t polyc__line_cut(polyc__store *s, int32_t u, int *ok);
 void polyc__line_join(polyc__store *s, int32_t tail, int32_t head);
 /* a flat form of v_cap vertices' allocations, on a counting arena */
-void polyc__flat_reserve(polyc__arena *a, int32_t v_cap);
+void polyc__flat_reserve(polyc__arena *a, int32_t v_cap, int result); /* result: a context's */
 /* 0: no room */
 int polyc__flat_init(polyc__arena *a, polyc__flat *f, uint32_t cap_lines, uint32_t cap_points);
+/* the same for a context's result, with room for its circles */
+int polyc__flat_result(polyc__arena *a, polyc__flat *f, uint32_t cap_lines, uint32_t cap_points);
 void polyc__flat_from_store(polyc__flat *f, const polyc__store *s);
 polyc_status polyc__store_from_flat(polyc__store *s, const polyc__flat *f);
 
@@ -227,5 +231,12 @@ polyc_status polyc__chains_build(polyc_ctx *ctx);
 void polyc__optimizer_reserve(polyc__arena *a, const polyc_config *cfg, const polyc_limits *lim);
 polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *user);
 polyc_status polyc__score(polyc_ctx *ctx, double *bic, double *err);
+/* the circles of the current map (circles.c) on an optimiser set up for it */
+polyc_status polyc__find_circles(polyc_ctx *ctx);
+/* circles.c: the polylines of o's map that go round and that a circle fits
+ * at a lower BIC, into the result's circle list (none with
+ * POLYC_FLAG_NO_ARCS) */
+struct polyc__opt;
+void polyc__circles_select(struct polyc__opt *o);
 
 #endif

@@ -3,9 +3,11 @@
  * thin walls, offices, flats), mapped in batch and online, written as TXT
  * and JSON by the tool's writers (tools/mapout.c, four decimals), read back,
  * and every pair of segments that share no vertex tested exactly on the
- * printed values: no proper crossing, and no vertex on the other segment.
- * (Ends at T-junctions stop 1 mm short of the segment they meet, corners
- * clear it by as much: topology.c, polyc__op_end_gaps.) */
+ * printed values: no proper crossing, and no vertex on the other segment;
+ * the circles (polyc_find_circles, written as circles) meet no segment and
+ * no other circle. (Ends at T-junctions stop 1 mm short of the segment they
+ * meet, corners clear it by as much: topology.c, polyc__op_end_gaps; a
+ * circle keeps 1 cm off every other segment: circles.c.) */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -26,11 +28,20 @@
 static const struct {
     const char *kind;
     uint32_t seeds;
-} SCENES[] = {{"flat", 6}, {"office", 3}, {"thinwalls", 3}, {"shelves", 2}, {"hall", 2}};
+} SCENES[] = {{"flat", 6},  {"office", 3},  {"thinwalls", 3}, {"shelves", 2},
+              {"hall", 2},  {"pillars", 2}, {"roundmix", 2}};
 
 typedef struct seg {
     double ax, ay, bx, by;
 } seg;
+
+typedef struct ring {
+    double cx, cy, r;
+} ring;
+
+#define MAX_RINGS 256
+static ring rings[MAX_RINGS];
+static uint32_t ring_n;
 
 /* The segments of a written map read back from the numbers as printed:
  * TXT lines `open|closed N x y ...`, or JSON arrays `[x, y]` within each
@@ -39,12 +50,24 @@ static uint32_t read_back(FILE *f, int json, seg *out, uint32_t cap)
 {
     rewind(f);
     uint32_t n = 0;
+    ring_n = 0;
     char line[1 << 16];
     double xy[2 * 4096];
     while (fgets(line, sizeof line, f)) {
         uint32_t k = 0;
         int closed = 0;
         const char *p = line;
+        ring g;
+        if (!json && sscanf(line, "circle %lf %lf %lf", &g.cx, &g.cy, &g.r) == 3) {
+            assert_true(ring_n < MAX_RINGS);
+            rings[ring_n++] = g;
+            continue;
+        }
+        if (json && sscanf(line, "{\"center\": [%lf, %lf], \"radius\": %lf}", &g.cx, &g.cy, &g.r) == 3) {
+            assert_true(ring_n < MAX_RINGS);
+            rings[ring_n++] = g;
+            continue;
+        }
         if (!json) {
             if (strncmp(line, "open ", 5) != 0 && strncmp(line, "closed ", 7) != 0)
                 continue;
@@ -129,8 +152,39 @@ static uint32_t strict_faults(const seg *s, uint32_t n, const char *what)
     return bad;
 }
 
+/* Circles read back that meet a segment (the ring's distance to it, the
+ * segment's nearest and farthest points round the centre, brackets the
+ * radius) or another circle. */
+static uint32_t ring_faults(const seg *s, uint32_t n, const char *what)
+{
+    uint32_t bad = 0;
+    for (uint32_t k = 0; k < ring_n; k++) {
+        const ring *g = &rings[k];
+        for (uint32_t i = 0; i < n; i++) {
+            const seg *a = &s[i];
+            double ex = a->bx - a->ax, ey = a->by - a->ay, l2 = ex * ex + ey * ey;
+            double t = l2 > 0.0 ? ((g->cx - a->ax) * ex + (g->cy - a->ay) * ey) / l2 : 0.0;
+            t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
+            double near = hypot(a->ax + t * ex - g->cx, a->ay + t * ey - g->cy);
+            double far = fmax(hypot(a->ax - g->cx, a->ay - g->cy), hypot(a->bx - g->cx, a->by - g->cy));
+            if (near <= g->r && far >= g->r && bad++ < 3)
+                print_error("%s: circle (%.4f, %.4f) r %.4f meets [%.4f, %.4f]-[%.4f, %.4f]\n", what,
+                            g->cx, g->cy, g->r, a->ax, a->ay, a->bx, a->by);
+        }
+        for (uint32_t j = k + 1; j < ring_n; j++) {
+            const ring *h = &rings[j];
+            double d = hypot(g->cx - h->cx, g->cy - h->cy);
+            if (d <= g->r + h->r && d >= fabs(g->r - h->r) && bad++ < 3)
+                print_error("%s: circles (%.4f, %.4f) and (%.4f, %.4f) meet\n", what, g->cx, g->cy,
+                            h->cx, h->cy);
+        }
+    }
+    return bad;
+}
+
 /* The scene's map, batch or online, written both ways and checked. */
-static uint32_t check_scene(const char *kind, uint64_t seed, int online, uint32_t *segments)
+static uint32_t check_scene(const char *kind, uint64_t seed, int online, uint32_t *segments,
+                            uint32_t *circles)
 {
     scansim_scene sc;
     assert_int_equal(scansim_scene_builtin(&sc, kind, seed), 0);
@@ -175,12 +229,18 @@ static uint32_t check_scene(const char *kind, uint64_t seed, int online, uint32_
     uint32_t n = polyc_polyline_count(ctx);
     polyc_polyline *lines = calloc(n ? n : 1u, sizeof *lines);
     assert_non_null(lines);
-    for (uint32_t i = 0; i < n; i++)
+    polyc_circle *circ = calloc(n ? n : 1u, sizeof *circ);
+    assert_non_null(circ);
+    assert_int_equal(polyc_find_circles(ctx), POLYC_OK);
+    for (uint32_t i = 0; i < n; i++) {
         assert_int_equal(polyc_get_polyline(ctx, i, &lines[i]), POLYC_OK);
+        assert_int_equal(polyc_get_circle(ctx, i, &circ[i]), POLYC_OK);
+    }
     mapout_map m;
     memset(&m, 0, sizeof m);
     m.lines = lines;
     m.line_count = n;
+    m.circles = circ;
     uint32_t bad = 0, cap = 200000;
     seg *s = malloc(cap * sizeof *s);
     assert_non_null(s);
@@ -193,10 +253,12 @@ static uint32_t check_scene(const char *kind, uint64_t seed, int online, uint32_
         fclose(f);
         snprintf(what, sizeof what, "%s seed %u %s %s", kind, (unsigned)seed,
                  online ? "online" : "batch", json ? "JSON" : "TXT");
-        bad += strict_faults(s, ns, what);
+        bad += strict_faults(s, ns, what) + ring_faults(s, ns, what);
         *segments += ns;
+        *circles += ring_n;
     }
     free(s);
+    free(circ);
     free(lines);
     free(block);
     scansim_scene_free(&sc);
@@ -206,16 +268,17 @@ static uint32_t check_scene(const char *kind, uint64_t seed, int online, uint32_
 static void test_no_crossing_no_touch_as_written(void **state)
 {
     (void)state;
-    uint32_t bad = 0, segments = 0, maps = 0;
+    uint32_t bad = 0, segments = 0, circles = 0, maps = 0;
     for (size_t k = 0; k < sizeof SCENES / sizeof SCENES[0]; k++)
         for (uint64_t seed = 1; seed <= SCENES[k].seeds; seed++)
             for (int online = 0; online < 2; online++) {
-                bad += check_scene(SCENES[k].kind, seed, online, &segments);
+                bad += check_scene(SCENES[k].kind, seed, online, &segments, &circles);
                 maps++;
             }
-    print_message("%u maps written as TXT and JSON, %u segments read back: %u crossings or "
-                  "touches\n", maps, segments, bad);
+    print_message("%u maps written as TXT and JSON, %u segments and %u circles read back: %u "
+                  "crossings or touches\n", maps, segments, circles, bad);
     assert_int_equal(bad, 0);
+    assert_true(circles > 0); /* (the round kinds have some) */
 }
 
 int main(void)

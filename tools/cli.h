@@ -29,7 +29,7 @@ enum {
     OPT_FREE = 1u << 12, OPT_STATS = 1u << 13, OPT_NO_OPTIMIZE = 1u << 14, OPT_EXACT = 1u << 15,
     OPT_GRID_TRACE = 1u << 16, OPT_POINTS = 1u << 17, OPT_GRID = 1u << 18, OPT_VERTICES = 1u << 19,
     OPT_COLOR_LINES = 1u << 20, OPT_ONLINE = 1u << 21, OPT_WORK = 1u << 22, OPT_FRAMES = 1u << 23,
-    OPT_EVERY = 1u << 24
+    OPT_EVERY = 1u << 24, OPT_NO_ARCS = 1u << 25, OPT_CHORD = 1u << 26
 };
 /* what applies where */
 #define OPTS_LOG_ONLY (OPT_CELL | OPT_THRESHOLD | OPT_MAX_RANGE | OPT_EXACT | OPT_GRID_TRACE | \
@@ -48,6 +48,9 @@ typedef struct options {
     unsigned given;            /* OPT_* bits of the options on the command line */
     int stats, no_optimize, points, grid, vertices, color_lines, quiet;
     int online;                /* --online: the log replayed as a stream (online.c) */
+    int no_arcs;               /* --no-arcs: polylines only (POLYC_FLAG_NO_ARCS) */
+    double max_chord_m;        /* --max-chord-error: circles written as polygons
+                                  within this (0: as circles) */
     uint64_t work;             /* --work: an update's budget */
     const char *frames;        /* --frames DIR: an SVG every `every` scans; NULL: none */
     uint32_t every;
@@ -78,6 +81,8 @@ typedef struct run {
     map_input *map;            /* a map instead of a log; NULL for a log */
     void *block;
     polyc_polyline *lines;
+    polyc_circle *circles;     /* per polyline of `lines` (polyc_get_circle) */
+    float *chord_xy;           /* --max-chord-error: the circles' polygons' points */
     membuf out, trace;
     gridimage image;           /* polyc grid */
     membuf pgm, yaml;

@@ -8,12 +8,24 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* Polyline i is written as a circle. */
+static const polyc_circle *circle_at(const mapout_map *map, uint32_t i)
+{
+    return map->circles && map->circles[i].radius_m > 0.0f ? &map->circles[i] : NULL;
+}
+
 /* ---- TXT ---- */
 
 int mapout_txt(FILE *f, const mapout_map *map)
 {
     for (uint32_t i = 0; i < map->line_count; i++) {
         const polyc_polyline *pl = &map->lines[i];
+        const polyc_circle *c = circle_at(map, i);
+        if (c) {
+            fprintf(f, "circle %.4f %.4f %.4f\n", (double)c->center_x_m, (double)c->center_y_m,
+                    (double)c->radius_m);
+            continue;
+        }
         fprintf(f, "%s %u", pl->closed ? "closed" : "open", (unsigned)pl->point_count);
         for (uint32_t j = 0; j < pl->point_count; j++)
             fprintf(f, " %.4f %.4f", (double)pl->xy_m[2 * j], (double)pl->xy_m[2 * j + 1]);
@@ -78,17 +90,34 @@ static void json_stats(FILE *f, const polyc_stats *s, const mapout_times *t)
 
 int mapout_json(FILE *f, const mapout_map *map)
 {
+    uint32_t written = 0, circles = 0;
     fputs("{\"polylines\": [", f);
     for (uint32_t i = 0; i < map->line_count; i++) {
         const polyc_polyline *pl = &map->lines[i];
-        fprintf(f, "%s\n{\"closed\": %s, \"points\": [", i ? "," : "",
+        if (circle_at(map, i)) {
+            circles++;
+            continue;
+        }
+        fprintf(f, "%s\n{\"closed\": %s, \"points\": [", written++ ? "," : "",
                 pl->closed ? "true" : "false");
         for (uint32_t j = 0; j < pl->point_count; j++)
             fprintf(f, "%s[%.4f, %.4f]", j ? ", " : "", (double)pl->xy_m[2 * j],
                     (double)pl->xy_m[2 * j + 1]);
         fputs("]}", f);
     }
-    fputs(map->line_count ? "\n], \"stats\": " : "], \"stats\": ", f);
+    fputs(written ? "\n]" : "]", f);
+    if (circles) {             /* (only when there are: a map of lines is written as before) */
+        uint32_t k = 0;
+        fputs(", \"circles\": [", f);
+        for (uint32_t i = 0; i < map->line_count; i++) {
+            const polyc_circle *c = circle_at(map, i);
+            if (c)
+                fprintf(f, "%s\n{\"center\": [%.4f, %.4f], \"radius\": %.4f}", k++ ? "," : "",
+                        (double)c->center_x_m, (double)c->center_y_m, (double)c->radius_m);
+        }
+        fputs("\n]", f);
+    }
+    fputs(", \"stats\": ", f);
     json_stats(f, map->stats, map->times);
     fputs("}\n", f);
     return ferror(f) ? -1 : 0;
@@ -202,7 +231,15 @@ static void make_view(const mapout_map *map, view *v)
     v->x0 = v->y0 = HUGE_VAL;
     v->x1 = v->y1 = -HUGE_VAL;
     uint64_t vertices = 0;
+    uint32_t circles = 0;
     for (uint32_t i = 0; i < map->line_count; i++) {
+        const polyc_circle *c = circle_at(map, i);
+        if (c) {
+            circles++;
+            box_add(v, (double)c->center_x_m - (double)c->radius_m, (double)c->center_y_m - (double)c->radius_m);
+            box_add(v, (double)c->center_x_m + (double)c->radius_m, (double)c->center_y_m + (double)c->radius_m);
+            continue;
+        }
         vertices += map->lines[i].point_count;
         for (uint32_t j = 0; j < map->lines[i].point_count; j++)
             box_add(v, (double)map->lines[i].xy_m[2 * j], (double)map->lines[i].xy_m[2 * j + 1]);
@@ -259,7 +296,10 @@ static void make_view(const mapout_map *map, view *v)
     xml_name(name, sizeof name, map->title);
     snprintf(v->title, sizeof v->title, "%s", *name ? name : "polyc map");
     int n = snprintf(v->subtitle, sizeof v->subtitle, "%u polylines, %llu vertices",
-                     (unsigned)map->line_count, (unsigned long long)vertices);
+                     (unsigned)(map->line_count - circles), (unsigned long long)vertices);
+    if (circles && n > 0 && (size_t)n < sizeof v->subtitle)
+        n += snprintf(v->subtitle + n, sizeof v->subtitle - (size_t)n, ", %u circles",
+                      (unsigned)circles);
     if (map->cell_m > 0 && n > 0 && (size_t)n < sizeof v->subtitle)
         n += snprintf(v->subtitle + n, sizeof v->subtitle - (size_t)n, ", cells of %g m",
                       map->cell_m);
@@ -516,6 +556,13 @@ int mapout_svg(FILE *f, const mapout_map *map)
     for (uint32_t i = 0; i < map->line_count; i++) {
         const polyc_polyline *pl = &map->lines[i];
         const char *colour = map->color_lines ? palette[i % PALETTE_SIZE] : SVG_LINE_COLOUR;
+        const polyc_circle *c = circle_at(map, i);
+        if (c) {
+            fprintf(f, "<circle stroke=\"%s\" cx=\"%.2f\" cy=\"%.2f\" r=\"%.2f\"/>\n", colour,
+                    px_x(&v, (double)c->center_x_m), px_y(&v, (double)c->center_y_m),
+                    (double)c->radius_m * v.scale);
+            continue;
+        }
         if (pl->point_count == 0)
             continue;
         fprintf(f, "<path stroke=\"%s\" d=\"", colour);

@@ -16,6 +16,9 @@ typedef struct mapout_times {
 typedef struct mapout_map {
     const polyc_polyline *lines;   /* line_count polylines (metres, pose frame) */
     uint32_t line_count;
+    const polyc_circle *circles;   /* per polyline: radius_m > 0, written as that
+                                      circle (JSON "circles", TXT `circle`, SVG
+                                      <circle>); NULL: none */
     const polyc_stats *stats;      /* JSON "stats"; NULL: written as {} */
     const mapout_times *times;     /* JSON time_*_ms; NULL: left out */
     /* SVG only */

@@ -24,6 +24,7 @@ static const struct {
     {"--grid-trace", OPT_GRID_TRACE}, {"--points", OPT_POINTS}, {"--grid", OPT_GRID},
     {"--vertices", OPT_VERTICES},     {"--color-lines", OPT_COLOR_LINES}, {"--online", OPT_ONLINE},
     {"--work", OPT_WORK},             {"--frames", OPT_FRAMES},     {"--every", OPT_EVERY},
+    {"--no-arcs", OPT_NO_ARCS},       {"--max-chord-error", OPT_CHORD},
 };
 
 static const char usage_text[] =
@@ -66,6 +67,9 @@ static const char usage_text[] =
     "  --points, --grid, --vertices\n"
     "                          SVG layers: scan endpoints, grid cells, vertex dots\n"
     "  --color-lines           SVG: a colour per polyline (default: one for the map)\n"
+    "  --no-arcs               polylines only: no round thing drawn as a circle\n"
+    "  --max-chord-error E     write each circle as a closed polyline within E metres\n"
+    "                          of it, for readers that take lines only\n"
     "  --online                replay the log as a live stream: add each scan, update the\n"
     "                          map within a work budget, finish, then write it as above\n"
     "  --work N                --online: an update's budget in work units (default %u)\n"
@@ -140,6 +144,11 @@ static int set_value(options *o, const char *name, const char *val)
         o->every = (uint32_t)u;
     } else if (strcmp(name, "--frames") == 0) {
         o->frames = val;
+    } else if (strcmp(name, "--max-chord-error") == 0) {
+        if (parse_double(val, 1e-4, 1.0, &d))
+            return complain(EXIT_USAGE, "--max-chord-error needs metres in [0.0001, 1], not '%s'",
+                            val);
+        o->max_chord_m = d;
     } else if (strcmp(name, "--memory-mb") == 0) {
         if (parse_double(val, 1e-6, 1e9, &d))
             return complain(EXIT_USAGE, "--memory-mb needs MiB from 0.000001 to 1000000000,"
@@ -193,7 +202,10 @@ static int set_flag(options *o, const char *name)
         o->color_lines = 1;
     else if (strcmp(name, "--online") == 0)
         o->online = 1;
-    else
+    else if (strcmp(name, "--no-arcs") == 0) {
+        o->no_arcs = 1;
+        o->config.flags |= POLYC_FLAG_NO_ARCS;
+    } else
         return -1;
     return 0;
 }
@@ -204,7 +216,7 @@ static int takes_value(const char *name)
                                         "--seed",   "--iterations", "--max-range", "--memory-mb",
                                         "--cell",   "--threshold", "--alpha",     "--gamma",
                                         "--occupied-thresh", "--free-thresh", "--work",
-                                        "--frames", "--every"};
+                                        "--frames", "--every", "--max-chord-error"};
     for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
         if (strcmp(name, names[i]) == 0)
             return 1;

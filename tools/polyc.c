@@ -91,6 +91,8 @@ int main(int argc, char **argv)
         free(bufs[i]->data);
     }
     free(r.lines);
+    free(r.circles);
+    free(r.chord_xy);
     free(r.block);
     gridimage_free(&r.image);
     scanlog_free(&r.log);

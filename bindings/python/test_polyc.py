@@ -305,6 +305,67 @@ def seg_dist(w, x, y):
     return math.hypot(ax + t * dx - x, ay + t * dy - y)
 
 
+def pillar_scans():
+    """A 0.3 m round pillar at (1, 2) inside a 6 m x 5 m room, seen from 16
+    poses round it (361 beams over 180 degrees, facing the pillar)."""
+    cx, cy, r = 1.0, 2.0, 0.3
+    room = (-2.0, -0.5, 4.0, 4.5)
+    scans = []
+    for k in range(16):
+        a = 2 * math.pi * k / 16
+        px, py = cx + 1.4 * math.cos(a), cy + 1.4 * math.sin(a)
+        th = math.atan2(cy - py, cx - px)
+        ranges = []
+        for i in range(361):
+            b = th - math.pi / 2 + i * math.pi / 360
+            dx, dy = math.cos(b), math.sin(b)
+            best = 20.0
+            # the pillar
+            ox, oy = px - cx, py - cy
+            bb = dx * ox + dy * oy
+            disc = bb * bb - (ox * ox + oy * oy - r * r)
+            if disc >= 0 and -bb - math.sqrt(disc) > 0:
+                best = -bb - math.sqrt(disc)
+            # the room's walls
+            for t in ((room[0] - px) / dx if dx < 0 else (room[2] - px) / dx if dx > 0 else 1e9,
+                      (room[1] - py) / dy if dy < 0 else (room[3] - py) / dy if dy > 0 else 1e9):
+                if 0 < t < best:
+                    best = t
+            ranges.append(round(best, 3))
+        scans.append(((px, py, th), -math.pi / 2, math.pi / 360, 0.02, 20.0, ranges))
+    return scans
+
+
+class Circles(unittest.TestCase):
+    def test_pillar_is_a_circle(self):
+        scans = pillar_scans()
+        for flags in (0, polyc.FLAG_NO_ARCS):
+            ctx = polyc.Context((len(scans), 361 * len(scans), 1 << 20, 0), flags=flags)
+            for s in scans:
+                ctx.add_scan(*s)
+            ctx.build()
+            circles = ctx.circles()
+            if flags:
+                self.assertEqual(circles, [])
+                continue
+            self.assertEqual(len(circles), 1, circles)
+            c = circles[0]
+            self.assertLess(math.hypot(c.center[0] - 1.0, c.center[1] - 2.0), 0.01, c)
+            self.assertLess(abs(c.radius - 0.3), 0.01, c)
+            line = ctx.polylines()[c.index]
+            self.assertTrue(all(abs(math.hypot(x - c.center[0], y - c.center[1]) - c.radius)
+                                <= c.polyline_dev + 1e-6 for x, y in line.points))
+
+    def test_online_pillar(self):
+        scans = pillar_scans()
+        m = polyc.OnlineMap(12.0, 361)
+        for s in scans:
+            m.add_scan(*s)
+            m.update()
+        m.finish()
+        self.assertEqual(len(m.circles), 1)
+
+
 class Grid(unittest.TestCase):
     @classmethod
     def setUpClass(cls):

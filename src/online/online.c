@@ -103,9 +103,9 @@ static int lay_out(polyc_ctx *ctx, polyc__online *on, polyc__arena *a)
         return 0;
     int32_t lines = polyc__line_cap(V);
     if (a->base)
-        ok &= polyc__flat_init(a, &ctx->flat, (uint32_t)lines, (uint32_t)V);
+        ok &= polyc__flat_result(a, &ctx->flat, (uint32_t)lines, (uint32_t)V);
     else
-        polyc__flat_reserve(a, V);
+        polyc__flat_reserve(a, V, 1);
     polyc__online_pub_carve(a, on, lines);
     ok &= on->pubs.pub && on->pubs.pub_next && on->pubs.gone;
     /* the grid's geometry first (its directory is carved last) */
@@ -181,10 +181,16 @@ static int lay_out(polyc_ctx *ctx, polyc__online *on, polyc__arena *a)
 
 
 
+/* The online map's optimiser, kept between the calls. */
+static polyc__opt *live_opt(polyc_ctx *ctx)
+{
+    return &ctx->online->opt;
+}
+
 /* What the online layer lends the batch stages it runs on its own data. */
 static const polyc__layer online_layer = {
     polyc__online_spacing, polyc__online_points_scratch, polyc__online_collect, polyc__records_walk,
-    polyc__records_take,
+    polyc__records_take, live_opt,
 };
 
 static size_t header_bytes(void)

@@ -58,7 +58,7 @@ void polyc__optimizer_reserve(polyc__arena *a, const polyc_config *cfg, const po
     polyc__hash_reserve(a, &o, lim);
     polyc__points_reserve(a, cfg, lim);
     opt_carve(a, &o, P > 0 ? P : 1, V, lim->max_scans > 1, loc_soa_cap(cfg, lim), 0);
-    polyc__flat_reserve(a, V);
+    polyc__flat_reserve(a, V, 0);
 }
 
 /* An occupancy grid's data are cell centres, not noisy endpoints
@@ -133,7 +133,7 @@ int polyc__opt_carve_lasting(polyc_ctx *ctx, polyc__arena *a, polyc__opt *o, int
     int ok = polyc__hash_lay_out(o, a, bucket_cap) && polyc__points_carve_online(a, o) &&
              opt_carve(a, o, P > 0 ? P : 1, V, 1, loc_soa_cap(o->cfg, &ctx->lim), 1);
     if (!a->base) { /* a counting arena: nothing is written */
-        polyc__flat_reserve(a, V);
+        polyc__flat_reserve(a, V, 0);
         return ok;
     }
     if (!ok || !polyc__flat_init(a, &o->best, (uint32_t)polyc__line_cap(V), (uint32_t)V))

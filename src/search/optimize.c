@@ -243,6 +243,7 @@ polyc_status polyc__search(polyc__opt *o, polyc_progress_fn progress, void *user
     polyc_ctx *ctx = o->ctx;
     polyc_status st;
     const polyc_config *cfg = o->cfg;
+    ctx->flat.circ_n = 0; /* (the map changes under them) */
     polyc__flat_from_store(&o->best, o->s);
     polyc__size_forget(o);
     float best = polyc__bic(o);
@@ -335,6 +336,15 @@ polyc_status polyc__search(polyc__opt *o, polyc_progress_fn progress, void *user
         return st;
     fill_stats(o);
     return result;
+}
+
+polyc_status polyc__find_circles(polyc_ctx *ctx)
+{
+    polyc__opt o;
+    polyc_status st = polyc__opt_setup(ctx, &o);
+    if (st == POLYC_OK)
+        polyc__circles_select(&o);
+    return st;
 }
 
 polyc_status polyc__score(polyc_ctx *ctx, double *bic, double *err)

@@ -16,6 +16,7 @@
 #include <string.h>
 
 #include "gtband.h"
+#include "gtround.h"
 #include "gttopo.h"
 #include "pipeline.h"
 #include "polyc.h"
@@ -40,16 +41,20 @@ static const char usage_text[] =
     "draws a wall as a band.\n"
     "Exit: 0 ok; 1 the log, the map or the library failed; 2 usage.\n";
 
-/* The polylines of a TXT map: "open|closed N x1 y1 ... xN yN" per line.
- * *lines and each xy_m are malloc'ed (free_lines). -1 with a message on
- * stderr when the file is not such a map. */
-static int read_txt_map(const char *path, polyc_polyline **lines, uint32_t *count)
+/* The polylines of a TXT map: "open|closed N x1 y1 ... xN yN" or "circle
+ * X Y R" per line; a circle is a polyline of no points whose *circ entry
+ * holds it (*circ parallel to *lines). *lines, *circ and each xy_m are
+ * malloc'ed (free_lines). -1 with a message on stderr when the file is not
+ * such a map. */
+static int read_txt_map(const char *path, polyc_polyline **lines, polyc_circle **circ,
+                        uint32_t *count)
 {
     FILE *f = fopen(path, "r");
     char word[16];
     uint32_t cap = 0;
     int c;
     *lines = NULL;
+    *circ = NULL;
     *count = 0;
     if (!f) {
         fprintf(stderr, "mapscore: %s: %s\n", path, strerror(errno));
@@ -59,16 +64,30 @@ static int read_txt_map(const char *path, polyc_polyline **lines, uint32_t *coun
         polyc_polyline *pl;
         unsigned long n, k;
         float *xy;
+        int is_circle = strcmp(word, "circle") == 0;
+        if (*count == cap) {
+            polyc_polyline *p = realloc(*lines, (cap ? 2u * cap : 64u) * sizeof *p);
+            if (p)
+                *lines = p;
+            polyc_circle *q = realloc(*circ, (cap ? 2u * cap : 64u) * sizeof *q);
+            if (q)
+                *circ = q;
+            if (!p || !q)
+                goto bad;
+            cap = cap ? 2u * cap : 64u;
+        }
+        memset(&(*circ)[*count], 0, sizeof **circ);
+        if (is_circle) {
+            polyc_circle *cc = &(*circ)[*count];
+            if (fscanf(f, "%f %f %f", &cc->center_x_m, &cc->center_y_m, &cc->radius_m) != 3 ||
+                !(cc->radius_m > 0.0f))
+                goto bad;
+            memset(&(*lines)[(*count)++], 0, sizeof **lines);
+            continue;
+        }
         if ((strcmp(word, "open") != 0 && strcmp(word, "closed") != 0) ||
             fscanf(f, "%lu", &n) != 1 || n == 0 || n > 100000000ul)
             goto bad;
-        if (*count == cap) {
-            polyc_polyline *p = realloc(*lines, (cap ? 2u * cap : 64u) * sizeof *p);
-            if (!p)
-                goto bad;
-            *lines = p;
-            cap = cap ? 2u * cap : 64u;
-        }
         xy = malloc(2u * n * sizeof *xy);
         if (!xy)
             goto bad;
@@ -129,7 +148,10 @@ int main(int argc, char **argv)
 {
     scanlog log;
     pipeline p;
-    polyc_polyline *lines = NULL;
+    polyc_polyline *lines = NULL, *scored = NULL;
+    polyc_circle *circ = NULL;
+    float *circ_xy = NULL;
+    uint32_t params = 0, arcs = 0, circles = 0;
     uint32_t count = 0, verts = 0, i;
     gttopo_score topo;
     gtband_score band;
@@ -167,7 +189,7 @@ int main(int argc, char **argv)
     }
     fclose(f);
     if (from_file) {
-        if (read_txt_map(argv[2], &lines, &count) != 0)
+        if (read_txt_map(argv[2], &lines, &circ, &count) != 0)
             goto done;
     } else {
         polyc_config config;
@@ -175,7 +197,8 @@ int main(int argc, char **argv)
         polyc_config_default(&config);
         if (pipeline_open(&p, &config, log.scans, log.count) != 0 ||
             pipeline_run(&p, log.scans, log.count, times) != 0 ||
-            (lines = pipeline_lines(&p, &count)) == NULL) {
+            (lines = pipeline_lines(&p, &count)) == NULL ||
+            (circ = pipeline_circles(&p, count)) == NULL) {
             fprintf(stderr, "mapscore: error in %s: %s (%s)\n",
                     p.failed_at ? p.failed_at : "pipeline_lines", polyc_status_str(p.status),
                     p.ctx ? polyc_last_error(p.ctx) : "");
@@ -184,12 +207,16 @@ int main(int argc, char **argv)
         for (i = 0; i < PIPELINE_STAGES; i++)
             lib_ms += times[i];
     }
-    for (i = 0; i < count; i++)
-        verts += lines[i].point_count;
+    /* a circle is scored as itself (a fine polygon) and counted as 3 numbers */
+    if (gtround_lines(lines, circ, count, &scored, &circ_xy) != 0) {
+        fprintf(stderr, "mapscore: out of memory\n");
+        goto done;
+    }
+    gtround_params(lines, circ, count, &verts, &params, &arcs, &circles);
     t0 = pipeline_now_ms();
     if (gtband_scan_points(log.scans, log.count, &xy, &from, &n) != 0 ||
-        gttopo_score_map(lines, count, xy, n, &topo) != 0 ||
-        gtband_score_map_runs(lines, count, xy, from, n, &band, want_runs ? keep_run : NULL,
+        gttopo_score_map(scored, count, xy, n, &topo) != 0 ||
+        gtband_score_map_runs(scored, count, xy, from, n, &band, want_runs ? keep_run : NULL,
                               &runs) != 0 ||
         runs.failed) {
         fprintf(stderr, "mapscore: the scorers ran out of memory\n");
@@ -198,11 +225,10 @@ int main(int argc, char **argv)
     printf("%-28s %6s %7s %7s %5s %5s %9s %8s %6s %5s %5s %5s %5s %8s %6s %6s %6s %6s %8s %7s\n",
            "map", "lines", "verts", "params", "arcs", "circ", "len", "dcov", "dcov%", "cross", "uns20", "uns10", "loose",
            "band15", "band%", "end20", "end10", "end5", "libms", "scorems");
-    /* parameters: 2 a vertex, 1 an arc, 3 a circle; the maps are of straight
-     * segments only */
+    /* parameters: 2 a vertex, 1 an arc, 3 a circle */
     printf("%-28s %6u %7u %7u %5u %5u %9.1f %8.2f %6.2f %5u %5u %5u %5u %8.2f %6.2f %6.4f %6.4f "
            "%6.4f %8.1f %7.1f\n",
-           from_file ? argv[2] : "(library defaults)", count, verts, 2u * verts, 0u, 0u,
+           from_file ? argv[2] : "(library defaults)", count, verts, params, arcs, circles,
            topo.map_length_m,
            topo.double_cover_m,
            topo.map_length_m > 0.0 ? 100.0 * topo.double_cover_m / topo.map_length_m : 0.0,
@@ -220,6 +246,9 @@ done:
     free(xy);
     free(from);
     free_lines(lines, count, from_file);
+    free(circ);
+    free(scored);
+    free(circ_xy);
     pipeline_close(&p);
     scanlog_free(&log);
     return rc;

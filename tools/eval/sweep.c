@@ -26,6 +26,7 @@
 #include <time.h>
 
 #include "gtband.h"
+#include "gtround.h"
 #include "gtscore.h"
 #include "gttopo.h"
 #include "occmap.h"
@@ -216,6 +217,41 @@ typedef struct row {
 
 /* ---- one scene -------------------------------------------------------------- */
 
+/* A map as the scorers take it: its polylines, a circle's as a fine
+ * polygon (gtround.h), and per polyline its circle (radius 0: none). */
+typedef struct map_view {
+    polyc_polyline *lines;
+    polyc_circle *circ;
+    float *xy;                 /* the circles' polygons' points */
+    uint32_t count;
+} map_view;
+
+static void map_free(map_view *m)
+{
+    free(m->lines);
+    free(m->circ);
+    free(m->xy);
+    memset(m, 0, sizeof *m);
+}
+
+/* The pipeline's map into m (freed first); 0, or -1 (the pipeline's
+ * failed_at says where, or out of memory). */
+static int map_get(pipeline *p, map_view *m)
+{
+    polyc_polyline *raw;
+    map_free(m);
+    if ((raw = pipeline_lines(p, &m->count)) == NULL)
+        return -1;
+    if ((m->circ = pipeline_circles(p, m->count)) == NULL ||
+        gtround_lines(raw, m->circ, m->count, &m->lines, &m->xy) != 0) {
+        free(raw);
+        map_free(m);
+        return -1;
+    }
+    free(raw);
+    return 0;
+}
+
 /* The scene's ground truth as gtscore reads it: written by scansim to
  * memory and read back, exactly what KIND-sSEED.gt.txt would hold. */
 static int truth_of(const scansim_scene *sc, gtscore_truth *truth, char *err, size_t err_size)
@@ -275,10 +311,11 @@ static double grid_completeness(const gtscore_truth *truth, const polyc_occupanc
  * scores a scene. The topology's data: the occupied cells' centres of
  * `grid` when it is given (--occupancy, whose targets then apply), else the
  * scans' endpoints. */
-static int score_scene(const scansim_scene *sc, const gtscore_truth *truth,
-                       const polyc_polyline *lines, uint32_t count, double pipeline_ms,
-                       const polyc_occupancy_grid *grid, row *r)
+static int score_scene(const scansim_scene *sc, const gtscore_truth *truth, const map_view *m,
+                       double pipeline_ms, const polyc_occupancy_grid *grid, row *r)
 {
+    const polyc_polyline *lines = m->lines;
+    uint32_t count = m->count, verts, params, arcs, circles;
     gtscore_map_score score;
     gttopo_score topo;
     gtband_score band = {0};
@@ -309,14 +346,19 @@ static int score_scene(const scansim_scene *sc, const gtscore_truth *truth,
     r->fig[FIG_SCANS] = sc->scan_count;
     r->fig[FIG_BEAMS] = (double)sc->scan_count * (double)sc->laser.beam_count;
     r->fig[FIG_MS] = pipeline_ms;
-    r->fig[FIG_VERTS] = score.vertices;
+    /* the vertices and parameters of the map as the library gives it (a
+     * circle is three numbers, not its scoring polygon) */
+    gtround_params(lines, m->circ, count, &verts, &params, &arcs, &circles);
+    score.vertices = verts;
+    score.params = params;
+    r->fig[FIG_VERTS] = verts;
     r->fig[FIG_IDEAL] = score.ideal;
-    r->fig[FIG_RATIO] = score.ideal ? score.vertex_ratio : (double)NAN;
-    r->fig[FIG_PARAMS] = score.params;
+    r->fig[FIG_RATIO] = score.ideal ? (double)verts / (double)score.ideal : (double)NAN;
+    r->fig[FIG_PARAMS] = params;
     r->fig[FIG_IPARAMS] = score.ideal_params ? (double)score.ideal_params : (double)NAN;
-    r->fig[FIG_PRATIO] = score.ideal_params ? score.param_ratio : (double)NAN;
-    r->fig[FIG_ARCS] = score.arcs;
-    r->fig[FIG_CIRCLES] = score.circles;
+    r->fig[FIG_PRATIO] = score.ideal_params ? (double)params / (double)score.ideal_params : (double)NAN;
+    r->fig[FIG_ARCS] = arcs;
+    r->fig[FIG_CIRCLES] = circles;
     r->fig[FIG_RMS] = score.precision_rms_m;
     r->fig[FIG_FIT] = fit_m >= 0.0 ? fit_m : (double)NAN;
     r->fig[FIG_FLOOR] = floor_m >= 0.0 ? floor_m : (double)NAN;
@@ -487,24 +529,22 @@ static int batch_core_high(const scansim_scene *sc, const gtscore_truth *truth,
     for (unsigned k = 1; k <= extra; k++) {
         polyc_config c = *config;
         pipeline p;
-        polyc_polyline *lines = NULL;
-        uint32_t count = 0;
+        map_view m = {0};
         double times[PIPELINE_STAGES];
         row r;
         int rc = -1;
         c.seed = config->seed + k;
         memset(&p, 0, sizeof p);
         if (pipeline_open(&p, &c, sc->scans, sc->scan_count) != 0 ||
-            pipeline_run(&p, sc->scans, sc->scan_count, times) != 0 ||
-            (lines = pipeline_lines(&p, &count)) == NULL)
+            pipeline_run(&p, sc->scans, sc->scan_count, times) != 0 || map_get(&p, &m) != 0)
             printf("%s error in %s (batch seed %llu): %s\n", label,
                    p.failed_at ? p.failed_at : "pipeline_lines", (unsigned long long)c.seed,
                    polyc_status_str(p.status));
-        else if (score_scene(sc, truth, lines, count, 0.0, NULL, &r) != 0)
+        else if (score_scene(sc, truth, &m, 0.0, NULL, &r) != 0)
             printf("%s error: scoring ran out of memory\n", label);
         else
             rc = 0;
-        free(lines);
+        map_free(&m);
         pipeline_close(&p);
         if (rc != 0)
             return -1;
@@ -516,24 +556,22 @@ static int batch_core_high(const scansim_scene *sc, const gtscore_truth *truth,
 
 /* --online: the scene's scans through an online context (pipeline.h), its
  * map scored into r as score_scene scores the batch map, and the batch
- * map's figures (the row `batch`) beside it. *lines and *count become the
- * online map's (the caller frees them). */
+ * map's figures (the row `batch`) beside it. *m becomes the online map
+ * (the caller frees it). */
 static int online_scene(const scansim_scene *sc, const gtscore_truth *truth, const row *batch,
                         const polyc_config *config, double wider_m, pipeline *q,
-                        polyc_polyline **lines, uint32_t *count, row *r, const char *label)
+                        map_view *m, row *r, const char *label)
 {
     double ms;
-    free(*lines);
-    *lines = NULL;
-    *count = 0;
+    map_free(m);
     if (pipeline_run_online_wider(q, config, sc->scans, sc->scan_count, wider_m, &ms) != 0 ||
-        (*lines = pipeline_lines(q, count)) == NULL) {
+        map_get(q, m) != 0) {
         printf("%s error in %s (online): %s (%s)\n", label,
                q->failed_at ? q->failed_at : "pipeline_lines", polyc_status_str(q->status),
                q->ctx ? polyc_last_error(q->ctx) : "");
         return -1;
     }
-    if (score_scene(sc, truth, *lines, *count, ms, NULL, r) != 0) {
+    if (score_scene(sc, truth, m, ms, NULL, r) != 0) {
         printf("%s error: scoring the online map ran out of memory\n", label);
         return -1;
     }
@@ -558,10 +596,10 @@ static int sweep_scene(const options *o, const char *kind, uint64_t seed, row *r
     polyc_occupancy_grid grid;
     pipeline p, q;
     polyc_config config;
-    polyc_polyline *lines = NULL;
+    map_view m = {0};
     row batch;
     double times[PIPELINE_STAGES], ms = 0.0;
-    uint32_t count = 0, i;
+    uint32_t i;
     char err[512] = "", label[48];
     int rc = -1;
 
@@ -597,8 +635,7 @@ static int sweep_scene(const options *o, const char *kind, uint64_t seed, row *r
             goto done;
         }
         occmap_grid(&occ, &grid);
-        if (pipeline_run_grid(&p, &config, &grid, &ms) != 0 ||
-            (lines = pipeline_lines(&p, &count)) == NULL) {
+        if (pipeline_run_grid(&p, &config, &grid, &ms) != 0 || map_get(&p, &m) != 0) {
             printf("%s error in %s: %s (%s)\n", label,
                    p.failed_at ? p.failed_at : "pipeline_lines", polyc_status_str(p.status),
                    p.ctx ? polyc_last_error(p.ctx) : "");
@@ -606,8 +643,7 @@ static int sweep_scene(const options *o, const char *kind, uint64_t seed, row *r
         }
     } else {
         if (pipeline_open(&p, &config, sc.scans, sc.scan_count) != 0 ||
-            pipeline_run(&p, sc.scans, sc.scan_count, times) != 0 ||
-            (lines = pipeline_lines(&p, &count)) == NULL) {
+            pipeline_run(&p, sc.scans, sc.scan_count, times) != 0 || map_get(&p, &m) != 0) {
             printf("%s error in %s: %s (%s)\n", label,
                    p.failed_at ? p.failed_at : "pipeline_lines", polyc_status_str(p.status),
                    p.ctx ? polyc_last_error(p.ctx) : "");
@@ -616,16 +652,15 @@ static int sweep_scene(const options *o, const char *kind, uint64_t seed, row *r
         for (i = 0; i < PIPELINE_STAGES; i++)
             ms += times[i];
     }
-    if (score_scene(&sc, &truth, lines, count, ms, o->occupancy ? &grid : NULL,
-                    o->online ? &batch : r) != 0) {
+    if (score_scene(&sc, &truth, &m, ms, o->occupancy ? &grid : NULL, o->online ? &batch : r) != 0) {
         printf("%s error: scoring ran out of memory\n", label);
         goto done;
     }
     if (o->online && batch_core_high(&sc, &truth, &config, o->batch_seeds - 1u,
                                      batch.fig[FIG_CORE], &batch.fig[FIG_BCORE_HI], label) != 0)
         goto done;
-    if (o->online && online_scene(&sc, &truth, &batch, &config, o->online_wider_m, &q, &lines,
-                                  &count, r, label) != 0)
+    if (o->online && online_scene(&sc, &truth, &batch, &config, o->online_wider_m, &q, &m, r,
+                                  label) != 0)
         goto done;
     r->ok = 1;
     printf("%s", label);
@@ -642,13 +677,13 @@ static int sweep_scene(const options *o, const char *kind, uint64_t seed, row *r
                  kind, (unsigned long long)seed);
         if (o->save_dir && scansim_save(&sc, log_path, gt_path) != 0)
             fprintf(stderr, "sweep: cannot write %s: %s\n", log_path, strerror(errno));
-        if (o->svg_dir && write_svg(svg_path, &sc, &truth, lines, count,
+        if (o->svg_dir && write_svg(svg_path, &sc, &truth, m.lines, m.count,
                                     o->occupancy ? &grid : NULL) != 0)
             fprintf(stderr, "sweep: cannot write %s: %s\n", svg_path, strerror(errno));
     }
     rc = 0;
 done:
-    free(lines);
+    map_free(&m);
     pipeline_close(&q);
     pipeline_close(&p);
     occmap_free(&occ);

@@ -62,7 +62,7 @@ __all__ = ["PolycError", "ResyncError", "Scan", "Points", "Polyline", "Result", 
            "build_map", "build_map_from_grid", "grid_image", "read_log", "read_map", "online_area",
            "default_config",
            "version", "STATUS", "FLAG_EXACT_POINTS", "FLAG_NO_GRAZING", "FLAG_GRID_TRACE",
-           "ONLINE_WORK_DEFAULT", "CHANGE_KINDS"]
+           "FLAG_NO_ARCS", "ONLINE_WORK_DEFAULT", "CHANGE_KINDS", "Circle"]
 
 # polyc_status, append-only like the C enum
 STATUS = {0: "POLYC_OK", 1: "POLYC_ERR_NULL", 2: "POLYC_ERR_CONFIG", 3: "POLYC_ERR_NOMEM",
@@ -73,6 +73,7 @@ ERR_EXTENT, ERR_LIMIT, ERR_RANGE, ERR_STOPPED, ERR_BUSY = 6, 7, 8, 9, 10
 FLAG_EXACT_POINTS = 0x1
 FLAG_NO_GRAZING = 0x2
 FLAG_GRID_TRACE = 0x4
+FLAG_NO_ARCS = 0x8
 ONLINE_WORK_DEFAULT = 8000                 # POLYC_ONLINE_WORK_DEFAULT: work units of one update
 CHANGE_KINDS = {1: "added", 2: "modified", 3: "removed"}   # POLYC_CHANGE_*
 
@@ -133,6 +134,11 @@ class _Polyline(ctypes.Structure):
     _fields_ = [("xy_m", ctypes.POINTER(_f32)), ("point_count", _u32), ("closed", _u32)]
 
 
+class _Circle(ctypes.Structure):
+    _fields_ = [("center_x_m", _f32), ("center_y_m", _f32), ("radius_m", _f32),
+                ("polyline_dev_m", _f32)]
+
+
 class _Stats(ctypes.Structure):
     _fields_ = [(n, _u64) for n in (
         "beams", "beams_skipped", "hits", "data_points", "memory_used_bytes",
@@ -174,7 +180,7 @@ _STRUCTS = {"polyc_config": _Config, "polyc_limits": _Limits, "polyc_scan": _Sca
             "polyc_box": _Box, "polyc_polyline": _Polyline, "polyc_stats": _Stats,
             "polyc_iteration": _Iteration, "polyc_occupancy_grid": _OccupancyGrid,
             "polyc_online_limits": _OnlineLimits, "polyc_online_report": _OnlineReport,
-            "polyc_change": _Change}
+            "polyc_change": _Change, "polyc_circle": _Circle}
 _PROGRESS = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.POINTER(_Iteration))
 
 
@@ -232,6 +238,8 @@ def _load():
         "polyc_polyline_count": (_u32, [ctx]),
         "polyc_get_polyline": (st, [ctx, _u32, P(_Polyline)]),
         "polyc_get_stats": (st, [ctx, P(_Stats)]),
+        "polyc_find_circles": (st, [ctx]),
+        "polyc_get_circle": (st, [ctx, _u32, P(_Circle)]),
         "polyc_score": (st, [ctx, P(_f64), P(_f64)]),
         "polyc_last_error": (ctypes.c_char_p, [ctx]),
         # online mapping (polyc.h, "Online mapping")
@@ -424,6 +432,16 @@ class Points:
 class Polyline(NamedTuple):
     points: Points                         # metres; a closed one does not repeat its start
     closed: bool
+
+
+class Circle(NamedTuple):
+    """A polyline of the map that the BIC prefers as a circle
+    (polyc_find_circles): `index` into polylines, the centre (x, y) and
+    radius in metres, and how far that polyline strays from the circle."""
+    index: int
+    center: tuple
+    radius: float
+    polyline_dev: float
 
 
 class Result(NamedTuple):
@@ -703,6 +721,17 @@ class _Block:
             out.append(Polyline(Points(array("d", map(_shortest, raw))), bool(pl.closed)))
         return out
 
+    def _find_circles(self):
+        self._check(_lib.polyc_find_circles(self._ctx), "find circles")
+        out = []
+        for i in range(_lib.polyc_polyline_count(self._ctx)):
+            c = _Circle()
+            self._check(_lib.polyc_get_circle(self._ctx, i, ctypes.byref(c)), "get circle")
+            if c.radius_m > 0:
+                out.append(Circle(i, (_shortest(c.center_x_m), _shortest(c.center_y_m)),
+                                  _shortest(c.radius_m), _shortest(c.polyline_dev_m)))
+        return out
+
     def _get_stats(self):
         s = _Stats()
         self._check(_lib.polyc_get_stats(self._ctx, ctypes.byref(s)), "stats")
@@ -797,6 +826,12 @@ class Context(_Block):
         """The current map, copied out: a list of Polyline."""
         with self._use("polylines"):
             return self._copy_polylines()
+
+    def circles(self):
+        """The polylines of the current map that are circles (round things:
+        polyc_find_circles), a list of Circle; none with flags FLAG_NO_ARCS."""
+        with self._use("circles"):
+            return self._find_circles()
 
     def grid_image(self):
         """The hit/miss grid (run build_grid first) as the image `polyc grid`
@@ -967,6 +1002,13 @@ class OnlineMap(_Block):
         of Polyline, as in a batch Result."""
         with self._use("polylines"):
             return self._copy_polylines()
+
+    @property
+    def circles(self):
+        """The polylines of the map as it stands that are circles
+        (polyc_find_circles), a list of Circle, as Context.circles gives."""
+        with self._use("circles"):
+            return self._find_circles()
 
     @property
     def polyline_ids(self):

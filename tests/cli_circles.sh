@@ -1,0 +1,92 @@
+#!/bin/sh
+# cli_circles.sh - round things in the tool's outputs (docs/formats.md): a
+# pillar hall simulated by gen_example, mapped batch and --online; its
+# pillars come out as JSON "circles", TXT `circle` lines and SVG <circle>
+# elements; --no-arcs and --max-chord-error E write polylines only (the
+# latter each circle as a closed polyline within E of it); a bad E is a
+# usage error.
+#   tests/cli_circles.sh POLYC GEN_EXAMPLE
+set -u
+[ $# -eq 2 ] || { echo "usage: $0 POLYC GEN_EXAMPLE" >&2; exit 2; }
+case $1 in /*) POLYC=$1 ;; *) POLYC=$(pwd)/$1 ;; esac
+case $2 in /*) GEN=$2 ;; *) GEN=$(pwd)/$2 ;; esac
+. "$(dirname "$0")/cli_lib.sh"
+cli_scratch circles
+run() {
+    count=$((count + 1))
+    timeout 120 "$POLYC" --quiet "$@" > out.txt 2> err.txt
+    rc=$?
+}
+"$GEN" hall.log hall.gt.txt pillars 1 > /dev/null || { echo "cli_circles: gen_example failed"; exit 1; }
+
+# JSON: the circles beside the polylines, none of them also a polyline
+name=json
+run --format json -o map.json hall.log
+[ $rc -eq 0 ] && python3 - map.json <<'PY' || bad "exit $rc, or the JSON's circles are wrong"
+import json, sys
+d = json.load(open(sys.argv[1]))
+c = d["circles"]
+assert len(c) >= 3, c
+for x in c:
+    assert len(x["center"]) == 2 and 0.05 < x["radius"] < 0.7, x
+n = len(d["polylines"])
+assert d["stats"]["polylines"] == n + len(c), (d["stats"]["polylines"], n, len(c))
+PY
+circles=$(python3 -c 'import json; print(len(json.load(open("map.json"))["circles"]))' 2>/dev/null)
+
+# TXT: one `circle X Y R` line each, the same count
+name=txt
+run --format txt -o map.txt hall.log
+[ $rc -eq 0 ] && [ "$(grep -c '^circle -\{0,1\}[0-9]*\.[0-9]\{4\} -\{0,1\}[0-9]*\.[0-9]\{4\} [0-9]*\.[0-9]\{4\}$' map.txt)" = "$circles" ] ||
+    bad "exit $rc, or not $circles circle lines"
+
+# SVG: a <circle> each, in the polylines' group
+name=svg
+run -o map.svg hall.log
+[ $rc -eq 0 ] && [ "$(grep -c '^<circle stroke=' map.svg)" = "$circles" ] && grep -q "$circles circles" map.svg ||
+    bad "exit $rc, or not $circles <circle> elements"
+
+# --online: the finished map's circles too
+name=online
+run --online --format json -o online.json hall.log
+[ $rc -eq 0 ] && python3 -c 'import json; assert len(json.load(open("online.json"))["circles"]) >= 3' ||
+    bad "exit $rc, or fewer than 3 circles online"
+
+# --no-arcs: polylines only, as many as the map with circles has in all
+name=no-arcs
+run --no-arcs --format json -o lines.json hall.log
+[ $rc -eq 0 ] && python3 - lines.json map.json <<'PY' || bad "exit $rc, or circles with --no-arcs"
+import json, sys
+a, b = json.load(open(sys.argv[1])), json.load(open(sys.argv[2]))
+assert "circles" not in a
+assert len(a["polylines"]) == len(b["polylines"]) + len(b["circles"])
+PY
+
+# --max-chord-error: each circle a closed polyline within E of it
+name=max-chord-error
+run --max-chord-error 0.002 --format json -o chord.json hall.log
+[ $rc -eq 0 ] && python3 - chord.json map.json <<'PY' || bad "exit $rc, or a circle not within 2 mm"
+import json, math, sys
+a, b = json.load(open(sys.argv[1])), json.load(open(sys.argv[2]))
+assert "circles" not in a
+for c in b["circles"]:
+    (cx, cy), r = c["center"], c["radius"]
+    near = [p for p in a["polylines"] if p["closed"] and len(p["points"]) >= 8 and
+            all(abs(math.hypot(x - cx, y - cy) - r) < 2e-4 for x, y in p["points"])]
+    assert len(near) == 1, c
+    pts = near[0]["points"]
+    for (x0, y0), (x1, y1) in zip(pts, pts[1:] + pts[:1]):
+        mx, my = (x0 + x1) / 2, (y0 + y1) / 2
+        assert r - math.hypot(mx - cx, my - cy) <= 0.002 + 2e-4, (c, x0, y0)
+PY
+for e in 0 -1 2 x 0.00001; do
+    name="max-chord-error $e"
+    run --max-chord-error "$e" -o bad.svg hall.log
+    [ $rc -eq 2 ] && [ ! -e bad.svg ] || bad "exit $rc, not 2"
+done
+name="no-arcs on polyc grid"
+run grid --no-arcs -o g hall.log
+[ $rc -eq 2 ] || bad "exit $rc, not 2"
+
+echo "cli_circles: $count runs, $failed failed"
+[ $failed -eq 0 ]
