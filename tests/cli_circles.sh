@@ -46,6 +46,12 @@ run -o map.svg hall.log
 [ $rc -eq 0 ] && [ "$(grep -c '^<circle stroke=' map.svg)" = "$circles" ] && grep -q "$circles circles" map.svg ||
     bad "exit $rc, or not $circles <circle> elements"
 
+# --stats: how many of the polylines are circles
+name=stats
+run --stats -o stats.svg hall.log
+[ $rc -eq 0 ] && grep -q "^circles        $circles of the polylines\$" err.txt ||
+    bad "exit $rc, or no line 'circles $circles of the polylines'"
+
 # --online: the finished map's circles too
 name=online
 run --online --format json -o online.json hall.log

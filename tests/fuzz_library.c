@@ -239,6 +239,22 @@ static void run(polyc_ctx *ctx, scene *sc, result *r)
         CHECK(st == POLYC_OK || st == POLYC_ERR_NOMEM);
         if (st == POLYC_OK)
             CHECK(!isnan(bic) && err >= 0.0);
+        /* the round things: finite circles of polylines that exist, the
+         * polylines unchanged */
+        st = polyc_find_circles(ctx);
+        CHECK(st == POLYC_OK || st == POLYC_ERR_NOMEM);
+        uint32_t circles = 0;
+        for (uint32_t i = 0; st == POLYC_OK && i < r->lines; i++) {
+            polyc_circle c;
+            CHECK(polyc_get_circle(ctx, i, &c) == POLYC_OK);
+            CHECK(c.radius_m >= 0.0f && isfinite(c.radius_m));
+            if (c.radius_m > 0.0f) {
+                circles++;
+                CHECK(isfinite(c.center_x_m) && isfinite(c.center_y_m) && c.polyline_dev_m >= 0.0f);
+            }
+        }
+        CHECK(st != POLYC_OK || circles == polyc_circle_count(ctx));
+        CHECK(polyc_polyline_count(ctx) == r->lines);
         uint32_t w = 0, h = 0;
         CHECK(polyc_grid_info(ctx, NULL, NULL, NULL, &w, &h) == POLYC_OK);
         uint32_t hits, misses, contour;

@@ -82,6 +82,7 @@ typedef struct run {
     void *block;
     polyc_polyline *lines;
     polyc_circle *circles;     /* per polyline of `lines` (polyc_get_circle) */
+    uint32_t circle_count;     /* how many of them are circles */
     float *chord_xy;           /* --max-chord-error: the circles' polygons' points */
     membuf out, trace;
     gridimage image;           /* polyc grid */

@@ -179,6 +179,8 @@ static void print_stats(const options *o, const run *r, const polyc_stats *s,
     }
     fprintf(e, "final          %u polylines, %u vertices, %u iterations\n",
             (unsigned)s->polylines, (unsigned)s->vertices, (unsigned)s->iterations);
+    fprintf(e, "circles        %u of the polylines%s\n", (unsigned)r->circle_count,
+            o->no_arcs ? " (--no-arcs)" : o->max_chord_m > 0.0 ? " (--max-chord-error: written as polylines)" : "");
     fprintf(e, "BIC            %.3f (error %.6f m^2)\n", s->bic, s->error_sq_m2);
     fprintf(e, "memory         block %llu bytes, used %llu bytes\n",
             (unsigned long long)s->memory_size_bytes, (unsigned long long)s->memory_used_bytes);
@@ -354,9 +356,12 @@ int map_to_draw(const options *o, run *r, const polyc_config *cfg, polyc_ctx *ct
         r->circles = calloc(n ? n : 1, sizeof *r->circles);
         if (!r->circles)
             return complain(EXIT_INPUT, "out of memory");
-        for (uint32_t i = 0; i < n; i++)
+        r->circle_count = 0;
+        for (uint32_t i = 0; i < n; i++) {
             if ((st = polyc_get_circle(ctx, i, &r->circles[i])) != POLYC_OK)
                 return library_fail("get circle", st, ctx, size);
+            r->circle_count += r->circles[i].radius_m > 0.0f;
+        }
         int rc = o->max_chord_m > 0.0 ? circles_as_polygons(o, r, n) : 0;
         if (rc)
             return rc;
