@@ -232,7 +232,7 @@ test-batch-alone: $(BATCH_OBJ)
 # Robustness (docs/security.md). test-cli: every bad input of the tool
 # (tests/cli_bad_input.sh), where it writes (tests/cli_output.sh: as root,
 # also as an ordinary user), --online (tests/cli_online.sh), circles in the
-# outputs (tests/cli_circles.sh) and the README's
+# outputs (tests/cli_curves.sh) and the README's
 # C example compiled as written (tests/cli_readme.sh).
 # test-fuzz-replay: the committed fuzz corpus through the fuzz targets, built
 # with $(CC). test-asan: unit tests, corpus replay and
@@ -251,7 +251,7 @@ test-cli: $(BUILD)/polyc $(BUILD)/gen_example
 	tests/cli_bad_input.sh $(CLI_TEST_ARGS) $(BUILD)/polyc
 	tests/cli_output.sh $(BUILD)/polyc
 	tests/cli_online.sh $(BUILD)/polyc
-	tests/cli_circles.sh $(BUILD)/polyc $(BUILD)/gen_example
+	tests/cli_curves.sh $(BUILD)/polyc $(BUILD)/gen_example
 	tests/cli_readme.sh "$(CC) $(OPT) $(CFLAGS)" $(BUILD)/polyc
 SAN_LIST  = address,undefined,float-cast-overflow
 SAN_FLAGS = -fsanitize=$(SAN_LIST) -fno-sanitize-recover=all

@@ -311,22 +311,41 @@ POLYC_API polyc_status polyc_get_polyline(const polyc_ctx *ctx, uint32_t index,
 POLYC_API polyc_status polyc_copy_polyline(const polyc_ctx *ctx, uint32_t index, float *xy_m,
                                            uint32_t capacity, uint32_t *count,
                                            uint32_t *closed);
-/* Round things: which polylines of the current map are circles. A
- * polyline that goes round (closed, or its ends nearer than split_gap_m)
- * becomes a circle where its own points, held all round with no stretch
- * over split_gap_m without one, fit a circle at a lower BIC than the
- * polyline's (3 numbers against 2 a vertex; docs/algorithm.md, "Circles").
- * Call after polyc_build or polyc_optimize (an online context: after any
- * update or the finish); a call that changes the map forgets them. None
- * with POLYC_FLAG_NO_ARCS. POLYC_ERR_STATE before polyc_trace;
- * POLYC_ERR_NOMEM if the block cannot hold the optimiser again. */
-POLYC_API polyc_status polyc_find_circles(polyc_ctx *ctx);
-/* Whether polyline `index` is a circle (polyc_find_circles): out->radius_m
+/* Round things: which polylines of the current map are circles, and which
+ * runs of their segments are arcs. A polyline that goes round (closed, or
+ * its ends nearer than split_gap_m) becomes a circle where its own points,
+ * held all round with no stretch over split_gap_m without one, fit a
+ * circle at a lower BIC than the polyline's (3 numbers against 2 a
+ * vertex); in the others, a run of segments that turn one way by small
+ * angles becomes one arc between its end vertices where its points fit the
+ * arc at a lower BIC (1 number, the bulge, against the vertices inside the
+ * run; docs/algorithm.md, "Circles and arcs"). Call after polyc_build or
+ * polyc_optimize (an online context: after any update or the finish); a
+ * call that changes the map forgets them. None with POLYC_FLAG_NO_ARCS.
+ * POLYC_ERR_STATE before polyc_trace; POLYC_ERR_NOMEM if the block cannot
+ * hold the optimiser again. */
+POLYC_API polyc_status polyc_find_curves(polyc_ctx *ctx);
+/* Whether polyline `index` is a circle (polyc_find_curves): out->radius_m
  * > 0 and its centre, or radius_m 0. polyc_get_polyline still gives the
  * polyline, which strays at most out->polyline_dev_m from the circle.
  * polyc_circle_count: how many of the polylines are circles. */
 POLYC_API polyc_status polyc_get_circle(const polyc_ctx *ctx, uint32_t index, polyc_circle *out);
 POLYC_API uint32_t polyc_circle_count(const polyc_ctx *ctx);
+/* Polyline `index` with its arcs (polyc_find_curves): its vertices that
+ * bound a straight segment or an arc into xy_m (2 * capacity floats), and
+ * per segment its bulge into bulges (capacity floats): tan of a quarter of
+ * the arc's angle, > 0 when the arc runs counter-clockwise from the
+ * segment's first vertex to its second (y up), 0 for a straight segment, as
+ * DXF's LWPOLYLINE stores it; *count gets the vertices (count - 1 bulges for
+ * an open polyline, count for a closed one, the last then 0: its closing
+ * segment is straight). A polyline without arcs comes out as
+ * polyc_copy_polyline gives it, every bulge 0. xy_m and bulges may be NULL
+ * to ask for the count only; POLYC_ERR_NOMEM if capacity is too small.
+ * polyc_arc_count: the arcs of the whole map. */
+POLYC_API polyc_status polyc_copy_arcs(const polyc_ctx *ctx, uint32_t index, float *xy_m,
+                                       float *bulges, uint32_t capacity, uint32_t *count,
+                                       uint32_t *closed);
+POLYC_API uint32_t polyc_arc_count(const polyc_ctx *ctx);
 POLYC_API polyc_status polyc_get_stats(const polyc_ctx *ctx, polyc_stats *out);
 /* Current BIC of the map and its parts, recomputed from scratch. */
 POLYC_API polyc_status polyc_score(polyc_ctx *ctx, double *bic, double *error_sq_m2);

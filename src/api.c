@@ -285,7 +285,7 @@ polyc_status polyc_build(polyc_ctx *ctx, polyc_progress_fn progress, void *user)
     return polyc_optimize(ctx, progress, user);
 }
 
-polyc_status polyc_find_circles(polyc_ctx *ctx)
+polyc_status polyc_find_curves(polyc_ctx *ctx)
 {
     polyc_status cst = polyc__enter(ctx, 1);
     if (cst != POLYC_OK)
@@ -294,10 +294,11 @@ polyc_status polyc_find_circles(polyc_ctx *ctx)
         return polyc__fail(ctx, POLYC_ERR_STATE, "no polylines yet: run polyc_trace first");
     if (ctx->layer && ctx->layer->live_opt) { /* its optimiser holds the map */
         polyc__circles_select(ctx->layer->live_opt(ctx));
+        polyc__arcs_select(ctx->layer->live_opt(ctx));
         return POLYC_OK;
     }
     ctx->arena.used = ctx->trace_mark;
-    polyc_status st = polyc__find_circles(ctx);
+    polyc_status st = polyc__find_curves(ctx);
     note_memory(ctx);
     ctx->arena.used = ctx->trace_mark;
     return st;

@@ -179,6 +179,12 @@ typedef struct polyc__flat {
      * polylines: set on the context's result only) */
     polyc__circle *circ;
     uint32_t circ_n, circ_cap;
+    /* and its arcs (arcs.c; arc_n 0: none, the arrays not read): per point,
+     * kept in the arc form (1) or inside an arc (0), and the bulge of the
+     * arc form's segment that starts at it (0: straight) */
+    uint8_t *arc_keep;
+    float *arc_bulge;
+    uint32_t arc_n;
 } polyc__flat;
 
 /* ---- data points (points.c): one weighted point per cell, or raw points ----
@@ -382,7 +388,7 @@ typedef struct polyc__layer {
                     int take_back);
     void (*rec_take)(struct polyc__records *r, struct polyc__tile *t, size_t d);
     /* api.c: the optimiser that holds the layer's map, its points assigned
-     * (polyc_find_circles) */
+     * (polyc_find_curves) */
     struct polyc__opt *(*live_opt)(polyc_ctx *ctx);
 } polyc__layer;
 

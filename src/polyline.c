@@ -226,8 +226,11 @@ static int flat_carve(polyc__arena *a, polyc__flat *f, uint32_t cap_lines, uint3
     if (circles) {
         f->circ = polyc__alloc(a, circle_cap(cap_lines), sizeof(polyc__circle));
         f->circ_cap = circle_cap(cap_lines);
+        f->arc_keep = polyc__alloc(a, cap_points, 1);
+        f->arc_bulge = polyc__alloc(a, cap_points, sizeof(float));
     }
-    return f->xy && f->start && f->closed && f->id && (!circles || f->circ);
+    return f->xy && f->start && f->closed && f->id &&
+           (!circles || (f->circ && f->arc_keep && f->arc_bulge));
 }
 
 void polyc__flat_reserve(polyc__arena *a, int32_t v_cap, int result)

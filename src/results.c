@@ -81,6 +81,46 @@ uint32_t polyc_circle_count(const polyc_ctx *ctx)
     return k;
 }
 
+polyc_status polyc_copy_arcs(const polyc_ctx *ctx, uint32_t index, float *xy_m, float *bulges,
+                             uint32_t capacity, uint32_t *count, uint32_t *closed)
+{
+    polyc_polyline pl;
+    polyc_status st = polyc_get_polyline(ctx, index, &pl);
+    if (st != POLYC_OK)
+        return st;
+    uint32_t a = ctx->flat.start[index], n = 0;
+    int arcs = ctx->flat.arc_n > 0 && ctx->flat.arc_keep;
+    for (uint32_t k = 0; k < pl.point_count; k++)
+        n += !arcs || ctx->flat.arc_keep[a + k];
+    if (count)
+        *count = n;
+    if (closed)
+        *closed = pl.closed;
+    if (!xy_m && !bulges)
+        return POLYC_OK;
+    if (capacity < n)
+        return POLYC_ERR_NOMEM;
+    for (uint32_t k = 0, j = 0; k < pl.point_count; k++) {
+        if (arcs && !ctx->flat.arc_keep[a + k])
+            continue;
+        if (xy_m) {
+            xy_m[2 * j] = pl.xy_m[2 * k];
+            xy_m[2 * j + 1] = pl.xy_m[2 * k + 1];
+        }
+        if (bulges)
+            bulges[j] = arcs ? ctx->flat.arc_bulge[a + k] : 0.0f;
+        j++;
+    }
+    return POLYC_OK;
+}
+
+uint32_t polyc_arc_count(const polyc_ctx *ctx)
+{
+    if (polyc__check_ctx(ctx) != POLYC_OK || ctx->stage < POLYC__STAGE_TRACE)
+        return 0;
+    return ctx->flat.arc_n;
+}
+
 polyc_status polyc_get_stats(const polyc_ctx *ctx, polyc_stats *out)
 {
     polyc_status cst = polyc__check_ctx(ctx);

@@ -232,11 +232,15 @@ void polyc__optimizer_reserve(polyc__arena *a, const polyc_config *cfg, const po
 polyc_status polyc__optimize(polyc_ctx *ctx, polyc_progress_fn progress, void *user);
 polyc_status polyc__score(polyc_ctx *ctx, double *bic, double *err);
 /* the circles of the current map (circles.c) on an optimiser set up for it */
-polyc_status polyc__find_circles(polyc_ctx *ctx);
+polyc_status polyc__find_curves(polyc_ctx *ctx);
 /* circles.c: the polylines of o's map that go round and that a circle fits
  * at a lower BIC, into the result's circle list (none with
  * POLYC_FLAG_NO_ARCS) */
 struct polyc__opt;
 void polyc__circles_select(struct polyc__opt *o);
+/* arcs.c: the runs of the polylines that are no circle that turn one way
+ * by small angles and that an arc fits at a lower BIC, into the result's
+ * arc form (none with POLYC_FLAG_NO_ARCS) */
+void polyc__arcs_select(struct polyc__opt *o);
 
 #endif

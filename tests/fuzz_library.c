@@ -241,7 +241,7 @@ static void run(polyc_ctx *ctx, scene *sc, result *r)
             CHECK(!isnan(bic) && err >= 0.0);
         /* the round things: finite circles of polylines that exist, the
          * polylines unchanged */
-        st = polyc_find_circles(ctx);
+        st = polyc_find_curves(ctx);
         CHECK(st == POLYC_OK || st == POLYC_ERR_NOMEM);
         uint32_t circles = 0;
         for (uint32_t i = 0; st == POLYC_OK && i < r->lines; i++) {

@@ -4,8 +4,9 @@
  * and JSON by the tool's writers (tools/mapout.c, four decimals), read back,
  * and every pair of segments that share no vertex tested exactly on the
  * printed values: no proper crossing, and no vertex on the other segment;
- * the circles (polyc_find_circles, written as circles) meet no segment and
- * no other circle. (Ends at T-junctions stop 1 mm short of the segment they
+ * the circles (polyc_find_curves, written as circles) meet no segment and
+ * no other circle, and the arcs (written as bulges; read back as polylines
+ * within 0.05 mm of them) cross and touch nothing either. (Ends at T-junctions stop 1 mm short of the segment they
  * meet, corners clear it by as much: topology.c, polyc__op_end_gaps; a
  * circle keeps 1 cm off every other segment: circles.c.) */
 #include <stdarg.h>
@@ -19,6 +20,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "curves.h"
 #include "mapout.h"
 #include "polyc.h"
 #include "scansim.h"
@@ -28,8 +30,8 @@
 static const struct {
     const char *kind;
     uint32_t seeds;
-} SCENES[] = {{"flat", 6},  {"office", 3},  {"thinwalls", 3}, {"shelves", 2},
-              {"hall", 2},  {"pillars", 2}, {"roundmix", 2}};
+} SCENES[] = {{"flat", 6},  {"office", 3},   {"thinwalls", 3}, {"shelves", 2}, {"hall", 2},
+              {"pillars", 2}, {"roundmix", 2}, {"arcwalls", 2}};
 
 typedef struct seg {
     double ax, ay, bx, by;
@@ -53,6 +55,8 @@ static uint32_t read_back(FILE *f, int json, seg *out, uint32_t cap)
     ring_n = 0;
     char line[1 << 16];
     double xy[2 * 4096];
+    static double bulge[4096];
+    uint32_t nb = 0;
     while (fgets(line, sizeof line, f)) {
         uint32_t k = 0;
         int closed = 0;
@@ -79,22 +83,60 @@ static uint32_t read_back(FILE *f, int json, seg *out, uint32_t cap)
                 xy[k++] = v;
                 p = end;
             }
+            const char *bl = strstr(p, " bulges");
+            nb = 0;
+            for (p = bl ? bl + 7 : p; bl && nb < 4096; p = end) {
+                double v = strtod(p, &end);
+                if (end == p)
+                    break;
+                bulge[nb++] = v;
+            }
         } else {
             const char *pts = strstr(line, "\"points\"");
             if (!pts)
                 continue;
             closed = strstr(line, "\"closed\": true") != NULL;
-            for (p = strchr(pts, '['); p && (p = strchr(p + 1, '[')) != NULL && k + 1 < 2 * 4096;) {
+            const char *bl = strstr(line, "\"bulges\"");
+            for (p = strchr(pts, '['); p && (p = strchr(p + 1, '[')) != NULL && k + 1 < 2 * 4096 &&
+                                      (!bl || p < bl);) {
                 char *end;
                 xy[k++] = strtod(p + 1, &end);
                 xy[k++] = strtod(strchr(end, ',') + 1, &end);
                 p = end;
             }
+            nb = 0;
+            for (p = bl ? strchr(bl, '[') + 1 : NULL; p && nb < 4096;) {
+                char *end;
+                double v = strtod(p, &end);
+                if (end == p)
+                    break;
+                bulge[nb++] = v;
+                p = strchr(end, ',');
+                p = p ? p + 1 : NULL;
+            }
         }
         uint32_t m = k / 2;
         for (uint32_t i = 0; i + 1 < m + (closed ? 1u : 0u) && n < cap; i++) {
             uint32_t j = (i + 1) % m;
-            out[n++] = (seg){xy[2 * i], xy[2 * i + 1], xy[2 * j], xy[2 * j + 1]};
+            if (i >= nb || bulge[i] == 0.0) {
+                out[n++] = (seg){xy[2 * i], xy[2 * i + 1], xy[2 * j], xy[2 * j + 1]};
+                continue;
+            }
+            /* an arc: pieces within 0.05 mm of it, its ends as printed */
+            float a[2] = {(float)xy[2 * i], (float)xy[2 * i + 1]}, b[2] = {(float)xy[2 * j], (float)xy[2 * j + 1]};
+            double cx, cy, r, a0, sweep;
+            curves_arc(a, b, bulge[i], &cx, &cy, &r, &a0, &sweep);
+            uint32_t pieces = (uint32_t)ceil(fabs(sweep) / (2.0 * acos(1.0 - 0.00005 / r)));
+            pieces = pieces < 1u ? 1u : (pieces > 4096u ? 4096u : pieces);
+            double px = xy[2 * i], py = xy[2 * i + 1];
+            for (uint32_t q = 1; q <= pieces && n < cap; q++) {
+                double ang = a0 + sweep * (double)q / (double)pieces;
+                double qx = q == pieces ? xy[2 * j] : cx + r * cos(ang);
+                double qy = q == pieces ? xy[2 * j + 1] : cy + r * sin(ang);
+                out[n++] = (seg){px, py, qx, qy};
+                px = qx;
+                py = qy;
+            }
         }
     }
     return n;
@@ -184,7 +226,7 @@ static uint32_t ring_faults(const seg *s, uint32_t n, const char *what)
 
 /* The scene's map, batch or online, written both ways and checked. */
 static uint32_t check_scene(const char *kind, uint64_t seed, int online, uint32_t *segments,
-                            uint32_t *circles)
+                            uint32_t *circles, uint32_t *arcs)
 {
     scansim_scene sc;
     assert_int_equal(scansim_scene_builtin(&sc, kind, seed), 0);
@@ -227,20 +269,19 @@ static uint32_t check_scene(const char *kind, uint64_t seed, int online, uint32_
         assert_int_equal(polyc_online_finish(ctx, NULL, NULL, NULL), POLYC_OK);
     }
     uint32_t n = polyc_polyline_count(ctx);
-    polyc_polyline *lines = calloc(n ? n : 1u, sizeof *lines);
-    assert_non_null(lines);
-    polyc_circle *circ = calloc(n ? n : 1u, sizeof *circ);
-    assert_non_null(circ);
-    assert_int_equal(polyc_find_circles(ctx), POLYC_OK);
-    for (uint32_t i = 0; i < n; i++) {
-        assert_int_equal(polyc_get_polyline(ctx, i, &lines[i]), POLYC_OK);
-        assert_int_equal(polyc_get_circle(ctx, i, &circ[i]), POLYC_OK);
-    }
+    curves_map cm;
+    assert_int_equal(curves_from_ctx(ctx, 0, &cm), POLYC_OK);
+    const float **bul = calloc(n ? n : 1u, sizeof *bul);
+    assert_non_null(bul);
+    for (uint32_t i = 0; i < n; i++)
+        bul[i] = curves_bulges(&cm, i);
+    *arcs += cm.arcs;
     mapout_map m;
     memset(&m, 0, sizeof m);
-    m.lines = lines;
+    m.lines = cm.lines;
     m.line_count = n;
-    m.circles = circ;
+    m.circles = cm.circ;
+    m.bulges = bul;
     uint32_t bad = 0, cap = 200000;
     seg *s = malloc(cap * sizeof *s);
     assert_non_null(s);
@@ -258,8 +299,8 @@ static uint32_t check_scene(const char *kind, uint64_t seed, int online, uint32_
         *circles += ring_n;
     }
     free(s);
-    free(circ);
-    free(lines);
+    free(bul);
+    curves_free(&cm);
     free(block);
     scansim_scene_free(&sc);
     return bad;
@@ -268,17 +309,17 @@ static uint32_t check_scene(const char *kind, uint64_t seed, int online, uint32_
 static void test_no_crossing_no_touch_as_written(void **state)
 {
     (void)state;
-    uint32_t bad = 0, segments = 0, circles = 0, maps = 0;
+    uint32_t bad = 0, segments = 0, circles = 0, arcs = 0, maps = 0;
     for (size_t k = 0; k < sizeof SCENES / sizeof SCENES[0]; k++)
         for (uint64_t seed = 1; seed <= SCENES[k].seeds; seed++)
             for (int online = 0; online < 2; online++) {
-                bad += check_scene(SCENES[k].kind, seed, online, &segments, &circles);
+                bad += check_scene(SCENES[k].kind, seed, online, &segments, &circles, &arcs);
                 maps++;
             }
-    print_message("%u maps written as TXT and JSON, %u segments and %u circles read back: %u "
-                  "crossings or touches\n", maps, segments, circles, bad);
+    print_message("%u maps with %u arcs written as TXT and JSON, %u segments and %u circles read "
+                  "back: %u crossings or touches\n", maps, arcs, segments, circles, bad);
     assert_int_equal(bad, 0);
-    assert_true(circles > 0); /* (the round kinds have some) */
+    assert_true(circles > 0 && arcs > 0); /* (the round kinds have some) */
 }
 
 int main(void)

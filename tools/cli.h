@@ -11,6 +11,7 @@
 #include "gridimage.h"
 #include "mapfile.h"
 #include "mapout.h"
+#include "curves.h"
 #include "polyc.h"
 #include "scanlog.h"
 
@@ -80,10 +81,10 @@ typedef struct run {
     scanlog log;
     map_input *map;            /* a map instead of a log; NULL for a log */
     void *block;
-    polyc_polyline *lines;
-    polyc_circle *circles;     /* per polyline of `lines` (polyc_get_circle) */
-    uint32_t circle_count;     /* how many of them are circles */
-    float *chord_xy;           /* --max-chord-error: the circles' polygons' points */
+    curves_map curves;         /* the map with its circles and arcs (curves.h) */
+    polyc_polyline *flat_lines; /* --max-chord-error: the curves as polylines */
+    float *flat_xy;
+    const float **bulges;      /* per polyline: its bulges, NULL: no arc */
     membuf out, trace;
     gridimage image;           /* polyc grid */
     membuf pgm, yaml;

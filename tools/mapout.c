@@ -4,6 +4,8 @@
  * or TXT on a FILE. */
 #include "mapout.h"
 
+#include "curves.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -12,6 +14,15 @@
 static const polyc_circle *circle_at(const mapout_map *map, uint32_t i)
 {
     return map->circles && map->circles[i].radius_m > 0.0f ? &map->circles[i] : NULL;
+}
+
+/* The bulges of polyline i (NULL: straight segments only), and how many
+ * it has: one a segment. */
+static const float *bulges_at(const mapout_map *map, uint32_t i, uint32_t *n)
+{
+    const polyc_polyline *pl = &map->lines[i];
+    *n = pl->closed ? pl->point_count : (pl->point_count ? pl->point_count - 1 : 0);
+    return map->bulges ? map->bulges[i] : NULL;
 }
 
 /* ---- TXT ---- */
@@ -29,6 +40,13 @@ int mapout_txt(FILE *f, const mapout_map *map)
         fprintf(f, "%s %u", pl->closed ? "closed" : "open", (unsigned)pl->point_count);
         for (uint32_t j = 0; j < pl->point_count; j++)
             fprintf(f, " %.4f %.4f", (double)pl->xy_m[2 * j], (double)pl->xy_m[2 * j + 1]);
+        uint32_t nb;
+        const float *b = bulges_at(map, i, &nb);
+        if (b) {
+            fputs(" bulges", f);
+            for (uint32_t j = 0; j < nb; j++)
+                fprintf(f, " %.6f", (double)b[j]);
+        }
         fputc('\n', f);
     }
     return ferror(f) ? -1 : 0;
@@ -103,6 +121,13 @@ int mapout_json(FILE *f, const mapout_map *map)
         for (uint32_t j = 0; j < pl->point_count; j++)
             fprintf(f, "%s[%.4f, %.4f]", j ? ", " : "", (double)pl->xy_m[2 * j],
                     (double)pl->xy_m[2 * j + 1]);
+        uint32_t nb;
+        const float *b = bulges_at(map, i, &nb);
+        if (b) {
+            fputs("], \"bulges\": [", f);
+            for (uint32_t j = 0; j < nb; j++)
+                fprintf(f, "%s%.6f", j ? ", " : "", (double)b[j]);
+        }
         fputs("]}", f);
     }
     fputs(written ? "\n]" : "]", f);
@@ -231,7 +256,7 @@ static void make_view(const mapout_map *map, view *v)
     v->x0 = v->y0 = HUGE_VAL;
     v->x1 = v->y1 = -HUGE_VAL;
     uint64_t vertices = 0;
-    uint32_t circles = 0;
+    uint32_t circles = 0, arcs = 0;
     for (uint32_t i = 0; i < map->line_count; i++) {
         const polyc_circle *c = circle_at(map, i);
         if (c) {
@@ -243,6 +268,17 @@ static void make_view(const mapout_map *map, view *v)
         vertices += map->lines[i].point_count;
         for (uint32_t j = 0; j < map->lines[i].point_count; j++)
             box_add(v, (double)map->lines[i].xy_m[2 * j], (double)map->lines[i].xy_m[2 * j + 1]);
+        uint32_t nb;
+        const float *b = bulges_at(map, i, &nb);
+        for (uint32_t j = 0; b && j < nb; j++)
+            if (b[j] != 0.0f) { /* the arc's middle */
+                arcs++;
+                double cx, cy, r, a0, sweep;
+                const float *p = &map->lines[i].xy_m[2 * j];
+                curves_arc(p, &map->lines[i].xy_m[2 * ((j + 1) % map->lines[i].point_count)],
+                           (double)b[j], &cx, &cy, &r, &a0, &sweep);
+                box_add(v, cx + r * cos(a0 + 0.5 * sweep), cy + r * sin(a0 + 0.5 * sweep));
+            }
     }
     for (uint32_t i = 0; map->scans && i < map->scan_count; i++) {
         double x, y;
@@ -300,6 +336,8 @@ static void make_view(const mapout_map *map, view *v)
     if (circles && n > 0 && (size_t)n < sizeof v->subtitle)
         n += snprintf(v->subtitle + n, sizeof v->subtitle - (size_t)n, ", %u circles",
                       (unsigned)circles);
+    if (arcs && n > 0 && (size_t)n < sizeof v->subtitle)
+        n += snprintf(v->subtitle + n, sizeof v->subtitle - (size_t)n, ", %u arcs", (unsigned)arcs);
     if (map->cell_m > 0 && n > 0 && (size_t)n < sizeof v->subtitle)
         n += snprintf(v->subtitle + n, sizeof v->subtitle - (size_t)n, ", cells of %g m",
                       map->cell_m);
@@ -566,9 +604,23 @@ int mapout_svg(FILE *f, const mapout_map *map)
         if (pl->point_count == 0)
             continue;
         fprintf(f, "<path stroke=\"%s\" d=\"", colour);
-        for (uint32_t j = 0; j < pl->point_count; j++)
-            fprintf(f, "%s%.2f %.2f", j ? " L" : "M", px_x(&v, (double)pl->xy_m[2 * j]),
-                    px_y(&v, (double)pl->xy_m[2 * j + 1]));
+        uint32_t nb;
+        const float *b = bulges_at(map, i, &nb);
+        fprintf(f, "M%.2f %.2f", px_x(&v, (double)pl->xy_m[0]), px_y(&v, (double)pl->xy_m[1]));
+        for (uint32_t j = 0; j < nb; j++) {
+            uint32_t k = (j + 1) % pl->point_count;
+            double x = px_x(&v, (double)pl->xy_m[2 * k]), y = px_y(&v, (double)pl->xy_m[2 * k + 1]);
+            if (b && b[j] != 0.0f) {
+                /* y is flipped: a counter-clockwise arc on the map (its
+                 * angle growing, y up) is SVG's negative sweep (y down) */
+                double cx, cy, r, a0, sweep;
+                curves_arc(&pl->xy_m[2 * j], &pl->xy_m[2 * k], (double)b[j], &cx, &cy, &r, &a0, &sweep);
+                fprintf(f, " A%.2f %.2f 0 %d %d %.2f %.2f", r * v.scale, r * v.scale,
+                        fabs(sweep) > 3.14159265358979 ? 1 : 0, b[j] > 0.0f ? 0 : 1, x, y);
+            } else if (j + 1 < pl->point_count || !pl->closed) {
+                fprintf(f, " L%.2f %.2f", x, y);
+            }
+        }
         fputs(pl->closed ? " Z\"/>\n" : "\"/>\n", f);
         if (map->vertices) {
             fprintf(f, "<path stroke=\"none\" fill=\"%s\" d=\"", colour);

@@ -19,6 +19,10 @@ typedef struct mapout_map {
     const polyc_circle *circles;   /* per polyline: radius_m > 0, written as that
                                       circle (JSON "circles", TXT `circle`, SVG
                                       <circle>); NULL: none */
+    const float *const *bulges;    /* per polyline: its bulges (one a point, the
+                                      segment from it), NULL: straight (JSON
+                                      "bulges", TXT `bulges`, SVG arcs); NULL:
+                                      none */
     const polyc_stats *stats;      /* JSON "stats"; NULL: written as {} */
     const mapout_times *times;     /* JSON time_*_ms; NULL: left out */
     /* SVG only */

@@ -90,9 +90,10 @@ int main(int argc, char **argv)
             fclose(bufs[i]->f);
         free(bufs[i]->data);
     }
-    free(r.lines);
-    free(r.circles);
-    free(r.chord_xy);
+    curves_free(&r.curves);
+    free(r.flat_lines);
+    free(r.flat_xy);
+    free(r.bulges);
     free(r.block);
     gridimage_free(&r.image);
     scanlog_free(&r.log);

@@ -179,7 +179,8 @@ static void print_stats(const options *o, const run *r, const polyc_stats *s,
     }
     fprintf(e, "final          %u polylines, %u vertices, %u iterations\n",
             (unsigned)s->polylines, (unsigned)s->vertices, (unsigned)s->iterations);
-    fprintf(e, "circles        %u of the polylines%s\n", (unsigned)r->circle_count,
+    fprintf(e, "curves         %u circles, %u arcs%s\n", (unsigned)r->curves.circles,
+            (unsigned)r->curves.arcs,
             o->no_arcs ? " (--no-arcs)" : o->max_chord_m > 0.0 ? " (--max-chord-error: written as polylines)" : "");
     fprintf(e, "BIC            %.3f (error %.6f m^2)\n", s->bic, s->error_sq_m2);
     fprintf(e, "memory         block %llu bytes, used %llu bytes\n",
@@ -291,85 +292,40 @@ static int run_stages(const options *o, run *r, const polyc_config *cfg, polyc_c
     return 0;
 }
 
-#define CIRCLE_PI 3.14159265358979323846
-
-/* --max-chord-error: each circle as a regular polygon whose sides stray at
- * most o->max_chord_m from it (and at least 8 of them), into r->lines. */
-static int circles_as_polygons(const options *o, run *r, uint32_t n)
-{
-    size_t points = 0, at = 0;
-    uint32_t *sides = calloc(n ? n : 1, sizeof *sides);
-    if (!sides)
-        return complain(EXIT_INPUT, "out of memory");
-    for (uint32_t i = 0; i < n; i++) {
-        double rad = (double)r->circles[i].radius_m;
-        if (!(rad > 0.0))
-            continue;
-        double step = 2.0 * acos(fmax(-1.0, 1.0 - o->max_chord_m / rad));
-        double k = ceil(2.0 * CIRCLE_PI / step);
-        sides[i] = k < 8.0 ? 8u : (k > 65536.0 ? 65536u : (uint32_t)k);
-        points += sides[i];
-    }
-    free(r->chord_xy);
-    r->chord_xy = malloc((points ? points : 1) * 2 * sizeof *r->chord_xy);
-    if (!r->chord_xy) {
-        free(sides);
-        return complain(EXIT_INPUT, "out of memory");
-    }
-    for (uint32_t i = 0; i < n; i++) {
-        if (!sides[i])
-            continue;
-        const polyc_circle *c = &r->circles[i];
-        float *xy = r->chord_xy + 2 * at;
-        for (uint32_t k = 0; k < sides[i]; k++) {
-            double a = 2.0 * CIRCLE_PI * (double)k / (double)sides[i];
-            xy[2 * k] = (float)((double)c->center_x_m + (double)c->radius_m * cos(a));
-            xy[2 * k + 1] = (float)((double)c->center_y_m + (double)c->radius_m * sin(a));
-        }
-        r->lines[i].xy_m = xy;
-        r->lines[i].point_count = sides[i];
-        r->lines[i].closed = 1;
-        r->circles[i].radius_m = 0.0f; /* (a polyline now) */
-        at += sides[i];
-    }
-    free(sides);
-    return 0;
-}
-
 int map_to_draw(const options *o, run *r, const polyc_config *cfg, polyc_ctx *ctx, size_t size,
                 mapout_map *map)
 {
-    polyc_status st;
-    uint32_t n = polyc_polyline_count(ctx);
-    free(r->lines);
-    free(r->circles);
-    r->circles = NULL;
-    r->lines = calloc(n ? n : 1, sizeof *r->lines);
-    if (!r->lines)
+    /* the round things (polyc_find_curves) unless --no-arcs; the map drawn
+     * before (an earlier frame) freed first */
+    curves_free(&r->curves);
+    polyc_status st = curves_from_ctx(ctx, o->no_arcs, &r->curves);
+    if (st != POLYC_OK)
+        return library_fail("find curves", st, ctx, size);
+    uint32_t n = r->curves.count;
+    free(r->flat_lines);
+    free(r->flat_xy);
+    free(r->bulges);
+    r->flat_lines = NULL;
+    r->flat_xy = NULL;
+    r->bulges = calloc(n ? n : 1, sizeof *r->bulges);
+    if (!r->bulges)
         return complain(EXIT_INPUT, "out of memory");
-    for (uint32_t i = 0; i < n; i++)
-        if ((st = polyc_get_polyline(ctx, i, &r->lines[i])) != POLYC_OK)
-            return library_fail("get polyline", st, ctx, size);
-    if (!o->no_arcs) {         /* the round things: polyc_find_circles */
-        if ((st = polyc_find_circles(ctx)) != POLYC_OK)
-            return library_fail("find circles", st, ctx, size);
-        r->circles = calloc(n ? n : 1, sizeof *r->circles);
-        if (!r->circles)
+    const polyc_polyline *lines = r->curves.lines;
+    const polyc_circle *circles = r->curves.circ;
+    if (o->max_chord_m > 0.0) {  /* lines only, each curve within the error */
+        if (curves_flatten(&r->curves, o->max_chord_m, &r->flat_lines, &r->flat_xy) != 0)
             return complain(EXIT_INPUT, "out of memory");
-        r->circle_count = 0;
-        for (uint32_t i = 0; i < n; i++) {
-            if ((st = polyc_get_circle(ctx, i, &r->circles[i])) != POLYC_OK)
-                return library_fail("get circle", st, ctx, size);
-            r->circle_count += r->circles[i].radius_m > 0.0f;
-        }
-        int rc = o->max_chord_m > 0.0 ? circles_as_polygons(o, r, n) : 0;
-        if (rc)
-            return rc;
+        lines = r->flat_lines;
+        circles = NULL;
+    } else {
+        for (uint32_t i = 0; i < n; i++)
+            r->bulges[i] = curves_bulges(&r->curves, i);
     }
     memset(map, 0, sizeof *map);
-    map->lines = r->lines;
+    map->lines = lines;
     map->line_count = n;
-    map->circles = r->circles;
+    map->circles = circles;
+    map->bulges = o->max_chord_m > 0.0 ? NULL : r->bulges;
     map->scans = o->points ? r->log.scans : NULL;
     map->scan_count = r->log.count;
     map->grid = o->grid ? ctx : NULL;

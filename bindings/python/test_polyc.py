@@ -356,6 +356,20 @@ class Circles(unittest.TestCase):
             self.assertTrue(all(abs(math.hypot(x - c.center[0], y - c.center[1]) - c.radius)
                                 <= c.polyline_dev + 1e-6 for x, y in line.points))
 
+    def test_arc_polylines(self):
+        scans = pillar_scans()
+        ctx = polyc.Context((len(scans), 361 * len(scans), 1 << 20, 0))
+        for s in scans:
+            ctx.add_scan(*s)
+        ctx.build()
+        lines, arcs = ctx.polylines(), ctx.arc_polylines()
+        self.assertEqual(len(lines), len(arcs))
+        for line, a in zip(lines, arcs):
+            self.assertLessEqual(len(a.points), len(line.points))
+            self.assertEqual(len(a.bulges), len(a.points) if a.closed else len(a.points) - 1)
+            self.assertTrue(all(-1 < b < 1 for b in a.bulges))
+            self.assertTrue(set(a.points.tolist()) <= set(line.points.tolist()))
+
     def test_online_pillar(self):
         scans = pillar_scans()
         m = polyc.OnlineMap(12.0, 361)
@@ -471,8 +485,9 @@ class Grid(unittest.TestCase):
 
 
 def tool_json(*args):
-    """The polyc tool's JSON map of args."""
-    out = subprocess.run([TOOL, "--format", "json"] + list(args), capture_output=True,
+    """The polyc tool's JSON map of args, polylines only (--no-arcs: build_map's
+    Result holds the polylines as the library gives them)."""
+    out = subprocess.run([TOOL, "--format", "json", "--no-arcs"] + list(args), capture_output=True,
                          text=True, check=True).stdout
     return json.loads(out)
 

@@ -346,7 +346,7 @@ static polyc_status remap_taken_tiles(polyc_ctx *ctx, uint64_t work, int all, ui
 polyc_status polyc__online_round(polyc_ctx *ctx, uint64_t work, int all, uint64_t *spent)
 {
     size_t mark = ctx->arena.used;
-    ctx->flat.circ_n = 0; /* (polyc_find_circles: the map changes under them) */
+    ctx->flat.circ_n = ctx->flat.arc_n = 0; /* (polyc_find_curves: the map changes) */
     polyc_status st = remap_taken_tiles(ctx, work, all, spent);
     ctx->arena.used = mark;
     ctx->online->scr.cells = NULL;

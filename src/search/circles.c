@@ -7,8 +7,8 @@
  * radius and how far that polyline strays from it. The polylines stay as
  * they are (what a caller that knows only vertices reads), and so do the
  * BIC and error the statistics give: those of the polylines. */
-#include "../cost.h"
 #include "../optimize.h"
+#include "round.h"
 
 #include <math.h>
 
@@ -27,52 +27,30 @@ typedef struct circle_fit {
     float w;                       /* their endpoints */
 } circle_fit;
 
-/* The buckets that hold a polyline's points: its vertices' box, R wider. */
-typedef struct bucket_box {
-    int32_t x0, y0, x1, y1;
-} bucket_box;
-
-static bucket_box line_buckets(const polyc__opt *o, int32_t l)
+/* The buckets that hold a polyline's points: its vertices' box. */
+static polyc__bucket_box line_buckets(const polyc__opt *o, int32_t l)
 {
     const polyc__line *ln = &o->s->l[l];
     float lo_x = INFINITY, lo_y = INFINITY, hi_x = -INFINITY, hi_y = -INFINITY;
     int32_t v = ln->head;
-    bucket_box bb;
     for (int32_t k = 0; k < ln->count; k++, v = o->s->v[v].next) {
         lo_x = fminf(lo_x, o->s->v[v].x);
         lo_y = fminf(lo_y, o->s->v[v].y);
         hi_x = fmaxf(hi_x, o->s->v[v].x);
         hi_y = fmaxf(hi_y, o->s->v[v].y);
     }
-    polyc__bucket_xy(&o->h, lo_x - o->R, lo_y - o->R, &bb.x0, &bb.y0);
-    polyc__bucket_xy(&o->h, hi_x + o->R, hi_y + o->R, &bb.x1, &bb.y1);
-    return bb;
+    return polyc__box_buckets(o, lo_x, lo_y, hi_x, hi_y);
 }
 
-/* Every point i in the buckets of bb whose nearest segment is one of line
- * l's (points are stored sorted by bucket). */
+/* Every point i of bb whose nearest segment is one of line l's. */
 #define FOR_LINE_POINTS(o, bb, l, i)                                                             \
-    for (int32_t i##_y = (bb).y0; i##_y <= (bb).y1; i##_y++)                                      \
-        for (int32_t i##_x = (bb).x0; i##_x <= (bb).x1; i##_x++)                                  \
-            for (uint32_t i = (o)->h.pt_start[i##_y * (o)->h.bx + i##_x];                         \
-                 i < (o)->h.pt_start[i##_y * (o)->h.bx + i##_x + 1]; i++)                         \
-                if ((o)->d.pt_seg[i] != POLYC__NONE && (o)->s->v[(o)->d.pt_seg[i]].line == (l))
+    POLYC__FOR_BOX_POINTS(o, bb, i)                                                               \
+    if ((o)->d.pt_seg[i] != POLYC__NONE && (o)->s->v[(o)->d.pt_seg[i]].line == (l))
 
-/* A point's cost against the circle (cx, cy, r) about the origin: its
- * endpoints' squared distances, taken across the circle at their mean (the
- * tangent there stands for the arc over a cell), capped as a segment's. */
+/* A point's cost against the fitted circle, capped as a segment's. */
 static float circle_cost(const polyc__opt *o, const polyc__point *p, const circle_fit *f)
 {
-    float dx = (p->x - f->ox) - f->cx, dy = (p->y - f->oy) - f->cy;
-    float d = sqrtf(dx * dx + dy * dy);
-    float c;
-    if (d < 1e-9f) {
-        c = p->w * f->r * f->r + p->cxx + p->cyy;
-    } else {
-        float nx = dx / d, ny = dy / d, e = d - f->r;
-        c = p->w * e * e + nx * nx * p->cxx + 2.0f * nx * ny * p->cxy + ny * ny * p->cyy;
-    }
-    c = c > 0.0f ? c : 0.0f;
+    float c = polyc__ring_cost(p, f->ox + f->cx, f->oy + f->cy, f->r);
     float cap = polyc__point_cap(o, p);
     return c < cap ? c : cap;
 }
@@ -117,7 +95,7 @@ static int solve3(float a[3][3], float b[3], float x[3])
  * back would be a run without data)? Bins of at most half the gap round the
  * circle; the longest run of empty ones decides. */
 #define COVER_BINS 1024
-static int covered_round(const polyc__opt *o, bucket_box bb, int32_t l, const circle_fit *f)
+static int covered_round(const polyc__opt *o, polyc__bucket_box bb, int32_t l, const circle_fit *f)
 {
     uint8_t hit[COVER_BINS] = {0};
     float gap = o->cfg->split_gap_m, need = 2.0f * 3.14159265f * f->r / (0.5f * gap);
@@ -143,7 +121,7 @@ static int covered_round(const polyc__opt *o, bucket_box bb, int32_t l, const ci
  * not make a circle. */
 static int fit_circle(const polyc__opt *o, int32_t l, circle_fit *f)
 {
-    const bucket_box bb = line_buckets(o, l);
+    const polyc__bucket_box bb = line_buckets(o, l);
     /* the mean about the first point, so that float keeps its resolution */
     float sw = 0.0f, sx = 0.0f, sy = 0.0f, x0 = 0.0f, y0 = 0.0f;
     int first = 1;
@@ -248,7 +226,7 @@ static float polygon_dev(const polyc__opt *o, int32_t l, const circle_fit *f)
 static int clear_of_others(const polyc__opt *o, int32_t l, const circle_fit *f)
 {
     float cx = f->ox + f->cx, cy = f->oy + f->cy, reach = f->r + CLEAR_M;
-    bucket_box bb;
+    polyc__bucket_box bb;
     polyc__bucket_xy(&o->h, cx - reach - o->R, cy - reach - o->R, &bb.x0, &bb.y0);
     polyc__bucket_xy(&o->h, cx + reach + o->R, cy + reach + o->R, &bb.x1, &bb.y1);
     for (int32_t by = bb.y0; by <= bb.y1; by++)

@@ -243,7 +243,7 @@ polyc_status polyc__search(polyc__opt *o, polyc_progress_fn progress, void *user
     polyc_ctx *ctx = o->ctx;
     polyc_status st;
     const polyc_config *cfg = o->cfg;
-    ctx->flat.circ_n = 0; /* (the map changes under them) */
+    ctx->flat.circ_n = ctx->flat.arc_n = 0; /* (the map changes under them) */
     polyc__flat_from_store(&o->best, o->s);
     polyc__size_forget(o);
     float best = polyc__bic(o);
@@ -338,12 +338,14 @@ polyc_status polyc__search(polyc__opt *o, polyc_progress_fn progress, void *user
     return result;
 }
 
-polyc_status polyc__find_circles(polyc_ctx *ctx)
+polyc_status polyc__find_curves(polyc_ctx *ctx)
 {
     polyc__opt o;
     polyc_status st = polyc__opt_setup(ctx, &o);
-    if (st == POLYC_OK)
+    if (st == POLYC_OK) {
         polyc__circles_select(&o);
+        polyc__arcs_select(&o);
+    }
     return st;
 }
 

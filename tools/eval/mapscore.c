@@ -41,82 +41,128 @@ static const char usage_text[] =
     "draws a wall as a band.\n"
     "Exit: 0 ok; 1 the log, the map or the library failed; 2 usage.\n";
 
-/* The polylines of a TXT map: "open|closed N x1 y1 ... xN yN" or "circle
- * X Y R" per line; a circle is a polyline of no points whose *circ entry
- * holds it (*circ parallel to *lines). *lines, *circ and each xy_m are
- * malloc'ed (free_lines). -1 with a message on stderr when the file is not
- * such a map. */
-static int read_txt_map(const char *path, polyc_polyline **lines, polyc_circle **circ,
-                        uint32_t *count)
+/* Adds n floats of v to the growing array *a (*len of *cap). 0 or -1. */
+static int push(float **a, size_t *len, size_t *cap, const float *v, size_t n)
+{
+    if (*len + n > *cap) {
+        size_t c = *cap ? *cap : 1024;
+        while (c < *len + n)
+            c *= 2;
+        float *q = realloc(*a, c * sizeof *q);
+        if (!q)
+            return -1;
+        *a = q;
+        *cap = c;
+    }
+    memcpy(*a + *len, v, n * sizeof *v);
+    *len += n;
+    return 0;
+}
+
+/* One line's polyline or circle, the m->count-th, into m (its points
+ * from *xy_len on). 0, or -1 when the line is not one. */
+static int read_item(char *p, curves_map *m, size_t *xy_len, size_t *xy_cap, size_t *b_len,
+                     size_t *b_cap)
+{
+    char *end, word[16];
+    int used = 0;
+    polyc_polyline *pl = &m->lines[m->count];
+    polyc_circle *cc = &m->circ[m->count];
+    memset(pl, 0, sizeof *pl);
+    memset(cc, 0, sizeof *cc);
+    if (sscanf(p, "%15s%n", word, &used) != 1)
+        return -1;
+    p += used;
+    if (strcmp(word, "circle") == 0) {
+        if (sscanf(p, "%f %f %f", &cc->center_x_m, &cc->center_y_m, &cc->radius_m) != 3 ||
+            !(cc->radius_m > 0.0f))
+            return -1;
+        m->circles++;
+        return 0;
+    }
+    unsigned long n = strtoul(p, &end, 10);
+    if ((strcmp(word, "open") != 0 && strcmp(word, "closed") != 0) || end == p || n == 0 ||
+        n > 100000000ul)
+        return -1;
+    p = end;
+    for (unsigned long k = 0; k < 2u * n; k++) {
+        float v = strtof(p, &end);
+        if (end == p || push(&m->xy, xy_len, xy_cap, &v, 1) != 0)
+            return -1;
+        p = end;
+    }
+    pl->point_count = (uint32_t)n;
+    pl->closed = strcmp(word, "closed") == 0;
+    /* the bulges, one a segment (the closing one too), padded to one a point */
+    unsigned long nb = 0, want = pl->closed ? n : n - 1;
+    float b = 0.0f;
+    while (*p == ' ')
+        p++;
+    if (strncmp(p, "bulges", 6) == 0)
+        for (p += 6; nb < want; nb++, p = end) {
+            b = strtof(p, &end);
+            if (end == p || push(&m->bulge, b_len, b_cap, &b, 1) != 0)
+                return -1;
+            m->arcs += b != 0.0f;
+        }
+    for (b = 0.0f; nb < n; nb++)
+        if (push(&m->bulge, b_len, b_cap, &b, 1) != 0)
+            return -1;
+    while (*p == ' ' || *p == '\n' || *p == '\r')
+        p++;
+    return *p ? -1 : 0;
+}
+
+/* A TXT map (docs/formats.md) into m: per line "open|closed N x1 y1 ...
+ * xN yN [bulges b1 ...]" or "circle X Y R" (a polyline of no points whose
+ * m->circ entry holds it). -1 with a message on stderr when the file is
+ * not such a map (curves_free either way). */
+static int read_txt_map(const char *path, curves_map *m)
 {
     FILE *f = fopen(path, "r");
-    char word[16];
-    uint32_t cap = 0;
-    int c;
-    *lines = NULL;
-    *circ = NULL;
-    *count = 0;
+    char *line = NULL;
+    size_t line_cap = 0, xy_len = 0, xy_cap = 0, b_len = 0, b_cap = 0;
+    uint32_t cap = 0, *first = NULL;
+    int rc = -1;
+    memset(m, 0, sizeof *m);
     if (!f) {
         fprintf(stderr, "mapscore: %s: %s\n", path, strerror(errno));
         return -1;
     }
-    while (fscanf(f, "%15s", word) == 1) {
-        polyc_polyline *pl;
-        unsigned long n, k;
-        float *xy;
-        int is_circle = strcmp(word, "circle") == 0;
-        if (*count == cap) {
-            polyc_polyline *p = realloc(*lines, (cap ? 2u * cap : 64u) * sizeof *p);
-            if (p)
-                *lines = p;
-            polyc_circle *q = realloc(*circ, (cap ? 2u * cap : 64u) * sizeof *q);
-            if (q)
-                *circ = q;
-            if (!p || !q)
-                goto bad;
-            cap = cap ? 2u * cap : 64u;
-        }
-        memset(&(*circ)[*count], 0, sizeof **circ);
-        if (is_circle) {
-            polyc_circle *cc = &(*circ)[*count];
-            if (fscanf(f, "%f %f %f", &cc->center_x_m, &cc->center_y_m, &cc->radius_m) != 3 ||
-                !(cc->radius_m > 0.0f))
-                goto bad;
-            memset(&(*lines)[(*count)++], 0, sizeof **lines);
+    while (getline(&line, &line_cap, f) > 0) {
+        if (strspn(line, " \t\r\n") == strlen(line))
             continue;
+        if (m->count == cap) {
+            cap = cap ? 2u * cap : 64u;
+            polyc_polyline *l = realloc(m->lines, cap * sizeof *l);
+            if (l)
+                m->lines = l;
+            polyc_circle *c = realloc(m->circ, cap * sizeof *c);
+            if (c)
+                m->circ = c;
+            uint32_t *q = realloc(first, cap * sizeof *q);
+            if (q)
+                first = q;
+            if (!l || !c || !q)
+                goto done;
         }
-        if ((strcmp(word, "open") != 0 && strcmp(word, "closed") != 0) ||
-            fscanf(f, "%lu", &n) != 1 || n == 0 || n > 100000000ul)
-            goto bad;
-        xy = malloc(2u * n * sizeof *xy);
-        if (!xy)
-            goto bad;
-        pl = &(*lines)[(*count)++];
-        memset(pl, 0, sizeof *pl);
-        pl->xy_m = xy;
-        pl->point_count = (uint32_t)n;
-        pl->closed = strcmp(word, "closed") == 0;
-        for (k = 0; k < 2u * n; k++)
-            if (fscanf(f, "%f", &xy[k]) != 1)
-                goto bad;
+        first[m->count] = (uint32_t)(xy_len / 2);
+        if (read_item(line, m, &xy_len, &xy_cap, &b_len, &b_cap) != 0)
+            goto done;
+        m->count++;
     }
-    c = fgetc(f);
-    if (c != EOF || ferror(f))
-        goto bad;
+    if (ferror(f))
+        goto done;
+    for (uint32_t i = 0; i < m->count; i++) /* (the points moved while growing) */
+        m->lines[i].xy_m = m->xy ? m->xy + 2u * first[i] : NULL;
+    rc = 0;
+done:
+    if (rc != 0)
+        fprintf(stderr, "mapscore: %s: not a TXT map (polyline %u)\n", path, m->count);
+    free(first);
+    free(line);
     fclose(f);
-    return 0;
-bad:
-    fprintf(stderr, "mapscore: %s: not a TXT map (polyline %u)\n", path, *count);
-    fclose(f);
-    return -1;
-}
-
-static void free_lines(polyc_polyline *lines, uint32_t count, int owned_points)
-{
-    uint32_t i;
-    for (i = 0; owned_points && i < count; i++)
-        free((void *)lines[i].xy_m);
-    free(lines);
+    return rc;
 }
 
 /* The runs band15 counts, kept for printing after the row. */
@@ -148,9 +194,7 @@ int main(int argc, char **argv)
 {
     scanlog log;
     pipeline p;
-    polyc_polyline *lines = NULL, *scored = NULL;
-    polyc_circle *circ = NULL;
-    float *circ_xy = NULL;
+    gtround_map m;
     uint32_t params = 0, arcs = 0, circles = 0;
     uint32_t count = 0, verts = 0, i;
     gttopo_score topo;
@@ -177,6 +221,7 @@ int main(int argc, char **argv)
     }
     memset(&log, 0, sizeof log);
     memset(&p, 0, sizeof p);
+    memset(&m, 0, sizeof m);
     f = fopen(argv[1], "r");
     if (!f) {
         fprintf(stderr, "mapscore: %s: %s\n", argv[1], strerror(errno));
@@ -189,7 +234,7 @@ int main(int argc, char **argv)
     }
     fclose(f);
     if (from_file) {
-        if (read_txt_map(argv[2], &lines, &circ, &count) != 0)
+        if (read_txt_map(argv[2], &m.map) != 0)
             goto done;
     } else {
         polyc_config config;
@@ -197,8 +242,7 @@ int main(int argc, char **argv)
         polyc_config_default(&config);
         if (pipeline_open(&p, &config, log.scans, log.count) != 0 ||
             pipeline_run(&p, log.scans, log.count, times) != 0 ||
-            (lines = pipeline_lines(&p, &count)) == NULL ||
-            (circ = pipeline_circles(&p, count)) == NULL) {
+            (p.status = gtround_from_ctx(p.ctx, &m)) != POLYC_OK) {
             fprintf(stderr, "mapscore: error in %s: %s (%s)\n",
                     p.failed_at ? p.failed_at : "pipeline_lines", polyc_status_str(p.status),
                     p.ctx ? polyc_last_error(p.ctx) : "");
@@ -207,12 +251,17 @@ int main(int argc, char **argv)
         for (i = 0; i < PIPELINE_STAGES; i++)
             lib_ms += times[i];
     }
-    /* a circle is scored as itself (a fine polygon) and counted as 3 numbers */
-    if (gtround_lines(lines, circ, count, &scored, &circ_xy) != 0) {
-        fprintf(stderr, "mapscore: out of memory\n");
-        goto done;
+    /* a circle or an arc is scored as itself (a fine polyline) and counted
+     * as 3 numbers or 1 more */
+    if (from_file) {
+        if (gtround_score(&m) != 0) {
+            fprintf(stderr, "mapscore: out of memory\n");
+            goto done;
+        }
     }
-    gtround_params(lines, circ, count, &verts, &params, &arcs, &circles);
+    count = m.count;
+    gtround_params(&m, &verts, &params, &arcs, &circles);
+    const polyc_polyline *scored = m.scored;
     t0 = pipeline_now_ms();
     if (gtband_scan_points(log.scans, log.count, &xy, &from, &n) != 0 ||
         gttopo_score_map(scored, count, xy, n, &topo) != 0 ||
@@ -245,10 +294,7 @@ done:
     free(runs.xy_len);
     free(xy);
     free(from);
-    free_lines(lines, count, from_file);
-    free(circ);
-    free(scored);
-    free(circ_xy);
+    gtround_free(&m);
     pipeline_close(&p);
     scanlog_free(&log);
     return rc;

@@ -212,24 +212,6 @@ int pipeline_run_online_wider(pipeline *p, const polyc_config *config, const pol
     return 0;
 }
 
-polyc_circle *pipeline_circles(pipeline *p, uint32_t count)
-{
-    uint32_t i;
-    polyc_circle *circ = calloc(count ? count : 1u, sizeof *circ);
-    if (!circ)
-        return NULL;
-    if (step(p, polyc_find_circles(p->ctx), "polyc_find_circles")) {
-        free(circ);
-        return NULL;
-    }
-    for (i = 0; i < count; i++)
-        if (step(p, polyc_get_circle(p->ctx, i, &circ[i]), "polyc_get_circle")) {
-            free(circ);
-            return NULL;
-        }
-    return circ;
-}
-
 polyc_polyline *pipeline_lines(pipeline *p, uint32_t *count)
 {
     uint32_t i, n = polyc_polyline_count(p->ctx);

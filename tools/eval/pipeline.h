@@ -73,9 +73,6 @@ int pipeline_run_online_wider(pipeline *p, const polyc_config *config, const pol
                               uint32_t n, double wider_m, double *ms);
 /* The current map as an array of polylines (malloc'ed; NULL on failure). */
 polyc_polyline *pipeline_lines(pipeline *p, uint32_t *count);
-/* Per polyline of the map (count of them, as pipeline_lines gave), its
- * circle (polyc_get_circle; radius 0: none); malloc'ed, NULL on failure. */
-polyc_circle *pipeline_circles(pipeline *p, uint32_t count);
 
 /* A monotonic clock in milliseconds, and a qsort comparison of doubles
  * (the bench's and the sweep's medians). */

@@ -217,38 +217,26 @@ typedef struct row {
 
 /* ---- one scene -------------------------------------------------------------- */
 
-/* A map as the scorers take it: its polylines, a circle's as a fine
- * polygon (gtround.h), and per polyline its circle (radius 0: none). */
-typedef struct map_view {
-    polyc_polyline *lines;
-    polyc_circle *circ;
-    float *xy;                 /* the circles' polygons' points */
-    uint32_t count;
-} map_view;
+/* A map as the scorers take it (gtround.h): the library's polylines in
+ * their arc form, their circles, and the curves as fine polylines. */
+typedef gtround_map map_view;
 
 static void map_free(map_view *m)
 {
-    free(m->lines);
-    free(m->circ);
-    free(m->xy);
-    memset(m, 0, sizeof *m);
+    gtround_free(m);
 }
 
 /* The pipeline's map into m (freed first); 0, or -1 (the pipeline's
- * failed_at says where, or out of memory). */
+ * failed_at says where). */
 static int map_get(pipeline *p, map_view *m)
 {
-    polyc_polyline *raw;
+    polyc_status st;
     map_free(m);
-    if ((raw = pipeline_lines(p, &m->count)) == NULL)
-        return -1;
-    if ((m->circ = pipeline_circles(p, m->count)) == NULL ||
-        gtround_lines(raw, m->circ, m->count, &m->lines, &m->xy) != 0) {
-        free(raw);
-        map_free(m);
+    if ((st = gtround_from_ctx(p->ctx, m)) != POLYC_OK) {
+        p->status = st;
+        p->failed_at = "polyc_find_curves";
         return -1;
     }
-    free(raw);
     return 0;
 }
 
@@ -314,7 +302,7 @@ static double grid_completeness(const gtscore_truth *truth, const polyc_occupanc
 static int score_scene(const scansim_scene *sc, const gtscore_truth *truth, const map_view *m,
                        double pipeline_ms, const polyc_occupancy_grid *grid, row *r)
 {
-    const polyc_polyline *lines = m->lines;
+    const polyc_polyline *lines = m->scored;
     uint32_t count = m->count, verts, params, arcs, circles;
     gtscore_map_score score;
     gttopo_score topo;
@@ -348,7 +336,7 @@ static int score_scene(const scansim_scene *sc, const gtscore_truth *truth, cons
     r->fig[FIG_MS] = pipeline_ms;
     /* the vertices and parameters of the map as the library gives it (a
      * circle is three numbers, not its scoring polygon) */
-    gtround_params(lines, m->circ, count, &verts, &params, &arcs, &circles);
+    gtround_params(m, &verts, &params, &arcs, &circles);
     score.vertices = verts;
     score.params = params;
     r->fig[FIG_VERTS] = verts;
@@ -677,7 +665,7 @@ static int sweep_scene(const options *o, const char *kind, uint64_t seed, row *r
                  kind, (unsigned long long)seed);
         if (o->save_dir && scansim_save(&sc, log_path, gt_path) != 0)
             fprintf(stderr, "sweep: cannot write %s: %s\n", log_path, strerror(errno));
-        if (o->svg_dir && write_svg(svg_path, &sc, &truth, m.lines, m.count,
+        if (o->svg_dir && write_svg(svg_path, &sc, &truth, m.scored, m.count,
                                     o->occupancy ? &grid : NULL) != 0)
             fprintf(stderr, "sweep: cannot write %s: %s\n", svg_path, strerror(errno));
     }

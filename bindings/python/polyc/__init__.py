@@ -62,7 +62,7 @@ __all__ = ["PolycError", "ResyncError", "Scan", "Points", "Polyline", "Result", 
            "build_map", "build_map_from_grid", "grid_image", "read_log", "read_map", "online_area",
            "default_config",
            "version", "STATUS", "FLAG_EXACT_POINTS", "FLAG_NO_GRAZING", "FLAG_GRID_TRACE",
-           "FLAG_NO_ARCS", "ONLINE_WORK_DEFAULT", "CHANGE_KINDS", "Circle"]
+           "FLAG_NO_ARCS", "ONLINE_WORK_DEFAULT", "CHANGE_KINDS", "Circle", "ArcPolyline"]
 
 # polyc_status, append-only like the C enum
 STATUS = {0: "POLYC_OK", 1: "POLYC_ERR_NULL", 2: "POLYC_ERR_CONFIG", 3: "POLYC_ERR_NOMEM",
@@ -238,7 +238,8 @@ def _load():
         "polyc_polyline_count": (_u32, [ctx]),
         "polyc_get_polyline": (st, [ctx, _u32, P(_Polyline)]),
         "polyc_get_stats": (st, [ctx, P(_Stats)]),
-        "polyc_find_circles": (st, [ctx]),
+        "polyc_find_curves": (st, [ctx]),
+        "polyc_copy_arcs": (st, [ctx, _u32, P(_f32), P(_f32), _u32, P(_u32), P(_u32)]),
         "polyc_get_circle": (st, [ctx, _u32, P(_Circle)]),
         "polyc_score": (st, [ctx, P(_f64), P(_f64)]),
         "polyc_last_error": (ctypes.c_char_p, [ctx]),
@@ -436,12 +437,22 @@ class Polyline(NamedTuple):
 
 class Circle(NamedTuple):
     """A polyline of the map that the BIC prefers as a circle
-    (polyc_find_circles): `index` into polylines, the centre (x, y) and
+    (polyc_find_curves): `index` into polylines, the centre (x, y) and
     radius in metres, and how far that polyline strays from the circle."""
     index: int
     center: tuple
     radius: float
     polyline_dev: float
+
+
+class ArcPolyline(NamedTuple):
+    """A polyline with its arcs (polyc_copy_arcs): the vertices that bound a
+    straight segment or an arc, and per segment its bulge (tan of a quarter
+    of the arc's angle, > 0 counter-clockwise, 0 straight; as DXF's
+    LWPOLYLINE), one fewer than the points for an open polyline."""
+    points: Points
+    bulges: tuple
+    closed: bool
 
 
 class Result(NamedTuple):
@@ -721,8 +732,23 @@ class _Block:
             out.append(Polyline(Points(array("d", map(_shortest, raw))), bool(pl.closed)))
         return out
 
+    def _arc_polylines(self):
+        self._check(_lib.polyc_find_curves(self._ctx), "find curves")
+        out = []
+        for i in range(_lib.polyc_polyline_count(self._ctx)):
+            n, closed = _u32(), _u32()
+            self._check(_lib.polyc_copy_arcs(self._ctx, i, None, None, 0, ctypes.byref(n), None),
+                        "copy arcs")
+            xy, bul = (_f32 * (2 * n.value + 2))(), (_f32 * (n.value + 1))()
+            self._check(_lib.polyc_copy_arcs(self._ctx, i, xy, bul, n.value, ctypes.byref(n),
+                                             ctypes.byref(closed)), "copy arcs")
+            pts = Points(array("d", map(_shortest, xy[:2 * n.value])))
+            nb = n.value if closed.value else max(n.value - 1, 0)
+            out.append(ArcPolyline(pts, tuple(_shortest(b) for b in bul[:nb]), bool(closed.value)))
+        return out
+
     def _find_circles(self):
-        self._check(_lib.polyc_find_circles(self._ctx), "find circles")
+        self._check(_lib.polyc_find_curves(self._ctx), "find circles")
         out = []
         for i in range(_lib.polyc_polyline_count(self._ctx)):
             c = _Circle()
@@ -829,9 +855,16 @@ class Context(_Block):
 
     def circles(self):
         """The polylines of the current map that are circles (round things:
-        polyc_find_circles), a list of Circle; none with flags FLAG_NO_ARCS."""
+        polyc_find_curves), a list of Circle; none with flags FLAG_NO_ARCS."""
         with self._use("circles"):
             return self._find_circles()
+
+    def arc_polylines(self):
+        """The current map with its arcs (polyc_find_curves, polyc_copy_arcs):
+        a list of ArcPolyline in the order of polylines(); every bulge 0 with
+        flags FLAG_NO_ARCS."""
+        with self._use("arc polylines"):
+            return self._arc_polylines()
 
     def grid_image(self):
         """The hit/miss grid (run build_grid first) as the image `polyc grid`
@@ -1006,9 +1039,16 @@ class OnlineMap(_Block):
     @property
     def circles(self):
         """The polylines of the map as it stands that are circles
-        (polyc_find_circles), a list of Circle, as Context.circles gives."""
+        (polyc_find_curves), a list of Circle, as Context.circles gives."""
         with self._use("circles"):
             return self._find_circles()
+
+    @property
+    def arc_polylines(self):
+        """The map as it stands with its arcs, a list of ArcPolyline, as
+        Context.arc_polylines gives."""
+        with self._use("arc polylines"):
+            return self._arc_polylines()
 
     @property
     def polyline_ids(self):

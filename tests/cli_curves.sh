@@ -1,11 +1,11 @@
 #!/bin/sh
-# cli_circles.sh - round things in the tool's outputs (docs/formats.md): a
-# pillar hall simulated by gen_example, mapped batch and --online; its
-# pillars come out as JSON "circles", TXT `circle` lines and SVG <circle>
-# elements; --no-arcs and --max-chord-error E write polylines only (the
-# latter each circle as a closed polyline within E of it); a bad E is a
-# usage error.
-#   tests/cli_circles.sh POLYC GEN_EXAMPLE
+# cli_curves.sh - round things in the tool's outputs (docs/formats.md): a
+# pillar hall and a room of curved walls simulated by gen_example, mapped
+# batch and --online; pillars come out as JSON "circles", TXT `circle` lines
+# and SVG <circle> elements, curved walls as "bulges", TXT `bulges` and SVG
+# arcs; --no-arcs and --max-chord-error E write polylines only (the latter
+# each curve as a polyline within E of it); a bad E is a usage error.
+#   tests/cli_curves.sh POLYC GEN_EXAMPLE
 set -u
 [ $# -eq 2 ] || { echo "usage: $0 POLYC GEN_EXAMPLE" >&2; exit 2; }
 case $1 in /*) POLYC=$1 ;; *) POLYC=$(pwd)/$1 ;; esac
@@ -17,7 +17,7 @@ run() {
     timeout 120 "$POLYC" --quiet "$@" > out.txt 2> err.txt
     rc=$?
 }
-"$GEN" hall.log hall.gt.txt pillars 1 > /dev/null || { echo "cli_circles: gen_example failed"; exit 1; }
+"$GEN" hall.log hall.gt.txt pillars 1 > /dev/null || { echo "cli_curves: gen_example failed"; exit 1; }
 
 # JSON: the circles beside the polylines, none of them also a polyline
 name=json
@@ -46,11 +46,62 @@ run -o map.svg hall.log
 [ $rc -eq 0 ] && [ "$(grep -c '^<circle stroke=' map.svg)" = "$circles" ] && grep -q "$circles circles" map.svg ||
     bad "exit $rc, or not $circles <circle> elements"
 
-# --stats: how many of the polylines are circles
+# --stats: the circles and arcs
 name=stats
 run --stats -o stats.svg hall.log
-[ $rc -eq 0 ] && grep -q "^circles        $circles of the polylines\$" err.txt ||
-    bad "exit $rc, or no line 'circles $circles of the polylines'"
+[ $rc -eq 0 ] && grep -q "^curves         $circles circles, [0-9]* arcs\$" err.txt ||
+    bad "exit $rc, or no line 'curves $circles circles, N arcs'"
+
+# arcs: a room of curved walls; JSON "bulges" one a segment, TXT `bulges`,
+# SVG arcs; --max-chord-error: none, each arc within E of the polyline
+"$GEN" arcs.log arcs.gt.txt arcwalls 1 > /dev/null || { echo "cli_curves: gen_example failed"; exit 1; }
+name=arcs-json
+run --format json -o arcs.json arcs.log
+[ $rc -eq 0 ] && python3 - arcs.json <<'PY' || bad "exit $rc, or the JSON's bulges are wrong"
+import json, sys
+d = json.load(open(sys.argv[1]))
+with_arcs = [p for p in d["polylines"] if "bulges" in p]
+assert with_arcs, "no arc"
+for p in with_arcs:
+    n = len(p["points"])
+    assert len(p["bulges"]) == (n if p["closed"] else n - 1), p
+    assert all(-1.0 < b < 1.0 for b in p["bulges"]) and any(b != 0 for b in p["bulges"])
+PY
+name=arcs-txt
+run --format txt -o arcs.txt arcs.log
+[ $rc -eq 0 ] && grep -q '^\(open\|closed\) [0-9]* .* bulges -\{0,1\}[0-9]\.[0-9]\{6\}' arcs.txt ||
+    bad "exit $rc, or no TXT line with bulges"
+name=arcs-svg
+run -o arcs.svg arcs.log
+[ $rc -eq 0 ] && grep -q '^<path stroke=[^>]* A[0-9.]* [0-9.]* 0 [01] [01] ' arcs.svg && grep -q ' arcs, ' arcs.svg ||
+    bad "exit $rc, or no SVG arc"
+name=arcs-max-chord-error
+run --max-chord-error 0.001 --format json -o arcs-lines.json arcs.log
+[ $rc -eq 0 ] && python3 - arcs-lines.json arcs.json <<'PY' || bad "exit $rc, or an arc not within 1 mm"
+import json, math, sys
+a, b = json.load(open(sys.argv[1])), json.load(open(sys.argv[2]))
+assert all("bulges" not in p for p in a["polylines"]) and "circles" not in a
+assert len(a["polylines"]) == len(b["polylines"]) + len(b.get("circles", []))
+def arc(p, q, bulge):
+    dx, dy = q[0] - p[0], q[1] - p[1]
+    c = math.hypot(dx, dy)
+    half = 2 * math.atan(abs(bulge))
+    r = c / (2 * math.sin(half))
+    s = 1 if bulge >= 0 else -1
+    d = r * math.cos(half)
+    return (p[0] + q[0]) / 2 + s * d * (-dy / c), (p[1] + q[1]) / 2 + s * d * (dx / c), r
+flat = [pt for p in a["polylines"] for pt in p["points"]]
+for p in b["polylines"]:
+    for k, bulge in enumerate(p.get("bulges", [])):
+        if bulge == 0:
+            continue
+        u, v = p["points"][k], p["points"][(k + 1) % len(p["points"])]
+        cx, cy, r = arc(u, v, bulge)
+        # the flattened polyline has points on the arc, its sides within 1 mm
+        on = [q for q in flat if abs(math.hypot(q[0] - cx, q[1] - cy) - r) < 2e-4 and
+              min(math.hypot(q[0] - u[0], q[1] - u[1]), math.hypot(q[0] - v[0], q[1] - v[1])) > 1e-3]
+        assert on, (u, v, bulge)
+PY
 
 # --online: the finished map's circles too
 name=online
@@ -94,5 +145,5 @@ name="no-arcs on polyc grid"
 run grid --no-arcs -o g hall.log
 [ $rc -eq 2 ] || bad "exit $rc, not 2"
 
-echo "cli_circles: $count runs, $failed failed"
+echo "cli_curves: $count runs, $failed failed"
 [ $failed -eq 0 ]
