@@ -168,6 +168,9 @@ typedef struct polyc_circle {
     float center_x_m, center_y_m;
     float radius_m;            /* 0: the polyline is no circle */
     float polyline_dev_m;
+    uint32_t same_as;          /* the polyline given as the circle: this one's
+                                  index, or for a ring the search left in
+                                  pieces one piece's, the same for all */
 } polyc_circle;
 
 typedef struct polyc_stats {
@@ -327,8 +330,10 @@ POLYC_API polyc_status polyc_copy_polyline(const polyc_ctx *ctx, uint32_t index,
 POLYC_API polyc_status polyc_find_curves(polyc_ctx *ctx);
 /* Whether polyline `index` is a circle (polyc_find_curves): out->radius_m
  * > 0 and its centre, or radius_m 0. polyc_get_polyline still gives the
- * polyline, which strays at most out->polyline_dev_m from the circle.
- * polyc_circle_count: how many of the polylines are circles. */
+ * polyline, which strays at most out->polyline_dev_m from the circle. A
+ * circle may stand for several polylines (the pieces of a ring): each gets
+ * it, with out->same_as the same piece's index for all. polyc_circle_count: how
+ * many circles there are (each once). */
 POLYC_API polyc_status polyc_get_circle(const polyc_ctx *ctx, uint32_t index, polyc_circle *out);
 POLYC_API uint32_t polyc_circle_count(const polyc_ctx *ctx);
 /* Polyline `index` with its arcs (polyc_find_curves): its vertices that

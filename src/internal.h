@@ -161,10 +161,11 @@ typedef struct polyc__store {
 } polyc__store;
 
 /* ---- flattened map, the form results are read in ---- */
-/* A closed polyline the BIC prefers as a circle (circles.c): its store
- * id, the circle (frame metres) and how far the polyline strays from it. */
+/* A polyline the BIC prefers as a circle, or one of the pieces a circle
+ * stands for (circles.c): its store id, the first piece's, the circle
+ * (frame metres) and how far the polyline strays from it. */
 typedef struct polyc__circle {
-    uint32_t line_id;
+    uint32_t line_id, first_id;
     float cx, cy, r, dev;
 } polyc__circle;
 

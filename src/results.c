@@ -65,10 +65,14 @@ polyc_status polyc_get_circle(const polyc_ctx *ctx, uint32_t index, polyc_circle
         return st != POLYC_OK ? st : POLYC_ERR_NULL;
     const polyc__circle *c = circle_of(ctx, index);
     memset(out, 0, sizeof *out);
+    out->same_as = index;
     if (c) {
         polyc__frame_point_out(ctx, c->cx, c->cy, &out->center_x_m, &out->center_y_m);
         out->radius_m = c->r;
         out->polyline_dev_m = c->dev;
+        for (uint32_t i = 0; i < ctx->flat.count; i++)
+            if (ctx->flat.id[i] == c->first_id)
+                out->same_as = i;
     }
     return POLYC_OK;
 }
@@ -76,8 +80,10 @@ polyc_status polyc_get_circle(const polyc_ctx *ctx, uint32_t index, polyc_circle
 uint32_t polyc_circle_count(const polyc_ctx *ctx)
 {
     uint32_t n = polyc_polyline_count(ctx), k = 0;
-    for (uint32_t i = 0; i < n; i++)
-        k += circle_of(ctx, i) != NULL;
+    for (uint32_t i = 0; i < n; i++) {
+        const polyc__circle *c = circle_of(ctx, i);
+        k += c && c->line_id == c->first_id;
+    }
     return k;
 }
 

@@ -248,8 +248,12 @@ static void run(polyc_ctx *ctx, scene *sc, result *r)
             polyc_circle c;
             CHECK(polyc_get_circle(ctx, i, &c) == POLYC_OK);
             CHECK(c.radius_m >= 0.0f && isfinite(c.radius_m));
+            CHECK(c.same_as < r->lines);
             if (c.radius_m > 0.0f) {
-                circles++;
+                polyc_circle first;
+                CHECK(polyc_get_circle(ctx, c.same_as, &first) == POLYC_OK);
+                CHECK(first.same_as == c.same_as && first.radius_m == c.radius_m);
+                circles += c.same_as == i;
                 CHECK(isfinite(c.center_x_m) && isfinite(c.center_y_m) && c.polyline_dev_m >= 0.0f);
             }
         }

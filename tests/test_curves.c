@@ -61,7 +61,7 @@ static void check_circles(const polyc_ctx *ctx, double turn)
     for (uint32_t i = 0; i < n; i++) {
         polyc_circle ci;
         check(polyc_get_circle(ctx, i, &ci), ctx, "polyc_get_circle");
-        if (!(ci.radius_m > 0.0f))
+        if (!(ci.radius_m > 0.0f) || ci.same_as != i)
             continue;
         found++;
         int match = -1;

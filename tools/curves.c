@@ -48,6 +48,8 @@ static uint32_t flat_points(const curves_map *m, uint32_t i, double sagitta_m, f
     const polyc_polyline *l = &m->lines[i];
     uint32_t n = 0;
     if (m->circ && m->circ[i].radius_m > 0.0f) {
+        if (m->circ[i].same_as != i) /* another piece of a circle: given at the first */
+            return 0;
         double r = (double)m->circ[i].radius_m;
         uint32_t sides = pieces(r, TWO_PI, sagitta_m);
         sides = sides < 8u ? 8u : sides;
@@ -132,7 +134,7 @@ polyc_status curves_from_ctx(polyc_ctx *ctx, int no_curves, curves_map *m)
         m->lines[i].xy_m = m->xy + 2u * at;
         m->lines[i].point_count = n;
         m->lines[i].closed = closed;
-        m->circles += m->circ[i].radius_m > 0.0f;
+        m->circles += m->circ[i].radius_m > 0.0f && m->circ[i].same_as == i;
         for (uint32_t k = 0; k < n; k++)
             m->arcs += m->bulge[at + k] != 0.0f;
         at += n;

@@ -34,9 +34,9 @@ void curves_free(curves_map *m);
 const float *curves_bulges(const curves_map *m, uint32_t i);
 
 /* m's polylines with every circle and arc as a polyline whose sides stray
- * at most sagitta_m from it (a circle: 8 sides or more): *out gets count
- * polylines, their points in *xy (the caller frees both). 0, or -1 out of
- * memory. */
+ * at most sagitta_m from it (a circle: 8 sides or more, at its first piece;
+ * its other pieces get no point): *out gets count polylines, their points
+ * in *xy (the caller frees both). 0, or -1 out of memory. */
 int curves_flatten(const curves_map *m, double sagitta_m, polyc_polyline **out, float **xy);
 
 /* The arc from a to b of bulge b as its centre, radius, start angle and

@@ -13,7 +13,18 @@
 /* Polyline i is written as a circle. */
 static const polyc_circle *circle_at(const mapout_map *map, uint32_t i)
 {
-    return map->circles && map->circles[i].radius_m > 0.0f ? &map->circles[i] : NULL;
+    return map->circles && map->circles[i].radius_m > 0.0f && map->circles[i].same_as == i
+               ? &map->circles[i]
+               : NULL;
+}
+
+/* Polyline i is written not at all: a piece of a circle given at its first
+ * piece, or a polyline of no points. */
+static int skipped(const mapout_map *map, uint32_t i)
+{
+    if (map->circles && map->circles[i].radius_m > 0.0f)
+        return map->circles[i].same_as != i;
+    return map->lines[i].point_count == 0;
 }
 
 /* The bulges of polyline i (NULL: straight segments only), and how many
@@ -32,6 +43,8 @@ int mapout_txt(FILE *f, const mapout_map *map)
     for (uint32_t i = 0; i < map->line_count; i++) {
         const polyc_polyline *pl = &map->lines[i];
         const polyc_circle *c = circle_at(map, i);
+        if (skipped(map, i))
+            continue;
         if (c) {
             fprintf(f, "circle %.4f %.4f %.4f\n", (double)c->center_x_m, (double)c->center_y_m,
                     (double)c->radius_m);
@@ -112,10 +125,10 @@ int mapout_json(FILE *f, const mapout_map *map)
     fputs("{\"polylines\": [", f);
     for (uint32_t i = 0; i < map->line_count; i++) {
         const polyc_polyline *pl = &map->lines[i];
-        if (circle_at(map, i)) {
+        if (circle_at(map, i))
             circles++;
+        if (circle_at(map, i) || skipped(map, i))
             continue;
-        }
         fprintf(f, "%s\n{\"closed\": %s, \"points\": [", written++ ? "," : "",
                 pl->closed ? "true" : "false");
         for (uint32_t j = 0; j < pl->point_count; j++)
@@ -256,15 +269,18 @@ static void make_view(const mapout_map *map, view *v)
     v->x0 = v->y0 = HUGE_VAL;
     v->x1 = v->y1 = -HUGE_VAL;
     uint64_t vertices = 0;
-    uint32_t circles = 0, arcs = 0;
+    uint32_t circles = 0, arcs = 0, drawn = 0;
     for (uint32_t i = 0; i < map->line_count; i++) {
         const polyc_circle *c = circle_at(map, i);
+        if (skipped(map, i))
+            continue;
         if (c) {
             circles++;
             box_add(v, (double)c->center_x_m - (double)c->radius_m, (double)c->center_y_m - (double)c->radius_m);
             box_add(v, (double)c->center_x_m + (double)c->radius_m, (double)c->center_y_m + (double)c->radius_m);
             continue;
         }
+        drawn++;
         vertices += map->lines[i].point_count;
         for (uint32_t j = 0; j < map->lines[i].point_count; j++)
             box_add(v, (double)map->lines[i].xy_m[2 * j], (double)map->lines[i].xy_m[2 * j + 1]);
@@ -332,7 +348,7 @@ static void make_view(const mapout_map *map, view *v)
     xml_name(name, sizeof name, map->title);
     snprintf(v->title, sizeof v->title, "%s", *name ? name : "polyc map");
     int n = snprintf(v->subtitle, sizeof v->subtitle, "%u polylines, %llu vertices",
-                     (unsigned)(map->line_count - circles), (unsigned long long)vertices);
+                     (unsigned)drawn, (unsigned long long)vertices);
     if (circles && n > 0 && (size_t)n < sizeof v->subtitle)
         n += snprintf(v->subtitle + n, sizeof v->subtitle - (size_t)n, ", %u circles",
                       (unsigned)circles);
@@ -595,6 +611,8 @@ int mapout_svg(FILE *f, const mapout_map *map)
         const polyc_polyline *pl = &map->lines[i];
         const char *colour = map->color_lines ? palette[i % PALETTE_SIZE] : SVG_LINE_COLOUR;
         const polyc_circle *c = circle_at(map, i);
+        if (skipped(map, i))
+            continue;
         if (c) {
             fprintf(f, "<circle stroke=\"%s\" cx=\"%.2f\" cy=\"%.2f\" r=\"%.2f\"/>\n", colour,
                     px_x(&v, (double)c->center_x_m), px_y(&v, (double)c->center_y_m),

@@ -149,8 +149,8 @@ static void arc_at(const arc *g, float t, float *x, float *y)
     *y = g->cy + g->r * s;
 }
 
-/* Do the run's points hold the arc with no stretch longer than the split
- * gap without one? */
+/* Do the run's points near the arc (within support_m) hold it with no
+ * stretch longer than the split gap without one? */
 static int arc_covered(const polyc__opt *o, const run *ru, const arc *g)
 {
     enum { BINS = 256 };
@@ -161,7 +161,10 @@ static int arc_covered(const polyc__opt *o, const run *ru, const arc *g)
     float a0 = polyc__atan2f(g->ay - g->cy, g->ax - g->cx), sweep = len / g->r;
     FOR_RUN_POINTS(o, ru, i) {
         const polyc__point *p = &o->d.pts[i];
-        float a = polyc__atan2f(p->y - g->cy, p->x - g->cx) - a0;
+        float dx = p->x - g->cx, dy = p->y - g->cy;
+        if (fabsf(sqrtf(dx * dx + dy * dy) - g->r) > o->d.support_m)
+            continue; /* (a point holds the arc only near it) */
+        float a = polyc__atan2f(dy, dx) - a0;
         a = g->sense > 0.0f ? a : -a;
         while (a < 0.0f)
             a += 6.2831853f;

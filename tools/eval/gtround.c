@@ -36,8 +36,10 @@ void gtround_params(const gtround_map *m, uint32_t *vertices, uint32_t *params, 
     *vertices = *params = *arcs = *circles = 0;
     for (uint32_t i = 0; i < c->count; i++) {
         if (c->circ && c->circ[i].radius_m > 0.0f) {
-            (*circles)++;
-            *params += 3u;
+            if (c->circ[i].same_as == i) { /* (once for the pieces of a ring) */
+                (*circles)++;
+                *params += 3u;
+            }
             continue;
         }
         const float *b = curves_bulges(c, i);

@@ -77,6 +77,7 @@ static int read_item(char *p, curves_map *m, size_t *xy_len, size_t *xy_cap, siz
         if (sscanf(p, "%f %f %f", &cc->center_x_m, &cc->center_y_m, &cc->radius_m) != 3 ||
             !(cc->radius_m > 0.0f))
             return -1;
+        cc->same_as = m->count;
         m->circles++;
         return 0;
     }

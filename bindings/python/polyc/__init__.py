@@ -136,7 +136,7 @@ class _Polyline(ctypes.Structure):
 
 class _Circle(ctypes.Structure):
     _fields_ = [("center_x_m", _f32), ("center_y_m", _f32), ("radius_m", _f32),
-                ("polyline_dev_m", _f32)]
+                ("polyline_dev_m", _f32), ("same_as", _u32)]
 
 
 class _Stats(ctypes.Structure):
@@ -753,7 +753,7 @@ class _Block:
         for i in range(_lib.polyc_polyline_count(self._ctx)):
             c = _Circle()
             self._check(_lib.polyc_get_circle(self._ctx, i, ctypes.byref(c)), "get circle")
-            if c.radius_m > 0:
+            if c.radius_m > 0 and c.same_as == i:   # (a ring in pieces: once, at the first)
                 out.append(Circle(i, (_shortest(c.center_x_m), _shortest(c.center_y_m)),
                                   _shortest(c.radius_m), _shortest(c.polyline_dev_m)))
         return out
