@@ -1,12 +1,14 @@
 /* circles.c - round things as circles (the paper's "more features than line
- * segments"): after the search, a closed polyline whose own points a circle
- * fits at a lower BIC becomes a circle, three numbers against two a vertex.
- * Takes: the optimiser at its final map (points assigned to their nearest
+ * segments"): after the search, a polyline that goes round (or the pieces
+ * of a ring the search left apart) whose own points a circle fits at a
+ * lower BIC becomes a circle, three numbers against two a vertex. Takes:
+ * the optimiser at its final map (points assigned to their nearest
  * segments, angle terms per vertex). Gives: the result's circle list
- * (ctx->flat.circ), each circle the polyline it stands for, its centre and
- * radius and how far that polyline strays from it. The polylines stay as
- * they are (what a caller that knows only vertices reads), and so do the
- * BIC and error the statistics give: those of the polylines. */
+ * (ctx->flat.circ), an entry for each polyline a circle stands for, with
+ * the circle's centre and radius, its first piece and how far that
+ * polyline strays from it. The polylines stay as they are (what a caller
+ * that knows only vertices reads), and so do the BIC and error the
+ * statistics give: those of the polylines. */
 #include "../optimize.h"
 #include "round.h"
 
