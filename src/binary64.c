@@ -15,34 +15,6 @@
 #define EXP64_MAX 0x7ffu
 #define QUIET_NAN64 (UINT64_C(0x7ff8) << 48)
 
-static uint64_t bits64(double v)
-{
-    uint64_t u;
-    memcpy(&u, &v, sizeof u);
-    return u;
-}
-
-static double double_of(uint64_t u)
-{
-    double v;
-    memcpy(&v, &u, sizeof v);
-    return v;
-}
-
-static uint32_t bits32(float v)
-{
-    uint32_t u;
-    memcpy(&u, &v, sizeof u);
-    return u;
-}
-
-static float float_of(uint32_t u)
-{
-    float v;
-    memcpy(&v, &u, sizeof v);
-    return v;
-}
-
 /* Both finite. With three bits below the last place (guard, round and a
  * sticky bit for everything shifted out) the sum rounds as if exact. */
 static uint64_t add_finite(uint64_t ua, uint64_t ub)
@@ -96,36 +68,36 @@ static uint64_t add_finite(uint64_t ua, uint64_t ub)
 
 double polyc__d_add(double a, double b)
 {
-    uint64_t ua = bits64(a), ub = bits64(b);
+    uint64_t ua = polyc__bits64(a), ub = polyc__bits64(b);
     int a_special = ((ua >> 52) & EXP64_MAX) == EXP64_MAX, b_special = ((ub >> 52) & EXP64_MAX) == EXP64_MAX;
     if (!a_special && !b_special)
-        return double_of(add_finite(ua, ub));
+        return polyc__double_of(add_finite(ua, ub));
     if ((a_special && (ua & FRAC64)) || (b_special && (ub & FRAC64)))
-        return double_of(QUIET_NAN64); /* NaN */
+        return polyc__double_of(QUIET_NAN64); /* NaN */
     if (a_special && b_special && ((ua ^ ub) & SIGN64))
-        return double_of(QUIET_NAN64); /* inf - inf */
+        return polyc__double_of(QUIET_NAN64); /* inf - inf */
     return a_special ? a : b;
 }
 
 double polyc__d_sub(double a, double b)
 {
-    return polyc__d_add(a, double_of(bits64(b) ^ SIGN64));
+    return polyc__d_add(a, polyc__double_of(polyc__bits64(b) ^ SIGN64));
 }
 
 float polyc__d_to_f(double v)
 {
-    uint64_t u = bits64(v);
+    uint64_t u = polyc__bits64(v);
     uint32_t sign = (uint32_t)(u >> 32) & 0x80000000u;
     int32_t e = (int32_t)((u >> 52) & EXP64_MAX);
     uint64_t frac = u & FRAC64;
     if (e == (int32_t)EXP64_MAX)
-        return float_of(sign | 0x7f800000u | (frac ? 0x00400000u : 0u));
+        return polyc__float_of(sign | 0x7f800000u | (frac ? 0x00400000u : 0u));
     if (e == 0)
-        return float_of(sign); /* a subnormal double is far below float's least */
+        return polyc__float_of(sign); /* a subnormal double is far below float's least */
     uint64_t m = frac | (UINT64_C(1) << 52);
     int32_t fe = e - 1023 + 127;   /* float's biased exponent */
     if (fe >= 0xff)
-        return float_of(sign | 0x7f800000u);
+        return polyc__float_of(sign | 0x7f800000u);
     int k = 29 + (fe < 1 ? 1 - fe : 0); /* bits dropped (more for a subnormal float) */
     k = k > 60 ? 60 : k;
     uint64_t q = m >> k, rem = m & ((UINT64_C(1) << k) - 1), half = UINT64_C(1) << (k - 1);
@@ -134,20 +106,20 @@ float polyc__d_to_f(double v)
     /* as in add_finite: a subnormal's field comes out 0, a carry lifts it,
      * and a carry out of the largest float gives infinity */
     uint32_t f = fe < 1 ? (uint32_t)q : ((uint32_t)(fe - 1) << 23) + (uint32_t)q;
-    return float_of(sign | f);
+    return polyc__float_of(sign | f);
 }
 
 double polyc__f_to_d(float v)
 {
-    uint32_t u = bits32(v);
+    uint32_t u = polyc__bits32(v);
     uint64_t sign = (uint64_t)(u & 0x80000000u) << 32;
     int32_t e = (int32_t)((u >> 23) & 0xffu);
     uint64_t frac = u & 0x7fffffu;
     if (e == 0xff)
-        return double_of(sign | ((uint64_t)EXP64_MAX << 52) | (frac << 29) | (frac ? QUIET_NAN64 : 0));
+        return polyc__double_of(sign | ((uint64_t)EXP64_MAX << 52) | (frac << 29) | (frac ? QUIET_NAN64 : 0));
     if (e == 0) {
         if (frac == 0)
-            return double_of(sign);
+            return polyc__double_of(sign);
         e = 1; /* a subnormal float is a normal double: its top bit hidden */
         while (!(frac & 0x800000u)) {
             frac <<= 1;
@@ -155,5 +127,5 @@ double polyc__f_to_d(float v)
         }
         frac &= 0x7fffffu;
     }
-    return double_of(sign | ((uint64_t)(e - 127 + 1023) << 52) | (frac << 29));
+    return polyc__double_of(sign | ((uint64_t)(e - 127 + 1023) << 52) | (frac << 29));
 }

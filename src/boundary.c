@@ -6,10 +6,10 @@
  * grid's origin), the map back in the caller's frame, and the BIC and
  * error figures as the API's doubles.
  * Everything else computes in float: on a Cortex-M4F (a single-precision
- * FPU) each double operation is a software call. The calls here run a few
- * times per scan, per grid or per result (the Makefile's cold list); what
- * needs no double arithmetic (the checks, the comparisons) is done on the
- * doubles' bits, exactly as the FPU would decide it. */
+ * FPU) each double operation is a software call. The sums and
+ * conversions here are binary64.c's, on the bits with integers; what
+ * needs no arithmetic (the checks, the comparisons) is done on the
+ * doubles' bits too, exactly as the FPU would decide it. */
 #include "context.h"
 
 #include <math.h>
@@ -22,29 +22,22 @@
 
 #define SIGN_BIT (UINT64_C(1) << 63)
 
-static uint64_t bits_of(double v)
-{
-    uint64_t u;
-    memcpy(&u, &v, sizeof u);
-    return u;
-}
-
 static int is_nan(double v)
 {
-    return (bits_of(v) << 1) > (UINT64_C(0x7ff) << 53); /* exponent all ones, a fraction */
+    return (polyc__bits64(v) << 1) > (UINT64_C(0x7ff) << 53); /* exponent all ones, a fraction */
 }
 
 /* |v| as an integer that orders as |v| does (infinity and NaN above every
  * finite number): `fabs(v) < lim` is magnitude(v) < magnitude(lim) */
 static uint64_t magnitude(double v)
 {
-    return bits_of(v) & ~SIGN_BIT;
+    return polyc__bits64(v) & ~SIGN_BIT;
 }
 
 /* v (not NaN) as an integer that orders as v does, -0 and +0 as 0 */
 static int64_t order(double v)
 {
-    uint64_t u = bits_of(v);
+    uint64_t u = polyc__bits64(v);
     return (u & SIGN_BIT) ? -(int64_t)(u & ~SIGN_BIT) : (int64_t)u;
 }
 

@@ -6,6 +6,8 @@
 #include "polyc.h"
 #include "tunables.h"
 
+#include <string.h>
+
 #ifndef POLYC_ASSERT
 #include <assert.h>
 #define POLYC_ASSERT(x) assert(x)
@@ -63,6 +65,31 @@ double polyc__d_add(double a, double b);
 double polyc__d_sub(double a, double b);
 float polyc__d_to_f(double v);
 double polyc__f_to_d(float v);
+/* a double's or a float's bits, and back (memcpy: no aliasing rule broken) */
+static inline uint64_t polyc__bits64(double v)
+{
+    uint64_t u;
+    memcpy(&u, &v, sizeof u);
+    return u;
+}
+static inline double polyc__double_of(uint64_t u)
+{
+    double v;
+    memcpy(&v, &u, sizeof v);
+    return v;
+}
+static inline uint32_t polyc__bits32(float v)
+{
+    uint32_t u;
+    memcpy(&u, &v, sizeof u);
+    return u;
+}
+static inline float polyc__float_of(uint32_t u)
+{
+    float v;
+    memcpy(&v, &u, sizeof v);
+    return v;
+}
 
 /* fmath.c: float sine, cosine, arc tangent, logarithm (libm's compute in
  * double on the target); angles within a few thousand turns, log of a

@@ -28,27 +28,6 @@ static uint64_t next64(void)
     return state * UINT64_C(2685821657736338717);
 }
 
-static uint64_t bits64(double v)
-{
-    uint64_t u;
-    memcpy(&u, &v, sizeof u);
-    return u;
-}
-
-static double double_of(uint64_t u)
-{
-    double v;
-    memcpy(&v, &u, sizeof v);
-    return v;
-}
-
-static uint32_t bits32(float v)
-{
-    uint32_t u;
-    memcpy(&u, &v, sizeof u);
-    return u;
-}
-
 /* a random double: any sign, an exponent near `center` (within `spread`
  * of it, clamped to the finite range, subnormals included), a random
  * fraction, sometimes with its low bits cleared (exact sums and ties) */
@@ -60,7 +39,7 @@ static double random_double(int32_t center, int32_t spread)
     uint64_t frac = r & ((UINT64_C(1) << 52) - 1);
     if ((r >> 60) == 0)
         frac &= ~((UINT64_C(1) << (next64() % 52)) - 1);
-    return double_of((r & (UINT64_C(1) << 63)) | ((uint64_t)e << 52) | frac);
+    return polyc__double_of((r & (UINT64_C(1) << 63)) | ((uint64_t)e << 52) | frac);
 }
 
 static void same_double(double got, double want)
@@ -68,7 +47,7 @@ static void same_double(double got, double want)
     if (isnan(want))
         assert_true(isnan(got));
     else
-        assert_true(bits64(got) == bits64(want));
+        assert_true(polyc__bits64(got) == polyc__bits64(want));
 }
 
 static void same_float(float got, float want)
@@ -76,7 +55,7 @@ static void same_float(float got, float want)
     if (isnan(want))
         assert_true(isnan(got));
     else
-        assert_true(bits32(got) == bits32(want));
+        assert_true(polyc__bits32(got) == polyc__bits32(want));
 }
 
 static void check_pair(double a, double b)
@@ -103,10 +82,10 @@ static void test_cancellation_and_ties(void **state_unused)
     (void)state_unused;
     for (int i = 0; i < 200000; i++) {
         double a = random_double(1023, 40);
-        uint64_t u = bits64(a);
+        uint64_t u = polyc__bits64(a);
         /* neighbours a few ulps away, either sign: the differences cancel
          * to a few bits */
-        double b = double_of(u + (next64() % 9) - 4);
+        double b = polyc__double_of(u + (next64() % 9) - 4);
         check_pair(a, b);
         check_pair(a, -b);
         /* a and half an ulp of it: a tie either way */

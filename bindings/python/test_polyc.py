@@ -357,6 +357,41 @@ class Circles(unittest.TestCase):
                                 <= c.polyline_dev + 1e-6 for x, y in line.points))
 
     def test_arc_polylines(self):
+        # a D-shaped room: a straight wall along y = 0 and a half circle of
+        # 4 m radius about the origin, seen from poses along its middle
+        scans, R = [], 4.0
+        for k in range(12):
+            px, py = -2.0 + 4.0 * k / 11, 1.5
+            for th in (0.0, math.pi):
+                ranges = []
+                for i in range(361):
+                    b = th - math.pi / 2 + i * math.pi / 360
+                    dx, dy = math.cos(b), math.sin(b)
+                    bb = dx * px + dy * py
+                    t = -bb + math.sqrt(bb * bb - (px * px + py * py - R * R))
+                    if py + t * dy < 0:            # the straight wall first
+                        t = -py / dy
+                    ranges.append(round(t, 3))
+                scans.append(((px, py, th), -math.pi / 2, math.pi / 360, 0.02, 20.0, ranges))
+        ctx = polyc.Context((len(scans), 361 * len(scans), 1 << 20, 0))
+        for s in scans:
+            ctx.add_scan(*s)
+        ctx.build()
+        bent = 0
+        for a in ctx.arc_polylines():
+            pts = a.points.tolist()
+            for k, b in enumerate(a.bulges):
+                if b == 0:
+                    continue
+                bent += 1
+                # the arc's middle lies on the true half circle (within 1 cm)
+                (x0, y0), (x1, y1) = pts[k], pts[(k + 1) % len(pts)]
+                c = math.hypot(x1 - x0, y1 - y0)
+                s = b * c / 2                      # the sagitta, to the right of the chord
+                mx = (x0 + x1) / 2 + s * (y1 - y0) / c
+                my = (y0 + y1) / 2 - s * (x1 - x0) / c
+                self.assertLess(abs(math.hypot(mx, my) - R), 0.01, (pts[k], b))
+        self.assertGreaterEqual(bent, 1)
         scans = pillar_scans()
         ctx = polyc.Context((len(scans), 361 * len(scans), 1 << 20, 0))
         for s in scans:

@@ -403,9 +403,10 @@ static int segment_off(const gtscore_truth *truth, const float *a, const float *
 /* The scene's true walls, the robot's path, its people and the map (a
  * segment in red where it strays over 5 cm from every true wall). */
 static int write_svg(const char *path, const scansim_scene *sc, const gtscore_truth *truth,
-                     const polyc_polyline *lines, uint32_t count,
-                     const polyc_occupancy_grid *grid)
+                     const map_view *m, const polyc_occupancy_grid *grid)
 {
+    const polyc_polyline *lines = m->scored;
+    uint32_t count = m->count;
     double x0 = HUGE_VAL, y0 = HUGE_VAL, x1 = -HUGE_VAL, y1 = -HUGE_VAL;
     uint32_t i, j, w;
     FILE *f = fopen(path, "w");
@@ -463,9 +464,13 @@ static int write_svg(const char *path, const scansim_scene *sc, const gtscore_tr
                     (double)a[0], -(double)a[1], (double)b[0], -(double)b[1],
                     segment_off(truth, a, b) ? "#e00" : "black");
         }
-        for (j = 0; j < l->point_count; j++)
+        /* a dot on every vertex of the map as the library gives it (its arc
+         * form; none on a circle), not on the curves' scoring points */
+        const polyc_polyline *v = &m->map.lines[i];
+        int circle = m->map.circ && m->map.circ[i].radius_m > 0.0f;
+        for (j = 0; !circle && j < v->point_count; j++)
             fprintf(f, "<circle cx=\"%.4f\" cy=\"%.4f\" r=\"0.03\" fill=\"black\"/>\n",
-                    (double)l->xy_m[2u * j], -(double)l->xy_m[2u * j + 1u]);
+                    (double)v->xy_m[2u * j], -(double)v->xy_m[2u * j + 1u]);
     }
     fprintf(f, "</svg>\n");
     {
@@ -665,7 +670,7 @@ static int sweep_scene(const options *o, const char *kind, uint64_t seed, row *r
                  kind, (unsigned long long)seed);
         if (o->save_dir && scansim_save(&sc, log_path, gt_path) != 0)
             fprintf(stderr, "sweep: cannot write %s: %s\n", log_path, strerror(errno));
-        if (o->svg_dir && write_svg(svg_path, &sc, &truth, m.scored, m.count,
+        if (o->svg_dir && write_svg(svg_path, &sc, &truth, &m,
                                     o->occupancy ? &grid : NULL) != 0)
             fprintf(stderr, "sweep: cannot write %s: %s\n", svg_path, strerror(errno));
     }
